@@ -1,0 +1,85 @@
+//! Forward kinematics of the chain (paper Eq. 2, ARC-MODEL.md):
+//! `p_{i+1} = p_i - l * [cos(psi_i) cos(theta_i), sin(psi_i) cos(theta_i), -sin(theta_i)]`.
+
+use nalgebra::Vector3;
+
+use crate::params::{ChainParams, MAX_UNITS};
+use crate::shape::{Config, Shape};
+
+/// Unit centres of a chain, head first; only the first N entries are meaningful.
+pub type Points = [Vector3<f32>; MAX_UNITS];
+
+/// Unit vector along link `k` from its front unit towards its back unit is the
+/// NEGATIVE of this direction: `d = [cos psi cos theta, sin psi cos theta, -sin theta]`.
+pub fn link_direction(pitch: f32, yaw: f32) -> Vector3<f32> {
+    let (st, ct) = libm::sincosf(pitch);
+    let (sp, cp) = libm::sincosf(yaw);
+    Vector3::new(cp * ct, sp * ct, -st)
+}
+
+/// Unit centres relative to the head (`offsets[0]` is zero).
+pub fn offsets(params: &ChainParams, shape: &Shape) -> Points {
+    let mut p = [Vector3::zeros(); MAX_UNITS];
+    for k in 0..shape.links() {
+        p[k + 1] = p[k] - params.link_length * link_direction(shape.pitch(k), shape.yaw(k));
+    }
+    p
+}
+
+/// Unit centres in the world frame.
+pub fn positions(params: &ChainParams, config: &Config) -> Points {
+    let head = Vector3::from(config.xi);
+    let mut p = offsets(params, &config.shape);
+    for q in p.iter_mut().take(config.shape.units()) {
+        *q += head;
+    }
+    p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::angle::deg;
+
+    fn close(a: Vector3<f32>, b: [f32; 3]) -> bool {
+        (a - Vector3::from(b)).norm() < 1e-5
+    }
+
+    #[test]
+    fn zero_angles_trail_along_minus_x() {
+        let p = ChainParams::new(3);
+        let c = Config {
+            xi: [1.0, 2.0, 3.0],
+            shape: Shape::line(3, 0.0),
+        };
+        let q = positions(&p, &c);
+        assert!(close(q[0], [1.0, 2.0, 3.0]));
+        assert!(close(q[1], [0.5, 2.0, 3.0]));
+        assert!(close(q[2], [0.0, 2.0, 3.0]));
+    }
+
+    #[test]
+    fn hand_computed_pitch_and_yaw() {
+        let p = ChainParams::new(3);
+        // Link 1: yaw 90 deg -> back unit at -y. Link 2: pitch 30 deg, yaw 0 ->
+        // back unit behind along -x and ABOVE (z grows by l sin 30 = 0.25).
+        let s = Shape::from_slice(3, &[0.0, 0.0, deg(90.0), deg(30.0), 0.0]).unwrap();
+        let q = offsets(&p, &s);
+        assert!(close(q[1], [0.0, -0.5, 0.0]));
+        let c30 = 0.5 * libm::cosf(deg(30.0));
+        assert!(close(q[2], [-c30, -0.5, 0.25]));
+    }
+
+    #[test]
+    fn links_keep_their_length() {
+        let p = ChainParams::new(16);
+        let mut s = Shape::line(16, 0.0);
+        for k in 0..15 {
+            s.set_link(k, 0.1 * k as f32 - 0.7, 0.37 * k as f32);
+        }
+        let q = offsets(&p, &s);
+        for k in 0..15 {
+            assert!(((q[k] - q[k + 1]).norm() - 0.5).abs() < 1e-5);
+        }
+    }
+}

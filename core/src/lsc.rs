@@ -1,0 +1,1 @@
+//! Library of shape configurations (being written).

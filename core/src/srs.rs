@@ -1,0 +1,1 @@
+//! Set of random shapes (being written).

@@ -1,0 +1,11 @@
+//! # arc-host-sim: the Aerial Robotic Chain on the host
+//!
+//! Maps (OctoMap `.bt` files, occupancy grids, distance fields, scenario
+//! generators), collision of the chain against a map, the ARCplanner, the chain's
+//! simulation, plan files and pictures, and the `arc` command line.
+//! The contract everything here follows is `shared/ARC-MODEL.md`.
+
+pub mod cli;
+pub mod fsutil;
+pub mod map;
+pub mod plan;

@@ -1,0 +1,1 @@
+//! Maps: OctoMap files, occupancy grids, distance fields and scenario generators.
