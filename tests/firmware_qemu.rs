@@ -1,0 +1,460 @@
+//! The unit firmware (`firmware-sketch/`) built for thumbv7em-none-eabihf and run
+//! in QEMU (netduinoplus2, an STM32F405), its defmt output decoded by
+//! `defmt-print`:
+//!
+//! - with the table its build script generates: the table is valid, every
+//!   scripted "go to shape k" settles within tolerance and time, the stack peak
+//!   is within budget, and the firmware exits with success;
+//! - with that table corrupted (feature `corrupt-table`): safe mode, every shape
+//!   command refused, attitude held, exit failure;
+//! - with a table file made on the host (`ARC_TABLE`, as `arc tables build`
+//!   writes them): accepted when it is for this chain, refused as a chain
+//!   mismatch when it is for another.
+//!
+//! When `qemu-system-arm` or `defmt-print` is missing the tests say so on stderr
+//! and pass without running (`.ci/run` installs both, so CI runs them for real).
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus, Stdio};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use arc_core::lsc::library;
+use arc_core::srs::{Srs, SrsSettings};
+use arc_core::table::encode_into;
+use arc_core::ChainParams;
+use arc_tests::{cargo, workspace_root};
+
+/// Builds share one target folder and one output path: one at a time.
+static BUILD: Mutex<()> = Mutex::new(());
+
+/// Longest a firmware run may take in QEMU.
+const QEMU_TIMEOUT: Duration = Duration::from_secs(120);
+/// Stack budget (bytes).
+const STACK_BUDGET: u64 = 8 * 1024;
+/// Settle tolerance the firmware uses (degrees).
+const TOLERANCE_DEG: f64 = 0.5;
+
+/// The `defmt-print` to use: on PATH, else in cargo's bin folder.
+fn defmt_print() -> Option<PathBuf> {
+    let mut candidates = vec![PathBuf::from("defmt-print")];
+    if let Some(home) = std::env::var_os("CARGO_HOME") {
+        candidates.push(Path::new(&home).join("bin/defmt-print"));
+    }
+    if let Some(home) = std::env::var_os("HOME") {
+        candidates.push(Path::new(&home).join(".cargo/bin/defmt-print"));
+    }
+    candidates.into_iter().find(|c| {
+        let mut probe = Command::new(c);
+        probe.arg("-V");
+        runs(probe)
+    })
+}
+
+/// Whether a command starts and exits with success (its output discarded).
+fn runs(mut c: Command) -> bool {
+    c.stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// Says on the real stderr (not the test harness's captured one, so the message
+/// shows even when the test passes) that `test` is skipped and why.
+fn skip(test: &str, why: &str) {
+    let _ = writeln!(
+        std::io::stderr(),
+        "SKIPPED {test}: {why}; the firmware was not run in QEMU"
+    );
+}
+
+/// The tools, or None after saying on stderr why the test is skipped.
+fn tools(test: &str) -> Option<PathBuf> {
+    let mut probe = Command::new("qemu-system-arm");
+    probe.arg("--version");
+    if !runs(probe) {
+        skip(
+            test,
+            "qemu-system-arm not found (apt-get install qemu-system-arm)",
+        );
+        return None;
+    }
+    let Some(dp) = defmt_print() else {
+        skip(test, "defmt-print not found (cargo install defmt-print)");
+        return None;
+    };
+    Some(dp)
+}
+
+/// Builds the firmware with `features` and build environment `env`, and copies
+/// the ELF to `target/firmware/qemu-tests/<name>.elf`.
+fn build(name: &str, features: &[&str], env: &[(&str, &str)]) -> PathBuf {
+    let _guard = BUILD.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = workspace_root().join("firmware-sketch");
+    let mut c = cargo("firmware");
+    c.current_dir(&dir).args(["build", "--release"]);
+    if !features.is_empty() {
+        c.args(["--features", &features.join(",")]);
+    }
+    for v in [
+        "RUSTFLAGS",
+        "CARGO_ENCODED_RUSTFLAGS",
+        "CARGO_BUILD_RUSTFLAGS",
+        "CARGO_BUILD_TARGET",
+        "ARC_TABLE",
+        "ARC_N_SRS",
+        "ARC_SEED",
+    ] {
+        c.env_remove(v);
+    }
+    c.env("DEFMT_LOG", "info")
+        .env("ARC_UNITS", "6")
+        .env("ARC_UNIT", "2");
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    let out = c.output().expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "firmware build `{name}` failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let built = workspace_root().join("target/firmware/thumbv7em-none-eabihf/release/arc-firmware");
+    let dest_dir = workspace_root().join("target/firmware/qemu-tests");
+    std::fs::create_dir_all(&dest_dir).expect("create qemu-tests folder");
+    let dest = dest_dir.join(format!("{name}.elf"));
+    std::fs::copy(&built, &dest).expect("copy firmware ELF");
+    dest
+}
+
+/// A run's decoded log and exit status.
+struct Run {
+    status: ExitStatus,
+    log: String,
+}
+
+impl Run {
+    fn lines_with<'a>(&'a self, needle: &'a str) -> impl Iterator<Item = &'a str> + 'a {
+        self.log.lines().filter(move |l| l.contains(needle))
+    }
+
+    fn has(&self, needle: &str) -> bool {
+        self.lines_with(needle).next().is_some()
+    }
+
+    fn context(&self) -> String {
+        format!("exit status {:?}; decoded log:\n{}", self.status, self.log)
+    }
+}
+
+/// Boots `elf` in QEMU and decodes its defmt frames with `defmt-print`.
+fn run(elf: &Path, defmt_print: &Path) -> Run {
+    let mut qemu = Command::new("qemu-system-arm")
+        .args([
+            "-cpu",
+            "cortex-m4",
+            "-machine",
+            "netduinoplus2",
+            "-nographic",
+        ])
+        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("qemu-system-arm starts");
+    let frames = qemu.stdout.take().expect("piped");
+    let mut decoder = Command::new(defmt_print)
+        .arg("-e")
+        .arg(elf)
+        .stdin(Stdio::from(frames))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("defmt-print starts");
+    let mut decoded = decoder.stdout.take().expect("piped");
+    let reader = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = decoded.read_to_string(&mut s);
+        s
+    });
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = qemu.try_wait().expect("wait for qemu") {
+            break s;
+        }
+        if start.elapsed() > QEMU_TIMEOUT {
+            let _ = qemu.kill();
+            let _ = decoder.kill();
+            let log = reader.join().unwrap_or_default();
+            panic!(
+                "firmware {} still running after {QEMU_TIMEOUT:?}; log so far:\n{log}",
+                elf.display()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let _ = decoder.wait();
+    let mut log = reader.join().expect("reader thread");
+    let mut err = String::new();
+    if let Some(mut e) = qemu.stderr.take() {
+        let _ = e.read_to_string(&mut err);
+    }
+    if !err.trim().is_empty() {
+        log.push_str("\n[qemu stderr] ");
+        log.push_str(&err);
+    }
+    Run { status, log }
+}
+
+/// The number after `key` in `line` (e.g. `key = "in "` in "settled ... in 2.1 s").
+fn number_after(line: &str, key: &str) -> f64 {
+    let rest = &line[line
+        .find(key)
+        .unwrap_or_else(|| panic!("no {key:?} in {line:?}"))
+        + key.len()..];
+    let end = rest
+        .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e'))
+        .unwrap_or(rest.len());
+    rest[..end]
+        .parse()
+        .unwrap_or_else(|_| panic!("no number after {key:?} in {line:?}"))
+}
+
+/// Common checks of a run that must not have crashed.
+fn assert_clean(r: &Run) {
+    assert!(!r.has("panic"), "firmware panicked; {}", r.context());
+    assert!(!r.has("hard fault"), "firmware faulted; {}", r.context());
+    let stack = r
+        .lines_with("stack peak")
+        .next()
+        .unwrap_or_else(|| panic!("no stack report; {}", r.context()));
+    let peak = number_after(stack, "stack peak ") as u64;
+    assert!(
+        peak > 0 && peak <= STACK_BUDGET,
+        "stack peak {peak} B over {STACK_BUDGET} B; {}",
+        r.context()
+    );
+}
+
+/// Checks a run that must have reached every target; returns the shapes visited.
+fn assert_mission_success(r: &Run, srs: u64) -> Vec<u64> {
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "firmware did not exit with success; {}",
+        r.context()
+    );
+    assert_clean(r);
+    let summary = r
+        .lines_with("table valid:")
+        .next()
+        .unwrap_or_else(|| panic!("no table summary; {}", r.context()));
+    assert!(summary.contains("format v1"), "{summary}");
+    assert!(summary.contains("chain N=6"), "{summary}");
+    assert!(
+        summary.contains(&format!("6 LSC + {srs} SRS shapes")),
+        "{summary}"
+    );
+    assert!(
+        !r.has("SAFE MODE"),
+        "valid table took safe mode; {}",
+        r.context()
+    );
+    assert!(
+        !r.has("NOT settled"),
+        "a target was missed; {}",
+        r.context()
+    );
+
+    let commanded: Vec<u64> = r
+        .lines_with("go to shape")
+        .map(|l| number_after(l, "go to shape ") as u64)
+        .collect();
+    let settles: Vec<&str> = r.lines_with("settled shape").collect();
+    let settled: Vec<u64> = settles
+        .iter()
+        .map(|l| number_after(l, "settled shape ") as u64)
+        .collect();
+    assert!(commanded.len() >= 7, "too few commands; {}", r.context());
+    assert_eq!(
+        settled,
+        commanded,
+        "every command must settle, in order; {}",
+        r.context()
+    );
+    let total = number_after(
+        r.lines_with("command 1/").next().expect("first command"),
+        "command 1/",
+    ) as usize;
+    assert_eq!(
+        commanded.len(),
+        total,
+        "commands logged vs announced; {}",
+        r.context()
+    );
+    for k in 0..6 {
+        assert!(
+            commanded.contains(&k),
+            "LSC shape {k} never commanded; {}",
+            r.context()
+        );
+    }
+    assert!(
+        commanded.iter().any(|&k| k >= 6),
+        "no SRS shape commanded; {}",
+        r.context()
+    );
+    for l in &settles {
+        let t = number_after(l, " in ");
+        let e = number_after(l, "final error ");
+        assert!(t > 0.0 && t < 6.0, "settle time {t} s out of range: {l}");
+        assert!(
+            e.abs() < TOLERANCE_DEG,
+            "final error {e} deg over tolerance: {l}"
+        );
+    }
+    let done = format!("all {total} targets reached");
+    assert!(
+        r.has(&done) && r.has("exit success"),
+        "no success report; {}",
+        r.context()
+    );
+    commanded
+}
+
+/// Checks a run that must have refused its table with `reason` and held attitude.
+fn assert_safe_mode(r: &Run, reason: &str) {
+    assert_eq!(
+        r.status.code(),
+        Some(1),
+        "safe mode must exit with failure (1); {}",
+        r.context()
+    );
+    assert_clean(r);
+    assert!(
+        !r.has("table valid"),
+        "corrupt table accepted; {}",
+        r.context()
+    );
+    let why = r
+        .lines_with("SAFE MODE: table rejected")
+        .next()
+        .unwrap_or_else(|| panic!("no safe-mode report; {}", r.context()));
+    assert!(
+        why.contains(reason),
+        "safe mode for another reason than {reason}: {why}"
+    );
+    let refused = r.lines_with("refused go to shape").count();
+    assert!(refused >= 7, "shape commands not refused; {}", r.context());
+    assert!(
+        r.lines_with("refused go to shape")
+            .all(|l| l.contains(reason)),
+        "{}",
+        r.context()
+    );
+    assert_eq!(
+        r.lines_with("holding attitude").count(),
+        refused,
+        "{}",
+        r.context()
+    );
+    assert!(
+        !r.has("settled shape"),
+        "a shape was flown in safe mode; {}",
+        r.context()
+    );
+    let held = r
+        .lines_with("attitude held within")
+        .next()
+        .unwrap_or_else(|| panic!("no hold report; {}", r.context()));
+    let e = number_after(held, "held within ");
+    assert!(e < TOLERANCE_DEG, "attitude not held: {held}");
+    assert!(
+        r.has("safe mode: no target reached: exit failure"),
+        "{}",
+        r.context()
+    );
+}
+
+#[test]
+fn firmware_reaches_every_commanded_shape() {
+    let Some(dp) = tools("firmware_reaches_every_commanded_shape") else {
+        return;
+    };
+    let elf = build("valid", &[], &[("ARC_N_SRS", "100")]);
+    let r = run(&elf, &dp);
+    assert_mission_success(&r, 100);
+}
+
+#[test]
+fn corrupted_table_puts_the_unit_in_safe_mode() {
+    let Some(dp) = tools("corrupted_table_puts_the_unit_in_safe_mode") else {
+        return;
+    };
+    let elf = build("corrupt", &["corrupt-table"], &[("ARC_N_SRS", "100")]);
+    let r = run(&elf, &dp);
+    assert_safe_mode(&r, "CrcMismatch");
+}
+
+/// A table file written on the host, as `arc tables build` does.
+fn host_table(units: u8, count: usize, name: &str) -> PathBuf {
+    let p = ChainParams::new(units);
+    let lib = library(&p);
+    let srs = Srs::<64, 8>::generate(p, &SrsSettings::new(count, 7)).expect("srs");
+    let mut buf = vec![0u8; 64 * 1024];
+    let len = encode_into(&mut buf, &p, &lib.entries, &srs.shapes, &srs.adjacency).expect("encode");
+    let dir = workspace_root().join("target/firmware/qemu-tests");
+    std::fs::create_dir_all(&dir).expect("create qemu-tests folder");
+    let path = dir.join(name);
+    std::fs::write(&path, &buf[..len]).expect("write table");
+    path
+}
+
+#[test]
+fn host_written_tables_are_checked_against_the_unit_chain() {
+    let Some(dp) = tools("host_written_tables_are_checked_against_the_unit_chain") else {
+        return;
+    };
+    // For this chain (N = 6), with 64 SRS shapes: the script's SRS shape 105 is
+    // not there, so that command is refused and the run fails, but the table is
+    // accepted and every shape it has is reached.
+    let own = host_table(6, 64, "host-n6.table");
+    let elf = build(
+        "host-n6",
+        &[],
+        &[("ARC_TABLE", own.to_str().expect("utf-8 path"))],
+    );
+    let r = run(&elf, &dp);
+    assert_clean(&r);
+    assert!(
+        r.has("table valid: format v1, chain N=6"),
+        "{}",
+        r.context()
+    );
+    assert!(r.has("6 LSC + 64 SRS shapes"), "{}", r.context());
+    assert!(
+        r.has("go to shape 105 refused: NoSuchShape"),
+        "{}",
+        r.context()
+    );
+    assert!(!r.has("NOT settled"), "{}", r.context());
+    assert_eq!(
+        r.status.code(),
+        Some(1),
+        "a refused command must fail the run; {}",
+        r.context()
+    );
+
+    // For another chain (N = 5): refused before any command is flown.
+    let other = host_table(5, 16, "host-n5.table");
+    let elf = build(
+        "host-n5",
+        &[],
+        &[("ARC_TABLE", other.to_str().expect("utf-8 path"))],
+    );
+    let r = run(&elf, &dp);
+    assert_safe_mode(&r, "ChainMismatch");
+}
