@@ -152,10 +152,15 @@ pub fn orthonormalize(r: &Mat3) -> Mat3 {
             None => Vec3::x(),
         },
     };
-    let y = match normalized(&(y1 - x * x.dot(&y1))) {
-        Some(y) => y,
-        None => any_perpendicular(&x),
+    // Gram-Schmidt twice ("twice is enough"): one pass loses orthogonality when y1 is
+    // nearly parallel to x; below 1e-4 of its length the remainder is noise.
+    let y2 = y1 - x * x.dot(&y1);
+    let y = if y2.norm() > 1e-4 * y1.norm() {
+        normalized(&y2).unwrap_or_else(|| any_perpendicular(&x))
+    } else {
+        any_perpendicular(&x)
     };
+    let y = normalized(&(y - x * x.dot(&y))).unwrap_or_else(|| any_perpendicular(&x));
     let z = x.cross(&y);
     Mat3::from_columns(&[x, y, z])
 }
@@ -453,7 +458,7 @@ pub fn step_attitude(
             Vec3::zeros()
         },
     };
-    if !(dt.is_finite() && dt > 0.0) || !all_finite3(moment) || !all_finite3(&state.w) {
+    if !(dt.is_finite() && dt > 0.0 && all_finite3(moment) && all_finite3(&state.w)) {
         return unchanged;
     }
     let Some(j_inv) = inertia.try_inverse() else {
