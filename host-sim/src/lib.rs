@@ -6,6 +6,7 @@
 //! The contract everything here follows is `shared/ARC-MODEL.md`.
 
 pub mod cli;
+pub mod collision;
 pub mod fsutil;
 pub mod map;
 pub mod plan;

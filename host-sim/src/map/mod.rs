@@ -1,1 +1,3 @@
 //! Maps: OctoMap files, occupancy grids, distance fields and scenario generators.
+pub mod distance;
+pub mod grid;

@@ -1,0 +1,364 @@
+//! Exact distances from the chain's bodies to the map's obstacle cubes, in `f64`, for
+//! verification. Independent of the distance field: the obstacle voxels near a body are
+//! enumerated from the [`Grid`] and measured one by one.
+
+use arc_core::validity::{check_shape, Body, Violation};
+use arc_core::{ChainParams, Shape};
+
+use crate::map::grid::Grid;
+
+/// Distance from point `p` to the closed box `lo..hi`.
+pub fn point_box_distance(p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> f64 {
+    let mut s = 0.0;
+    for a in 0..3 {
+        let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
+        s += d * d;
+    }
+    s.sqrt()
+}
+
+/// Exact distance from the segment `a b` to the closed box `lo..hi`.
+///
+/// The squared distance along the segment, `f(t) = sum_axis dist(a + t (b - a), slab)^2`,
+/// is convex and piecewise quadratic in `t`; its pieces change only where a coordinate
+/// crosses a slab face (at most six parameters). On each piece the minimiser of the
+/// quadratic is found in closed form and clamped to the piece, so the global minimum is
+/// the smallest of these candidates and the piece ends.
+pub fn segment_box_distance(a: [f64; 3], b: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let mut ts = [0.0f64; 8];
+    let mut n = 0;
+    ts[n] = 0.0;
+    n += 1;
+    ts[n] = 1.0;
+    n += 1;
+    for ax in 0..3 {
+        if d[ax] != 0.0 {
+            for bound in [lo[ax], hi[ax]] {
+                let t = (bound - a[ax]) / d[ax];
+                if t > 0.0 && t < 1.0 {
+                    ts[n] = t;
+                    n += 1;
+                }
+            }
+        }
+    }
+    let ts = &mut ts[..n];
+    ts.sort_by(|x, y| x.total_cmp(y));
+    let f = |t: f64| -> f64 {
+        let mut s = 0.0;
+        for ax in 0..3 {
+            let x = a[ax] + t * d[ax];
+            let e = (lo[ax] - x).max(x - hi[ax]).max(0.0);
+            s += e * e;
+        }
+        s
+    };
+    let mut best = f(0.0).min(f(1.0));
+    for w in ts.windows(2) {
+        let (t0, t1) = (w[0], w[1]);
+        if t1 <= t0 {
+            continue;
+        }
+        // Which face is active on this piece: decided at its midpoint.
+        let tm = 0.5 * (t0 + t1);
+        let (mut num, mut den) = (0.0, 0.0);
+        for ax in 0..3 {
+            let x = a[ax] + tm * d[ax];
+            let c = if x < lo[ax] {
+                a[ax] - lo[ax]
+            } else if x > hi[ax] {
+                a[ax] - hi[ax]
+            } else {
+                continue;
+            };
+            num += c * d[ax];
+            den += d[ax] * d[ax];
+        }
+        let t = if den > 0.0 {
+            (-num / den).clamp(t0, t1)
+        } else {
+            t0
+        };
+        best = best.min(f(t)).min(f(t0)).min(f(t1));
+    }
+    best.sqrt()
+}
+
+/// Distance from point `p` to the segment `a b` (f64).
+pub fn point_segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+    let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let ap = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+    let len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+    let t = if len2 > 0.0 {
+        ((ap[0] * ab[0] + ap[1] * ab[1] + ap[2] * ab[2]) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let q = [
+        a[0] + t * ab[0] - p[0],
+        a[1] + t * ab[1] - p[1],
+        a[2] + t * ab[2] - p[2],
+    ];
+    (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt()
+}
+
+/// The nearest obstacle cube to a body found within a search radius.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Nearest {
+    /// Exact distance from the body's core (centre point or segment) to the cube (m).
+    pub distance: f64,
+    /// Centre of that obstacle voxel (m).
+    pub voxel: [f64; 3],
+}
+
+/// Nearest obstacle cube to the segment `a b` (a point when `a == b`) among those at
+/// distance `<= reach`; `None` when every obstacle cube is farther than `reach`.
+/// Exact: every voxel intersecting the segment's bounding box grown by `reach` is
+/// examined (a voxel outside it is more than `reach` away along some axis), including
+/// voxels outside the grid (unknown, obstacles when unknown space counts as occupied).
+pub fn nearest_obstacle(grid: &Grid, a: [f64; 3], b: [f64; 3], reach: f64) -> Option<Nearest> {
+    if !(reach.is_finite() && reach >= 0.0) || a.iter().chain(b.iter()).any(|v| !v.is_finite()) {
+        return None;
+    }
+    let r = grid.resolution();
+    let mut lo = [0i64; 3];
+    let mut hi = [0i64; 3];
+    for ax in 0..3 {
+        let (mn, mx) = (a[ax].min(b[ax]) - reach, a[ax].max(b[ax]) + reach);
+        // Voxel i spans [i r, (i + 1) r]: it touches [mn, mx] when i r <= mx and (i+1) r >= mn.
+        lo[ax] = (mn / r).floor() as i64 - 1;
+        hi[ax] = (mx / r).floor() as i64 + 1;
+    }
+    let point = a == b;
+    let half_diag = 0.5 * r * 3f64.sqrt();
+    let mut best: Option<Nearest> = None;
+    for z in lo[2]..=hi[2] {
+        for y in lo[1]..=hi[1] {
+            for x in lo[0]..=hi[0] {
+                let i = [x as i32, y as i32, z as i32];
+                if !grid.is_obstacle(i) {
+                    continue;
+                }
+                let c = grid.voxel_center(i);
+                // Cheap rejection by the centre's distance.
+                let dc = if point {
+                    let e = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+                    (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
+                } else {
+                    point_segment_distance(c, a, b)
+                };
+                let limit = best.map_or(reach, |n| n.distance.min(reach));
+                if dc - half_diag > limit {
+                    continue;
+                }
+                let vlo = [c[0] - 0.5 * r, c[1] - 0.5 * r, c[2] - 0.5 * r];
+                let vhi = [c[0] + 0.5 * r, c[1] + 0.5 * r, c[2] + 0.5 * r];
+                let d = if point {
+                    point_box_distance(a, vlo, vhi)
+                } else {
+                    segment_box_distance(a, b, vlo, vhi)
+                };
+                if d <= limit && best.is_none_or(|n| d < n.distance) {
+                    best = Some(Nearest {
+                        distance: d,
+                        voxel: c,
+                    });
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Unit centres of a chain in `f64` (paper Eq. 2), from a head position and the shape
+/// angles `eta` (`2N - 1` numbers; only the link pitches and yaws matter).
+pub fn positions_f64(link_length: f64, head: [f64; 3], eta: &[f64]) -> Vec<[f64; 3]> {
+    let links = eta.len().saturating_sub(1) / 2;
+    let mut p = Vec::with_capacity(links + 1);
+    p.push(head);
+    for k in 0..links {
+        let (th, ps) = (eta[1 + 2 * k], eta[2 + 2 * k]);
+        let q = p[k];
+        p.push([
+            q[0] - link_length * ps.cos() * th.cos(),
+            q[1] - link_length * ps.sin() * th.cos(),
+            q[2] + link_length * th.sin(),
+        ]);
+    }
+    p
+}
+
+/// Why a configuration is invalid by the exact test.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ExactViolation {
+    /// Limits or self-collision (ARC-MODEL.md items 1-2), by the core's checks.
+    Shape(Violation),
+    /// A unit centre lies outside the map's bounding box (item 4).
+    OutOfBounds {
+        /// The unit.
+        body: Body,
+        /// Its centre (m).
+        point: [f64; 3],
+    },
+    /// A body is within its radius of an obstacle cube (item 3).
+    Map {
+        /// The body.
+        body: Body,
+        /// Its distance to the cube minus its radius (m, <= 0).
+        clearance: f64,
+        /// Centre of the obstacle voxel (m).
+        voxel: [f64; 3],
+    },
+    /// The shape angles are not a valid `eta` for the chain.
+    BadShape,
+}
+
+impl std::fmt::Display for ExactViolation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ExactViolation::Shape(v) => write!(f, "{v}"),
+            ExactViolation::OutOfBounds { body, point } => write!(
+                f,
+                "{body} centre ({:.3}, {:.3}, {:.3}) is outside the map's bounds",
+                point[0], point[1], point[2]
+            ),
+            ExactViolation::Map {
+                body,
+                clearance,
+                voxel,
+            } => write!(
+                f,
+                "{body} touches the obstacle voxel at ({:.3}, {:.3}, {:.3}) (clearance {:.4} m)",
+                voxel[0], voxel[1], voxel[2], clearance
+            ),
+            ExactViolation::BadShape => {
+                f.write_str("the shape angles are not finite or have the wrong count")
+            }
+        }
+    }
+}
+
+/// The exact test's findings for one valid configuration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExactClearance {
+    /// Smallest (distance to an obstacle cube - radius) over all bodies (m), capped at
+    /// the search horizon.
+    pub clearance: f64,
+    /// The body with that clearance.
+    pub body: Body,
+}
+
+/// The exact validity test of one configuration (ARC-MODEL.md "Validity of one
+/// configuration"), in `f64` for positions; limits and self-collision use the core's
+/// `f32` checks on the shape rounded to `f32`. `horizon` (m) caps how far beyond a
+/// body's radius obstacles are searched: the clearance reported is `min(true, horizon)`.
+pub fn check_config_exact(
+    grid: &Grid,
+    params: &ChainParams,
+    head: [f64; 3],
+    eta: &[f64],
+    horizon: f64,
+) -> Result<ExactClearance, ExactViolation> {
+    let n = params.n();
+    if eta.len() != 2 * n - 1 || eta.iter().chain(head.iter()).any(|v| !v.is_finite()) {
+        return Err(ExactViolation::BadShape);
+    }
+    let mut e32 = [0f32; arc_core::MAX_SHAPE_DIM];
+    for (d, s) in e32.iter_mut().zip(eta) {
+        *d = *s as f32;
+    }
+    let shape =
+        Shape::from_slice(params.units, &e32[..eta.len()]).map_err(|_| ExactViolation::BadShape)?;
+    check_shape(params, &shape).map_err(ExactViolation::Shape)?;
+    let p = positions_f64(params.link_length as f64, head, eta);
+    for (i, q) in p.iter().enumerate() {
+        if !grid.in_bounds(*q) {
+            return Err(ExactViolation::OutOfBounds {
+                body: Body::Unit(i as u8),
+                point: *q,
+            });
+        }
+    }
+    let horizon = horizon.max(0.0);
+    let mut best = ExactClearance {
+        clearance: horizon,
+        body: Body::Unit(0),
+    };
+    let bodies = (0..n)
+        .map(|i| (Body::Unit(i as u8), p[i], p[i], params.unit_radius as f64))
+        .chain((0..n - 1).map(|k| {
+            (
+                Body::Link(k as u8),
+                p[k],
+                p[k + 1],
+                params.link_radius as f64,
+            )
+        }));
+    for (body, a, b, radius) in bodies {
+        if let Some(near) = nearest_obstacle(grid, a, b, radius + horizon) {
+            let c = near.distance - radius;
+            if near.distance <= radius {
+                return Err(ExactViolation::Map {
+                    body,
+                    clearance: c,
+                    voxel: near.voxel,
+                });
+            }
+            if c < best.clearance {
+                best = ExactClearance { clearance: c, body };
+            }
+        }
+    }
+    Ok(best)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn box_distances_by_hand() {
+        let (lo, hi) = ([0.0; 3], [1.0; 3]);
+        assert_eq!(point_box_distance([0.5, 0.5, 0.5], lo, hi), 0.0);
+        assert!((point_box_distance([2.0, 0.5, 0.5], lo, hi) - 1.0).abs() < 1e-12);
+        assert!((point_box_distance([2.0, 2.0, 0.5], lo, hi) - 2f64.sqrt()).abs() < 1e-12);
+        // A segment passing diagonally above an edge.
+        let d = segment_box_distance([-1.0, 2.0, 0.5], [2.0, -1.0, 0.5], lo, hi);
+        // The line x + y = 1 passes through the box's face diagonal: distance 0.
+        assert!(d.abs() < 1e-12);
+        let d = segment_box_distance([-1.0, 3.0, 0.5], [3.0, -1.0, 0.5], lo, hi);
+        // x + y = 2: closest to corner (1, 1): distance sqrt(2)/2... (1,1) to line = 0/ sqrt2? (1+1-2)/sqrt2 = 0.
+        assert!(d.abs() < 1e-12);
+        let d = segment_box_distance([0.0, 3.0, 0.5], [3.0, 0.0, 0.5], lo, hi);
+        // x + y = 3: corner (1,1) at distance 1/sqrt(2).
+        assert!((d - 0.5f64.sqrt()).abs() < 1e-12);
+        // Parallel segment, beyond the end.
+        let d = segment_box_distance([3.0, 0.5, 2.0], [5.0, 0.5, 2.0], lo, hi);
+        assert!((d - 5f64.sqrt()).abs() < 1e-12);
+    }
+
+    proptest! {
+        /// The closed form never exceeds dense sampling, and is close to it.
+        #[test]
+        fn segment_box_matches_sampling(
+            a in proptest::array::uniform3(-2.0f64..3.0),
+            b in proptest::array::uniform3(-2.0f64..3.0),
+            lo in proptest::array::uniform3(-0.5f64..0.5),
+            size in proptest::array::uniform3(0.05f64..1.0),
+        ) {
+            let hi = [lo[0] + size[0], lo[1] + size[1], lo[2] + size[2]];
+            let d = segment_box_distance(a, b, lo, hi);
+            let mut best = f64::INFINITY;
+            for i in 0..=2000 {
+                let t = i as f64 / 2000.0;
+                let p = [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])];
+                best = best.min(point_box_distance(p, lo, hi));
+            }
+            prop_assert!(d <= best + 1e-9, "{} > {}", d, best);
+            let len = ((b[0]-a[0]).powi(2) + (b[1]-a[1]).powi(2) + (b[2]-a[2]).powi(2)).sqrt();
+            prop_assert!(best - d <= len / 2000.0 + 1e-9, "{} vs {}", d, best);
+        }
+    }
+}

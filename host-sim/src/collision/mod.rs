@@ -1,0 +1,677 @@
+//! Collision of the chain against a map (ARC-MODEL.md "Validity of one configuration",
+//! "Motion between two configurations").
+//!
+//! Two checkers:
+//! - the FAST, CONSERVATIVE one in this module ([`CollisionContext`]), built on the
+//!   distance field's proven lower bounds, for the planner: it may reject a valid
+//!   configuration or edge, never accept an invalid one;
+//! - the EXACT one ([`exact`], [`verify`]), independent of the distance field, for
+//!   verifying plans: exact point/segment-to-voxel-cube distances and ARC-MODEL.md's
+//!   edge sampling rule.
+//!
+//! # Conservative checks
+//! Every body's radius is grown by the user's clearance margin (`--clearance`, default
+//! [`DEFAULT_CLEARANCE`]) and by [`FK_TOLERANCE`], which covers the difference between
+//! the core's `f32` kinematics used here and the `f64` kinematics of the exact checker.
+//! A unit sphere is free when the field's lower bound at its centre exceeds its grown
+//! radius. A link capsule is certified by the 1-Lipschitz property of the distance: a
+//! lower bound `c` at a point `s` of the segment proves every point within `c - r` of
+//! `s` free, so the segment is walked in steps of the proven free distance ("sphere
+//! tracing"), starting and ending where the unit spheres' bounds already cover it.
+//!
+//! Edges use the same argument in time. For each body we know how fast its points can
+//! move along the edge: on a translation every point moves exactly as fast as the head;
+//! on a shape change the head stays, and a link direction `d(theta, psi)` moves on the
+//! unit sphere at speed `sqrt(theta'^2 + cos^2(theta) psi'^2) <= sqrt(dtheta^2 + dpsi^2)`
+//! per unit of the edge parameter (the two partial derivatives of `d` are orthogonal),
+//! so unit `i` moves at most at `l * sum_{k<i} sqrt(dtheta_k^2 + dpsi_k^2)` and a link's
+//! points at most as fast as its back unit. A body with free margin `m` (a proven lower
+//! bound on `distance - grown radius` over all its points) cannot touch anything before
+//! the edge parameter has advanced by `m / speed`. Each body keeps its own certified
+//! horizon, and the edge is evaluated only where some horizon ends, so open space is
+//! crossed in a few samples and no collision is ever skipped. A body whose margin falls
+//! below [`CollisionContext::min_step`] is reported as colliding (conservatively), which
+//! also bounds the work per edge. Limits and self-collision along a shape change come
+//! from `arc_core::validity::check_transition`.
+
+pub mod exact;
+pub mod verify;
+
+use std::fmt;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+use arc_core::kinematics::offsets;
+use arc_core::validity::{check_shape, check_transition, Body, Violation};
+use arc_core::{ChainParams, Shape, MAX_UNITS};
+
+use crate::map::distance::DistanceField;
+
+pub use verify::{verify_plan, verify_plan_with, EdgeKind, VerifyOptions, VerifyReport};
+
+/// Default clearance margin added to every body's radius by the planner's checks (m).
+pub const DEFAULT_CLEARANCE: f64 = 0.05;
+
+/// Added to every radius in the conservative checks (m): covers the `f32` forward
+/// kinematics (error well below 1e-5 m for 16 units of 0.5 m) against the exact `f64` test.
+pub const FK_TOLERANCE: f64 = 1e-4;
+
+/// Slack kept by `check_transition` for self-collision along shape changes (m, rad).
+const TRANSITION_MARGIN: f32 = 1e-4;
+
+/// Why the conservative checker rejected a configuration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Collision {
+    /// Limits or self-collision (exact, from the core).
+    Shape(Violation),
+    /// A unit centre is outside the map's bounding box.
+    OutOfBounds {
+        /// The unit.
+        body: Body,
+        /// Its centre (m).
+        point: [f64; 3],
+    },
+    /// A body may touch an obstacle (conservative: its proven free margin is not positive).
+    Map {
+        /// The body.
+        body: Body,
+        /// Where its margin was lowest: the unit centre, or the point of the link (m).
+        point: [f64; 3],
+    },
+    /// Bad input: non-finite numbers, or shapes of another chain size.
+    BadInput(&'static str),
+}
+
+impl fmt::Display for Collision {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Collision::Shape(v) => write!(f, "{v}"),
+            Collision::OutOfBounds { body, point } => {
+                write!(
+                    f,
+                    "{body} at ({:.3}, {:.3}, {:.3}) is outside the map",
+                    point[0], point[1], point[2]
+                )
+            }
+            Collision::Map { body, point } => {
+                write!(
+                    f,
+                    "{body} near ({:.3}, {:.3}, {:.3}) may touch an obstacle",
+                    point[0], point[1], point[2]
+                )
+            }
+            Collision::BadInput(w) => write!(f, "bad input: {w}"),
+        }
+    }
+}
+
+impl std::error::Error for Collision {}
+
+/// A rejected edge: what, and where along it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeCollision {
+    /// Fraction of the edge (0..=1) at which it was found; 0 for problems not tied to a
+    /// place (self-collision along a shape change is reported at 0).
+    pub t: f64,
+    /// What was found there.
+    pub collision: Collision,
+}
+
+impl fmt::Display for EdgeCollision {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "at {:.3} of the edge: {}", self.t, self.collision)
+    }
+}
+
+impl std::error::Error for EdgeCollision {}
+
+/// Counts of checks performed, for plan statistics.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CheckStats {
+    /// Full-chain configuration checks.
+    pub configs: u64,
+    /// Translation edges checked.
+    pub translations: u64,
+    /// Shape-change edges checked.
+    pub shape_changes: u64,
+    /// Head-only point checks.
+    pub head_points: u64,
+    /// Head-only segment checks.
+    pub head_segments: u64,
+}
+
+#[derive(Debug, Default)]
+struct Counters {
+    configs: AtomicU64,
+    translations: AtomicU64,
+    shape_changes: AtomicU64,
+    head_points: AtomicU64,
+    head_segments: AtomicU64,
+}
+
+/// What the conservative checks need: the map's distance field, the chain, the
+/// clearance margin. Cheap to clone; clones share the map and the counters.
+#[derive(Clone, Debug)]
+pub struct CollisionContext {
+    field: Arc<DistanceField>,
+    params: ChainParams,
+    clearance: f64,
+    min_step: f64,
+    unit_r: f64,
+    link_r: f64,
+    counters: Arc<Counters>,
+}
+
+/// Unit centres in the world frame (f64 head + f32 core offsets), head first.
+type WorldPoints = [[f64; 3]; MAX_UNITS];
+
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+fn finite3(a: [f64; 3]) -> bool {
+    a.iter().all(|v| v.is_finite())
+}
+
+impl CollisionContext {
+    /// A context for chain `params` (validated here) on `field`, growing every radius by
+    /// `clearance` (m, finite and `>= 0`).
+    pub fn new(
+        field: Arc<DistanceField>,
+        params: ChainParams,
+        clearance: f64,
+    ) -> Result<Self, String> {
+        let params = params.validate().map_err(|e| format!("chain: {e}"))?;
+        if !(clearance.is_finite() && clearance >= 0.0) {
+            return Err(format!(
+                "clearance {clearance} must be a finite number >= 0"
+            ));
+        }
+        let min_step = field.grid().resolution() / 64.0;
+        Ok(Self {
+            unit_r: params.unit_radius as f64 + clearance + FK_TOLERANCE,
+            link_r: params.link_radius as f64 + clearance + FK_TOLERANCE,
+            field,
+            params,
+            clearance,
+            min_step,
+            counters: Arc::default(),
+        })
+    }
+
+    /// The distance field (and through it the grid).
+    pub fn field(&self) -> &DistanceField {
+        &self.field
+    }
+
+    /// The shared distance field.
+    pub fn field_arc(&self) -> &Arc<DistanceField> {
+        &self.field
+    }
+
+    /// The chain.
+    pub fn params(&self) -> &ChainParams {
+        &self.params
+    }
+
+    /// The clearance margin added to every radius (m).
+    pub fn clearance_margin(&self) -> f64 {
+        self.clearance
+    }
+
+    /// Smallest free margin (m) a body may have and still be accepted on an edge
+    /// (default `r_v / 64`); smaller margins are rejected conservatively.
+    pub fn min_step(&self) -> f64 {
+        self.min_step
+    }
+
+    /// Sets [`Self::min_step`] (clamped to at least 1e-6 m).
+    pub fn set_min_step(&mut self, m: f64) {
+        self.min_step = if m.is_finite() {
+            m.max(1e-6)
+        } else {
+            self.min_step
+        };
+    }
+
+    /// Counts of checks performed so far (by this context and its clones).
+    pub fn stats(&self) -> CheckStats {
+        let c = &self.counters;
+        CheckStats {
+            configs: c.configs.load(Ordering::Relaxed),
+            translations: c.translations.load(Ordering::Relaxed),
+            shape_changes: c.shape_changes.load(Ordering::Relaxed),
+            head_points: c.head_points.load(Ordering::Relaxed),
+            head_segments: c.head_segments.load(Ordering::Relaxed),
+        }
+    }
+
+    /// Sets every counter back to zero.
+    pub fn reset_stats(&self) {
+        let c = &self.counters;
+        for a in [
+            &c.configs,
+            &c.translations,
+            &c.shape_changes,
+            &c.head_points,
+            &c.head_segments,
+        ] {
+            a.store(0, Ordering::Relaxed);
+        }
+    }
+
+    /// Proven lower bound on the distance from `p` to the nearest obstacle cube (m).
+    #[inline]
+    pub fn clearance(&self, p: [f64; 3]) -> f64 {
+        self.field.clearance(p)
+    }
+
+    /// Whether the head's unit sphere (grown by the clearance margin) is free at `p`
+    /// and `p` is inside the map's bounds. Conservative.
+    pub fn is_head_free(&self, p: [f64; 3]) -> bool {
+        self.counters.head_points.fetch_add(1, Ordering::Relaxed);
+        self.field.grid().in_bounds(p) && self.clearance(p) > self.unit_r
+    }
+
+    /// Whether the head's unit sphere can move along the straight segment `a b` (both
+    /// ends inside the bounds, the swept sphere free). Conservative.
+    pub fn is_head_segment_free(&self, a: [f64; 3], b: [f64; 3]) -> bool {
+        self.counters.head_segments.fetch_add(1, Ordering::Relaxed);
+        let g = self.field.grid();
+        if !(g.in_bounds(a) && g.in_bounds(b)) {
+            return false;
+        }
+        let (ca, cb) = (self.clearance(a), self.clearance(b));
+        ca > self.unit_r
+            && cb > self.unit_r
+            && self.segment_free(a, b, self.unit_r, ca, cb).is_none()
+    }
+
+    /// Unit centres for `head` and `shape`.
+    fn points(&self, head: [f64; 3], shape: &Shape) -> WorldPoints {
+        let o = offsets(&self.params, shape);
+        let mut p = [[0.0; 3]; MAX_UNITS];
+        for (q, v) in p.iter_mut().zip(o.iter()).take(shape.units()) {
+            *q = [
+                head[0] + v.x as f64,
+                head[1] + v.y as f64,
+                head[2] + v.z as f64,
+            ];
+        }
+        p
+    }
+
+    fn check_input(&self, head: [f64; 3], shape: &Shape) -> Result<(), Collision> {
+        if shape.units() != self.params.n() {
+            return Err(Collision::BadInput(
+                "the shape is for another number of units",
+            ));
+        }
+        if !finite3(head) {
+            return Err(Collision::BadInput("the head position is not finite"));
+        }
+        if shape.as_slice().iter().any(|a| !a.is_finite()) {
+            return Err(Collision::BadInput("the shape has a non-finite angle"));
+        }
+        Ok(())
+    }
+
+    /// Conservative validity of one configuration: limits and self-collision (exact,
+    /// core), every unit centre inside the bounds, and every body clear of obstacles by
+    /// its radius plus the clearance margin (distance-field lower bounds).
+    pub fn check_config(&self, head: [f64; 3], shape: &Shape) -> Result<(), Collision> {
+        self.counters.configs.fetch_add(1, Ordering::Relaxed);
+        self.check_input(head, shape)?;
+        check_shape(&self.params, shape).map_err(Collision::Shape)?;
+        self.placement(head, shape)
+    }
+
+    /// [`Self::check_config`] without the limits and self-collision part, for shapes
+    /// already known to be valid (library and SRS shapes).
+    pub fn check_placement(&self, head: [f64; 3], shape: &Shape) -> Result<(), Collision> {
+        self.counters.configs.fetch_add(1, Ordering::Relaxed);
+        self.check_input(head, shape)?;
+        self.placement(head, shape)
+    }
+
+    fn placement(&self, head: [f64; 3], shape: &Shape) -> Result<(), Collision> {
+        let n = shape.units();
+        let p = self.points(head, shape);
+        let g = self.field.grid();
+        let mut c = [0.0f64; MAX_UNITS];
+        for i in 0..n {
+            if !g.in_bounds(p[i]) {
+                return Err(Collision::OutOfBounds {
+                    body: Body::Unit(i as u8),
+                    point: p[i],
+                });
+            }
+            c[i] = self.clearance(p[i]);
+            if c[i] <= self.unit_r {
+                return Err(Collision::Map {
+                    body: Body::Unit(i as u8),
+                    point: p[i],
+                });
+            }
+        }
+        for k in 0..n - 1 {
+            if let Some(at) = self.segment_free(p[k], p[k + 1], self.link_r, c[k], c[k + 1]) {
+                return Err(Collision::Map {
+                    body: Body::Link(k as u8),
+                    point: at,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Sphere tracing of the capsule of radius `r` around segment `a b`, where `ca`, `cb`
+    /// are the field's bounds at the ends. `None` when proven free, else the point where
+    /// the proof failed.
+    fn segment_free(&self, a: [f64; 3], b: [f64; 3], r: f64, ca: f64, cb: f64) -> Option<[f64; 3]> {
+        let len = norm(sub(b, a));
+        // Points within ca - r of a (and cb - r of b) are proven free by the ends' bounds.
+        let mut t = ca - r;
+        let end = len - (cb - r);
+        if t > end {
+            return None;
+        }
+        if len <= 0.0 {
+            return if ca > r { None } else { Some(a) };
+        }
+        let dir = scale(sub(b, a), 1.0 / len);
+        loop {
+            let s = add(a, scale(dir, t.min(len)));
+            let m = self.clearance(s) - r;
+            if m < self.min_step {
+                return Some(s);
+            }
+            t += m;
+            if t > end {
+                return None;
+            }
+        }
+    }
+
+    /// A proven lower bound on `distance - r` over the segment `a b`, from the bounds at
+    /// its ends (`ca`, `cb`) and at the centres of pieces, halving pieces until the
+    /// Lipschitz loss is at most half the local bound (or the piece is tiny).
+    fn segment_margin(
+        &self,
+        a: [f64; 3],
+        b: [f64; 3],
+        r: f64,
+        ca: f64,
+        cb: f64,
+    ) -> (f64, [f64; 3]) {
+        let len = norm(sub(b, a));
+        let wmin = self.field.grid().resolution() / 16.0;
+        // Iterative refinement over a small stack of pieces [t0, t1] (in metres).
+        let mut stack = [(0.0f64, 0.0f64); 48];
+        let mut top = 1;
+        stack[0] = (0.0, len);
+        let mut best = (f64::INFINITY, a);
+        while top > 0 {
+            top -= 1;
+            let (t0, t1) = stack[top];
+            let w = 0.5 * (t1 - t0);
+            let tm = t0 + w;
+            let s = if len > 0.0 {
+                add(a, scale(sub(b, a), tm / len))
+            } else {
+                a
+            };
+            let raw = self.clearance(s);
+            // Bounds for the piece: from its centre, and from both ends of the link.
+            let m = (raw - w).max(ca - t1).max(cb - (len - t0)) - r;
+            let good_enough = m >= 0.5 * (raw - r) || m >= 0.5 * (ca.min(cb) - r);
+            if good_enough || w <= wmin || top + 2 > stack.len() {
+                if m < best.0 {
+                    best = (m, s);
+                }
+                if best.0 < self.min_step {
+                    return best;
+                }
+            } else {
+                stack[top] = (t0, tm);
+                stack[top + 1] = (tm, t1);
+                top += 2;
+            }
+        }
+        best
+    }
+
+    /// Conservative check of a translation edge: the shape stays, the head moves along
+    /// the straight segment `from -> to`. Checks the shape once (limits, self-collision),
+    /// the unit centres at both ends against the bounds (the box is convex), and every
+    /// body along the motion by certified horizons (see the module docs).
+    pub fn check_translation(
+        &self,
+        from: [f64; 3],
+        to: [f64; 3],
+        shape: &Shape,
+    ) -> Result<(), EdgeCollision> {
+        self.counters.translations.fetch_add(1, Ordering::Relaxed);
+        let at0 = |collision| EdgeCollision { t: 0.0, collision };
+        self.check_input(from, shape).map_err(at0)?;
+        if !finite3(to) {
+            return Err(at0(Collision::BadInput("the head position is not finite")));
+        }
+        check_shape(&self.params, shape).map_err(|v| at0(Collision::Shape(v)))?;
+        let n = shape.units();
+        let g = self.field.grid();
+        let p0 = self.points(from, shape);
+        let delta = sub(to, from);
+        let dist = norm(delta);
+        for (t, q) in [(0.0, from), (1.0, to)] {
+            let off = sub(q, from);
+            for (i, u) in p0.iter().enumerate().take(n) {
+                let w = add(*u, off);
+                if !g.in_bounds(w) {
+                    return Err(EdgeCollision {
+                        t,
+                        collision: Collision::OutOfBounds {
+                            body: Body::Unit(i as u8),
+                            point: w,
+                        },
+                    });
+                }
+            }
+        }
+        let dir = if dist > 0.0 {
+            scale(delta, 1.0 / dist)
+        } else {
+            [0.0; 3]
+        };
+        // Bodies: units 0..n, then links n..2n-1. horizon[b]: proven free for displacement < horizon.
+        let nb = 2 * n - 1;
+        let mut horizon = [0.0f64; 2 * MAX_UNITS];
+        let mut c = [0.0f64; MAX_UNITS];
+        loop {
+            let u = horizon[..nb]
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min)
+                .min(dist);
+            let off = scale(dir, u);
+            let frac = if dist > 0.0 { u / dist } else { 0.0 };
+            // Units first (the links use their bounds).
+            for i in 0..n {
+                let q = add(p0[i], off);
+                c[i] = self.clearance(q);
+                if horizon[i] <= u {
+                    let m = c[i] - self.unit_r;
+                    if m < self.min_step {
+                        let collision = Collision::Map {
+                            body: Body::Unit(i as u8),
+                            point: q,
+                        };
+                        return Err(EdgeCollision { t: frac, collision });
+                    }
+                    horizon[i] = u + m;
+                }
+            }
+            for k in 0..n - 1 {
+                if horizon[n + k] <= u {
+                    let (a, b) = (add(p0[k], off), add(p0[k + 1], off));
+                    let (m, at) = self.segment_margin(a, b, self.link_r, c[k], c[k + 1]);
+                    if m < self.min_step {
+                        let collision = Collision::Map {
+                            body: Body::Link(k as u8),
+                            point: at,
+                        };
+                        return Err(EdgeCollision { t: frac, collision });
+                    }
+                    horizon[n + k] = u + m;
+                }
+            }
+            if horizon[..nb].iter().all(|&h| h > dist) {
+                return Ok(());
+            }
+        }
+    }
+
+    /// Conservative check of a shape-change edge: the head stays at `head`, the shape
+    /// moves from `from` to `to` (each angle along its shortest difference,
+    /// `Shape::lerp`). Limits and self-collision by the core's `check_transition`; the
+    /// bounds and the map by certified horizons using each body's speed bound (see the
+    /// module docs).
+    pub fn check_shape_change(
+        &self,
+        head: [f64; 3],
+        from: &Shape,
+        to: &Shape,
+    ) -> Result<(), EdgeCollision> {
+        self.counters.shape_changes.fetch_add(1, Ordering::Relaxed);
+        let at0 = |collision| EdgeCollision { t: 0.0, collision };
+        self.check_input(head, from).map_err(at0)?;
+        self.check_input(head, to).map_err(|c| EdgeCollision {
+            t: 1.0,
+            collision: c,
+        })?;
+        check_transition(&self.params, from, to, TRANSITION_MARGIN)
+            .map_err(|v| at0(Collision::Shape(v)))?;
+        let n = from.units();
+        let l = self.params.link_length as f64;
+        // speed[i]: bound on unit i's speed per unit of the edge parameter.
+        let mut speed = [0.0f64; MAX_UNITS];
+        for k in 0..n - 1 {
+            let dp = arc_core::angle::diff(from.pitch(k), to.pitch(k)) as f64;
+            let dy = arc_core::angle::diff(from.yaw(k), to.yaw(k)) as f64;
+            // A small relative allowance for the f32 angle differences.
+            speed[k + 1] = speed[k] + l * (dp * dp + dy * dy).sqrt() * (1.0 + 1e-6);
+        }
+        let g = self.field.grid();
+        let (lo, hi) = g.bounds();
+        let nb = 2 * n - 1;
+        let mut horizon = [0.0f64; 2 * MAX_UNITS];
+        let mut c = [0.0f64; MAX_UNITS];
+        loop {
+            let t = horizon[..nb]
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min)
+                .min(1.0);
+            let s = if t >= 1.0 {
+                *to
+            } else {
+                from.lerp(to, t as f32)
+            };
+            let p = self.points(head, &s);
+            for i in 0..n {
+                c[i] = self.clearance(p[i]);
+                if horizon[i] <= t {
+                    // Inside-the-box margin and obstacle margin.
+                    let mut inside = f64::INFINITY;
+                    for a in 0..3 {
+                        inside = inside.min(p[i][a] - lo[a]).min(hi[a] - p[i][a]);
+                    }
+                    if inside < 0.0 {
+                        let collision = Collision::OutOfBounds {
+                            body: Body::Unit(i as u8),
+                            point: p[i],
+                        };
+                        return Err(EdgeCollision { t, collision });
+                    }
+                    let m = c[i] - self.unit_r;
+                    if m < self.min_step {
+                        let collision = Collision::Map {
+                            body: Body::Unit(i as u8),
+                            point: p[i],
+                        };
+                        return Err(EdgeCollision { t, collision });
+                    }
+                    if speed[i] > 0.0 {
+                        if inside < self.min_step {
+                            let collision = Collision::OutOfBounds {
+                                body: Body::Unit(i as u8),
+                                point: p[i],
+                            };
+                            return Err(EdgeCollision { t, collision });
+                        }
+                        horizon[i] = t + m.min(inside) / speed[i];
+                    } else {
+                        horizon[i] = f64::INFINITY;
+                    }
+                }
+            }
+            for k in 0..n - 1 {
+                if horizon[n + k] <= t {
+                    let (m, at) = self.segment_margin(p[k], p[k + 1], self.link_r, c[k], c[k + 1]);
+                    if m < self.min_step {
+                        let collision = Collision::Map {
+                            body: Body::Link(k as u8),
+                            point: at,
+                        };
+                        return Err(EdgeCollision { t, collision });
+                    }
+                    let v = speed[k + 1];
+                    horizon[n + k] = if v > 0.0 { t + m / v } else { f64::INFINITY };
+                }
+            }
+            if horizon[..nb].iter().all(|&h| h > 1.0) {
+                return Ok(());
+            }
+        }
+    }
+}
+
+/// [`CollisionContext::check_config`] as a free function.
+pub fn check_config(
+    ctx: &CollisionContext,
+    head: [f64; 3],
+    shape: &Shape,
+) -> Result<(), Collision> {
+    ctx.check_config(head, shape)
+}
+
+/// [`CollisionContext::check_translation`] as a free function.
+pub fn check_translation(
+    ctx: &CollisionContext,
+    from: [f64; 3],
+    to: [f64; 3],
+    shape: &Shape,
+) -> Result<(), EdgeCollision> {
+    ctx.check_translation(from, to, shape)
+}
+
+/// [`CollisionContext::check_shape_change`] as a free function.
+pub fn check_shape_change(
+    ctx: &CollisionContext,
+    head: [f64; 3],
+    from: &Shape,
+    to: &Shape,
+) -> Result<(), EdgeCollision> {
+    ctx.check_shape_change(head, from, to)
+}
+
+#[cfg(test)]
+mod tests;

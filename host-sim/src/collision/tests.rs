@@ -1,0 +1,235 @@
+//! Tests of the conservative checker against the exact one.
+
+use std::sync::Arc;
+
+use arc_core::validity::Body;
+use arc_core::{ChainParams, Shape};
+use proptest::prelude::*;
+
+use super::exact::check_config_exact;
+use super::verify::check_edge_exact;
+use super::*;
+use crate::map::distance::DistanceField;
+use crate::map::grid::{Cell, Grid};
+
+/// A free 4 x 4 x 2 m box at 0.1 m with the given occupied boxes.
+fn map(boxes: &[([f64; 3], [f64; 3])], unknown_occ: bool) -> Arc<DistanceField> {
+    let mut g = Grid::new(0.1, [0, 0, 0], [40, 40, 20], Cell::Free, unknown_occ).unwrap();
+    for (lo, hi) in boxes {
+        g.fill_box(*lo, *hi, Cell::Occupied);
+    }
+    Arc::new(DistanceField::new(g))
+}
+
+fn zeta(head: [f64; 3], s: &Shape) -> Vec<f64> {
+    let mut z = head.to_vec();
+    z.extend(s.as_slice().iter().map(|&a| a as f64));
+    z
+}
+
+#[test]
+fn open_space_and_a_wall() {
+    // A wall of voxels with centres x in [3.05, 3.15] (cubes 3.0..3.2).
+    let f = map(&[([3.05, 0.0, 0.0], [3.15, 4.0, 2.0])], true);
+    let ctx = CollisionContext::new(f.clone(), ChainParams::new(4), 0.05).unwrap();
+    let line = Shape::line(4, 0.0); // trails along -x
+                                    // 0.35 m from the wall: accepted (the bound loses some of the 0.15 m of slack).
+    assert_eq!(ctx.check_config([2.65, 1.95, 0.95], &line), Ok(()));
+    // 0.25 m from the wall at voxel faces: truly free, but the bound cannot prove it.
+    assert!(ctx.check_config([2.75, 2.0, 1.0], &line).is_err());
+    // Head sphere reaches the wall: 3.0 - 2.85 = 0.15 <= r_u.
+    assert!(matches!(
+        ctx.check_config([2.85, 2.0, 1.0], &line),
+        Err(Collision::Map {
+            body: Body::Unit(0),
+            ..
+        })
+    ));
+    // Behind the wall the tail would cross it.
+    assert!(matches!(
+        ctx.check_config([3.9, 2.0, 1.0], &line),
+        Err(Collision::Map { .. })
+    ));
+    // Outside the bounds.
+    assert!(matches!(
+        ctx.check_config([2.0, -0.5, 1.0], &line),
+        Err(Collision::OutOfBounds { .. })
+    ));
+    // Translation along the wall is fine, through it is not.
+    assert_eq!(
+        ctx.check_translation([2.6, 0.5, 1.0], [2.6, 3.5, 1.0], &line),
+        Ok(())
+    );
+    let e = ctx
+        .check_translation([2.6, 2.0, 1.0], [3.9, 2.0, 1.0], &line)
+        .unwrap_err();
+    assert!(e.t > 0.0 && e.t < 0.3, "{e}");
+    // Turning the tail towards the wall while the head is near it collides.
+    let towards = Shape::line(4, std::f32::consts::PI); // trails along +x
+    assert!(ctx
+        .check_shape_change([2.5, 2.0, 1.0], &line, &towards)
+        .is_err());
+    // Rotating by 90 degrees away from the wall is fine.
+    let side = Shape::line(4, std::f32::consts::FRAC_PI_2);
+    assert_eq!(
+        ctx.check_shape_change([2.5, 2.05, 1.0], &line, &side),
+        Ok(())
+    );
+    // Head helpers.
+    assert!(ctx.is_head_free([2.5, 2.0, 1.0]));
+    assert!(!ctx.is_head_free([2.9, 2.0, 1.0]));
+    assert!(ctx.is_head_segment_free([2.0, 0.5, 1.0], [2.0, 3.5, 1.0]));
+    assert!(!ctx.is_head_segment_free([2.0, 2.0, 1.0], [3.5, 2.0, 1.0]));
+    assert!((ctx.clearance([2.5, 2.0, 1.0]) - 0.5).abs() < 0.1);
+    let st = ctx.stats();
+    assert_eq!(st.configs, 5);
+    assert_eq!(st.translations, 2);
+    assert_eq!(st.shape_changes, 2);
+    assert_eq!(st.head_points, 2);
+    assert_eq!(st.head_segments, 2);
+    ctx.reset_stats();
+    assert_eq!(ctx.stats(), CheckStats::default());
+}
+
+#[test]
+fn bad_input_is_an_error_not_a_panic() {
+    let f = map(&[], true);
+    let ctx = CollisionContext::new(f, ChainParams::new(4), 0.05).unwrap();
+    let s5 = Shape::line(5, 0.0);
+    let s4 = Shape::line(4, 0.0);
+    assert!(matches!(
+        ctx.check_config([1.0; 3], &s5),
+        Err(Collision::BadInput(_))
+    ));
+    assert!(matches!(
+        ctx.check_config([f64::NAN, 1.0, 1.0], &s4),
+        Err(Collision::BadInput(_))
+    ));
+    assert!(ctx
+        .check_translation([2.0; 3], [f64::INFINITY, 1.0, 1.0], &s4)
+        .is_err());
+    assert!(ctx.check_shape_change([2.0; 3], &s4, &s5).is_err());
+    assert!(!ctx.is_head_free([f64::NAN; 3]));
+    assert!(CollisionContext::new(map(&[], true), ChainParams::new(1), 0.0).is_err());
+    assert!(CollisionContext::new(map(&[], true), ChainParams::new(4), -1.0).is_err());
+}
+
+#[test]
+fn open_space_edges_are_cheap_and_pass() {
+    let f = map(&[], false);
+    let ctx = CollisionContext::new(f, ChainParams::new(6), 0.05).unwrap();
+    let s = Shape::line(6, 0.0);
+    assert_eq!(
+        ctx.check_translation([3.6, 0.5, 1.0], [3.6, 3.5, 1.0], &s),
+        Ok(())
+    );
+}
+
+#[test]
+fn exact_checker_finds_a_thin_post() {
+    // A single voxel post the link passes through between units.
+    let f = map(&[([1.25, 1.95, 0.0], [1.25, 1.95, 2.0])], true);
+    let g = f.grid();
+    let p = ChainParams::new(3);
+    let s = Shape::line(3, 0.0);
+    // Units at x = 1.5, 1.0, 0.5 (y 1.95): the link 1.5 -> 1.0 crosses the post at 1.25.
+    let r = check_config_exact(g, &p, [1.5, 1.95, 1.0], &zeta([0.0; 3], &s)[3..], 0.5);
+    assert!(
+        matches!(
+            r,
+            Err(super::exact::ExactViolation::Map {
+                body: Body::Link(0),
+                ..
+            })
+        ),
+        "{r:?}"
+    );
+    let ctx = CollisionContext::new(f.clone(), p, 0.0).unwrap();
+    assert!(ctx.check_config([1.5, 1.95, 1.0], &s).is_err());
+}
+
+/// Random boxes inside the 4 x 4 x 2 map.
+fn boxes() -> impl Strategy<Value = Vec<([f64; 3], [f64; 3])>> {
+    proptest::collection::vec(
+        (
+            proptest::array::uniform3(0.0f64..1.0),
+            proptest::array::uniform3(0.0f64..0.6),
+        ),
+        0..6,
+    )
+    .prop_map(|v| {
+        v.into_iter()
+            .map(|(c, s)| {
+                let c = [c[0] * 4.0, c[1] * 4.0, c[2] * 2.0];
+                (c, [c[0] + s[0], c[1] + s[1], c[2] + s[2]])
+            })
+            .collect()
+    })
+}
+
+/// A random shape within the pitch limit (it may still self-collide or break the bend
+/// limit: the checks must agree on that too).
+fn shape(n: u8, raw: &[f32]) -> Shape {
+    let mut s = Shape::line(n, raw[0] * 3.1);
+    for k in 0..n as usize - 1 {
+        s.set_link(k, raw[1 + 2 * k] * 1.0, raw[0] * 3.1 + raw[2 + 2 * k] * 1.5);
+    }
+    s
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// The fast check never accepts a configuration the exact check rejects.
+    #[test]
+    fn fast_config_is_conservative(
+        b in boxes(),
+        unknown_occ in any::<bool>(),
+        n in 2u8..7,
+        raw in proptest::collection::vec(-1.0f32..1.0, 31),
+        head in proptest::array::uniform3(0.0f64..1.0),
+    ) {
+        let f = map(&b, unknown_occ);
+        let p = ChainParams::new(n);
+        let ctx = CollisionContext::new(f.clone(), p, 0.0).unwrap();
+        let s = shape(n, &raw);
+        let h = [0.3 + head[0] * 3.4, 0.3 + head[1] * 3.4, 0.2 + head[2] * 1.6];
+        if ctx.check_config(h, &s).is_ok() {
+            let z = zeta(h, &s);
+            let r = check_config_exact(f.grid(), &p, h, &z[3..], 0.2);
+            prop_assert!(r.is_ok(), "fast accepted, exact found {:?}", r);
+        }
+    }
+
+    /// The fast edge checks never accept an edge whose exact sampling finds a problem.
+    #[test]
+    fn fast_edges_are_conservative(
+        b in boxes(),
+        unknown_occ in any::<bool>(),
+        n in 2u8..7,
+        raw in proptest::collection::vec(-1.0f32..1.0, 31),
+        raw2 in proptest::collection::vec(-1.0f32..1.0, 31),
+        head in proptest::array::uniform3(0.0f64..1.0),
+        to in proptest::array::uniform3(0.0f64..1.0),
+        translate in any::<bool>(),
+    ) {
+        let f = map(&b, unknown_occ);
+        let p = ChainParams::new(n);
+        let ctx = CollisionContext::new(f.clone(), p, 0.0).unwrap();
+        let s = shape(n, &raw);
+        let h = [0.3 + head[0] * 3.4, 0.3 + head[1] * 3.4, 0.2 + head[2] * 1.6];
+        if translate {
+            let h2 = [0.3 + to[0] * 3.4, 0.3 + to[1] * 3.4, 0.2 + to[2] * 1.6];
+            if ctx.check_translation(h, h2, &s).is_ok() {
+                let r = check_edge_exact(f.grid(), &p, &zeta(h, &s), &zeta(h2, &s), 0.2);
+                prop_assert!(r.is_ok(), "fast accepted translation, exact found {:?}", r);
+            }
+        } else {
+            let s2 = shape(n, &raw2);
+            if ctx.check_shape_change(h, &s, &s2).is_ok() {
+                let r = check_edge_exact(f.grid(), &p, &zeta(h, &s), &zeta(h, &s2), 0.2);
+                prop_assert!(r.is_ok(), "fast accepted shape change, exact found {:?}", r);
+            }
+        }
+    }
+}

@@ -1,0 +1,407 @@
+//! Exact verification of a plan against a map (ARC-MODEL.md "Motion between two
+//! configurations"), independent of the distance field.
+//!
+//! Each edge is classified by which part of `zeta` changed (within 1e-9, angles compared
+//! after wrapping): a translation, a shape change, nothing (allowed), or both (invalid).
+//! It is then sampled so that no unit centre and no point of any link moves more than
+//! `r_v / 4` between consecutive samples: on a translation every point moves as far as
+//! the head; on a shape change a link direction moves on the unit sphere at most
+//! `sqrt(dtheta^2 + dpsi^2)` per unit of the edge parameter (the partial derivatives of
+//! the direction are orthogonal, of lengths 1 and `cos theta`), so the last unit, the
+//! fastest point, moves at most `l * sum_k sqrt(dtheta_k^2 + dpsi_k^2)` over the edge.
+//! Every sample must pass [`check_config_exact`].
+
+use std::f64::consts::{PI, TAU};
+
+use arc_core::validity::Body;
+use arc_core::ChainParams;
+
+use super::exact::{check_config_exact, ExactViolation};
+use crate::map::grid::Grid;
+use crate::plan::Plan;
+
+/// Tolerance for "stays" when classifying an edge (ARC-MODEL.md).
+pub const STAY_TOLERANCE: f64 = 1e-9;
+
+/// Default search horizon for the clearance report (m).
+pub const DEFAULT_HORIZON: f64 = 0.5;
+
+/// Wraps an angle to `(-pi, pi]`.
+pub fn wrap(a: f64) -> f64 {
+    let w = a.rem_euclid(TAU);
+    if w > PI {
+        w - TAU
+    } else {
+        w
+    }
+}
+
+/// Which kind of edge joins two configurations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EdgeKind {
+    /// Nothing changes (allowed).
+    Stay,
+    /// Only the head position changes.
+    Translation,
+    /// Only the shape changes.
+    ShapeChange,
+    /// Both change: not an admissible edge.
+    Both,
+}
+
+impl std::fmt::Display for EdgeKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            EdgeKind::Stay => "stay",
+            EdgeKind::Translation => "translation",
+            EdgeKind::ShapeChange => "shape change",
+            EdgeKind::Both => "both head and shape change",
+        })
+    }
+}
+
+/// Classifies the edge between configurations `a` and `b` (`zeta`, equal lengths).
+pub fn classify_edge(a: &[f64], b: &[f64]) -> EdgeKind {
+    let xi_stays = (0..3).all(|i| (b[i] - a[i]).abs() <= STAY_TOLERANCE);
+    let eta_stays = a
+        .iter()
+        .zip(b)
+        .skip(3)
+        .all(|(x, y)| wrap(y - x).abs() <= STAY_TOLERANCE);
+    match (xi_stays, eta_stays) {
+        (true, true) => EdgeKind::Stay,
+        (false, true) => EdgeKind::Translation,
+        (true, false) => EdgeKind::ShapeChange,
+        (false, false) => EdgeKind::Both,
+    }
+}
+
+/// Number of sample intervals ARC-MODEL.md's rule needs for the edge `a -> b` of `kind`
+/// at resolution `r_v` (at least 1; 0 for [`EdgeKind::Stay`] and [`EdgeKind::Both`]).
+pub fn edge_intervals(
+    kind: EdgeKind,
+    link_length: f64,
+    a: &[f64],
+    b: &[f64],
+    resolution: f64,
+) -> usize {
+    let step = resolution / 4.0;
+    let travel = match kind {
+        EdgeKind::Translation => {
+            ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
+        }
+        EdgeKind::ShapeChange => {
+            let links = (a.len() - 4) / 2;
+            (0..links)
+                .map(|k| {
+                    let dt = wrap(b[4 + 2 * k] - a[4 + 2 * k]);
+                    let dp = wrap(b[5 + 2 * k] - a[5 + 2 * k]);
+                    (dt * dt + dp * dp).sqrt()
+                })
+                .sum::<f64>()
+                * link_length
+        }
+        EdgeKind::Stay | EdgeKind::Both => return 0,
+    };
+    ((travel / step).ceil() as usize).max(1)
+}
+
+/// The configuration at fraction `t` of the edge `a -> b` of `kind`.
+pub fn edge_sample(kind: EdgeKind, a: &[f64], b: &[f64], t: f64) -> Vec<f64> {
+    if t >= 1.0 {
+        return b.to_vec();
+    }
+    let mut z = a.to_vec();
+    match kind {
+        EdgeKind::Translation => {
+            for i in 0..3 {
+                z[i] = a[i] + t * (b[i] - a[i]);
+            }
+        }
+        EdgeKind::ShapeChange => {
+            for i in 3..a.len() {
+                z[i] = wrap(a[i] + t * wrap(b[i] - a[i]));
+            }
+        }
+        EdgeKind::Stay | EdgeKind::Both => {}
+    }
+    z
+}
+
+/// Where along a plan something was found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Site {
+    /// The waypoint (for `edge = None`) or the edge's first waypoint.
+    pub waypoint: usize,
+    /// `Some(i)`: on the edge from waypoint `i` to `i + 1`.
+    pub edge: Option<usize>,
+    /// Sample number along the edge (0 at its start).
+    pub sample: usize,
+    /// Fraction of the edge.
+    pub t: f64,
+}
+
+impl std::fmt::Display for Site {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.edge {
+            None => write!(f, "waypoint {}", self.waypoint),
+            Some(e) => write!(
+                f,
+                "edge {} -> {} at t = {:.4} (sample {})",
+                e,
+                e + 1,
+                self.t,
+                self.sample
+            ),
+        }
+    }
+}
+
+/// What is wrong with a plan.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PlanProblem {
+    /// The plan breaks the file format's rules (see `Plan::check`).
+    Format(String),
+    /// An edge changes both the head position and the shape.
+    BothChange,
+    /// A configuration fails the exact test.
+    Invalid(ExactViolation),
+}
+
+impl std::fmt::Display for PlanProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PlanProblem::Format(s) => write!(f, "{s}"),
+            PlanProblem::BothChange => {
+                f.write_str("the edge changes both the head position and the shape")
+            }
+            PlanProblem::Invalid(v) => write!(f, "{v}"),
+        }
+    }
+}
+
+/// The first problem of a plan, and where.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanViolation {
+    /// Where.
+    pub site: Site,
+    /// What.
+    pub problem: PlanProblem,
+}
+
+impl std::fmt::Display for PlanViolation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.site, self.problem)
+    }
+}
+
+/// Options of [`verify_plan_with`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VerifyOptions {
+    /// How far beyond a body's radius obstacles are searched for the clearance report
+    /// (m); clearances above it are reported as this value.
+    pub horizon: f64,
+}
+
+impl Default for VerifyOptions {
+    fn default() -> Self {
+        Self {
+            horizon: DEFAULT_HORIZON,
+        }
+    }
+}
+
+/// The result of verifying a plan.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VerifyReport {
+    /// True when every waypoint and every sample of every edge is valid.
+    pub ok: bool,
+    /// The kind of each edge (`waypoints - 1` entries).
+    pub edges: Vec<EdgeKind>,
+    /// Configurations tested.
+    pub samples: usize,
+    /// Smallest (distance to an obstacle cube - radius) over every body of every valid
+    /// sample (m), capped at the horizon.
+    pub min_clearance: f64,
+    /// Where that clearance was found, and the body.
+    pub min_clearance_at: Option<(Site, Body)>,
+    /// The first problem found, if any.
+    pub violation: Option<PlanViolation>,
+    /// Remarks that do not make the plan invalid (a resolution that differs from the
+    /// map's, a different unknown-space assumption).
+    pub notes: Vec<String>,
+}
+
+/// Verifies `plan` on `grid` with the default options (see [`verify_plan_with`]).
+pub fn verify_plan(grid: &Grid, plan: &Plan) -> VerifyReport {
+    verify_plan_with(grid, plan, &VerifyOptions::default())
+}
+
+/// Verifies every waypoint and edge of `plan` on `grid` by the exact test, with the
+/// grid's choice of whether unknown space is occupied. Goes through the whole plan: the
+/// report names the FIRST violation and the smallest clearance over the valid samples.
+pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> VerifyReport {
+    let mut rep = VerifyReport {
+        ok: false,
+        edges: Vec::new(),
+        samples: 0,
+        min_clearance: opts.horizon.max(0.0),
+        min_clearance_at: None,
+        violation: None,
+        notes: Vec::new(),
+    };
+    let first = Site {
+        waypoint: 0,
+        edge: None,
+        sample: 0,
+        t: 0.0,
+    };
+    let params = match plan.check() {
+        Ok(p) => p,
+        Err(e) => {
+            rep.violation = Some(PlanViolation {
+                site: first,
+                problem: PlanProblem::Format(e),
+            });
+            return rep;
+        }
+    };
+    if (plan.map.resolution - grid.resolution()).abs() > 1e-9 {
+        rep.notes.push(format!(
+            "the plan was made for resolution {} m, the map has {} m",
+            plan.map.resolution,
+            grid.resolution()
+        ));
+    }
+    if plan.map.unknown_is_occupied != grid.unknown_is_occupied() {
+        rep.notes.push(format!(
+            "the plan assumed unknown space {}, this check treats it as {}",
+            if plan.map.unknown_is_occupied {
+                "occupied"
+            } else {
+                "free"
+            },
+            if grid.unknown_is_occupied() {
+                "occupied"
+            } else {
+                "free"
+            }
+        ));
+    }
+    let check = |rep: &mut VerifyReport, zeta: &[f64], site: Site| {
+        rep.samples += 1;
+        match check_config_exact(
+            grid,
+            &params,
+            [zeta[0], zeta[1], zeta[2]],
+            &zeta[3..],
+            opts.horizon,
+        ) {
+            Ok(c) => {
+                if rep.min_clearance_at.is_none() || c.clearance < rep.min_clearance {
+                    rep.min_clearance = c.clearance;
+                    rep.min_clearance_at = Some((site, c.body));
+                }
+            }
+            Err(v) => {
+                if let ExactViolation::Map {
+                    body, clearance, ..
+                } = v
+                {
+                    if clearance < rep.min_clearance {
+                        rep.min_clearance = clearance;
+                        rep.min_clearance_at = Some((site, body));
+                    }
+                }
+                if rep.violation.is_none() {
+                    rep.violation = Some(PlanViolation {
+                        site,
+                        problem: PlanProblem::Invalid(v),
+                    });
+                }
+            }
+        }
+    };
+    check(&mut rep, &plan.waypoints[0].zeta, first);
+    for (e, w) in plan.waypoints.windows(2).enumerate() {
+        let (a, b) = (&w[0].zeta, &w[1].zeta);
+        let kind = classify_edge(a, b);
+        rep.edges.push(kind);
+        let end = Site {
+            waypoint: e + 1,
+            edge: None,
+            sample: 0,
+            t: 1.0,
+        };
+        match kind {
+            EdgeKind::Stay => check(&mut rep, b, end),
+            EdgeKind::Both => {
+                if rep.violation.is_none() {
+                    let site = Site {
+                        waypoint: e,
+                        edge: Some(e),
+                        sample: 0,
+                        t: 0.0,
+                    };
+                    rep.violation = Some(PlanViolation {
+                        site,
+                        problem: PlanProblem::BothChange,
+                    });
+                }
+                check(&mut rep, b, end);
+            }
+            EdgeKind::Translation | EdgeKind::ShapeChange => {
+                let n = edge_intervals(kind, params.link_length as f64, a, b, grid.resolution());
+                for j in 1..=n {
+                    let t = j as f64 / n as f64;
+                    let z = edge_sample(kind, a, b, t);
+                    let site = if j == n {
+                        end
+                    } else {
+                        Site {
+                            waypoint: e,
+                            edge: Some(e),
+                            sample: j,
+                            t,
+                        }
+                    };
+                    check(&mut rep, &z, site);
+                }
+            }
+        }
+    }
+    rep.ok = rep.violation.is_none();
+    rep
+}
+
+/// Exact check of one edge `a -> b` (`zeta`s) on `grid` for chain `params`, by
+/// ARC-MODEL.md's sampling rule, including both ends. Returns the smallest clearance,
+/// or the first failing sample's fraction and violation (an edge that changes both parts
+/// fails at 0 with [`ExactViolation::BadShape`]).
+pub fn check_edge_exact(
+    grid: &Grid,
+    params: &ChainParams,
+    a: &[f64],
+    b: &[f64],
+    horizon: f64,
+) -> Result<f64, (f64, ExactViolation)> {
+    let dim = 2 * params.n() + 2;
+    if a.len() != dim || b.len() != dim {
+        return Err((0.0, ExactViolation::BadShape));
+    }
+    let kind = classify_edge(a, b);
+    if kind == EdgeKind::Both {
+        return Err((0.0, ExactViolation::BadShape));
+    }
+    let n = edge_intervals(kind, params.link_length as f64, a, b, grid.resolution());
+    let mut best = f64::INFINITY;
+    for j in 0..=n {
+        let t = if n == 0 { 0.0 } else { j as f64 / n as f64 };
+        let z = edge_sample(kind, a, b, t);
+        match check_config_exact(grid, params, [z[0], z[1], z[2]], &z[3..], horizon) {
+            Ok(c) => best = best.min(c.clearance),
+            Err(v) => return Err((t, v)),
+        }
+    }
+    Ok(best)
+}

@@ -1,0 +1,487 @@
+//! A dense occupancy grid over a map's bounding box, aligned to OctoMap's voxel lattice.
+//!
+//! The lattice: voxel index `i` (per axis, an `i32`, OctoMap's key minus 32768) is the
+//! closed cube of edge `r_v` around the centre `(i + 0.5) * r_v`, i.e. it spans
+//! `[i * r_v, (i + 1) * r_v]`. The grid stores one byte per voxel ([`Cell`]) for the
+//! voxels of the map's bounding box (ARC-MODEL.md validity item 4: the metric bounds of
+//! all known leaves, as OctoMap's `getMetricMin`/`getMetricMax` report them). A 100 m x
+//! 20 m x 5 m map at 0.1 m is 10^7 voxels, 10 MB.
+//!
+//! Everything outside the grid is unknown space. Whether unknown space is an obstacle
+//! is the user's choice ([`Grid::unknown_is_occupied`], `--unknown-free` sets it false);
+//! the grid keeps the three states so either choice can be made later.
+
+use std::fmt;
+
+/// Largest number of voxels a grid may hold (400 M: 400 MB of cells, 1.6 GB of distance
+/// field). Larger maps are refused with [`GridError::TooLarge`] rather than exhausting memory.
+pub const MAX_CELLS: usize = 400_000_000;
+
+/// The state of one voxel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Cell {
+    /// Known free (OctoMap max-likelihood free).
+    Free = 0,
+    /// Known occupied (OctoMap max-likelihood occupied).
+    Occupied = 1,
+    /// No node in the tree.
+    Unknown = 2,
+}
+
+impl Cell {
+    fn from_u8(v: u8) -> Cell {
+        match v {
+            0 => Cell::Free,
+            1 => Cell::Occupied,
+            _ => Cell::Unknown,
+        }
+    }
+}
+
+/// Why a grid cannot be built.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GridError {
+    /// The resolution is not a finite positive number.
+    Resolution(f64),
+    /// The map has no known voxel, so it has no bounding box.
+    Empty,
+    /// The bounds are not finite or are inverted.
+    Bounds([f64; 3], [f64; 3]),
+    /// The bounding box holds more than [`MAX_CELLS`] voxels at this resolution.
+    TooLarge {
+        /// Voxels per axis that the box would need.
+        dims: [u64; 3],
+    },
+}
+
+impl fmt::Display for GridError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            GridError::Resolution(r) => write!(f, "resolution {r} is not a positive number"),
+            GridError::Empty => f.write_str("the map has no known (occupied or free) voxel"),
+            GridError::Bounds(lo, hi) => write!(f, "bounds {lo:?} .. {hi:?} are not a finite box"),
+            GridError::TooLarge { dims } => write!(
+                f,
+                "the bounding box needs {} x {} x {} voxels, more than {MAX_CELLS}",
+                dims[0], dims[1], dims[2]
+            ),
+        }
+    }
+}
+
+impl std::error::Error for GridError {}
+
+/// Per-state voxel counts of a grid (inside its bounds).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CellCounts {
+    /// Occupied voxels.
+    pub occupied: usize,
+    /// Free voxels.
+    pub free: usize,
+    /// Unknown voxels.
+    pub unknown: usize,
+}
+
+/// A dense three-state occupancy grid on OctoMap's voxel lattice.
+#[derive(Clone, Debug)]
+pub struct Grid {
+    resolution: f64,
+    origin: [i32; 3],
+    dims: [usize; 3],
+    bounds: ([f64; 3], [f64; 3]),
+    cells: Vec<u8>,
+    unknown_is_occupied: bool,
+}
+
+impl Grid {
+    /// An all-`fill` grid whose voxel `(0, 0, 0)` has lattice index `origin` and which
+    /// has `dims` voxels per axis. Its bounds are the voxels' outer faces.
+    pub fn new(
+        resolution: f64,
+        origin: [i32; 3],
+        dims: [usize; 3],
+        fill: Cell,
+        unknown_is_occupied: bool,
+    ) -> Result<Grid, GridError> {
+        if !(resolution.is_finite() && resolution > 0.0) {
+            return Err(GridError::Resolution(resolution));
+        }
+        let total = dims
+            .iter()
+            .try_fold(1usize, |acc, &d| acc.checked_mul(d))
+            .filter(|&t| t <= MAX_CELLS && t > 0);
+        let Some(total) = total else {
+            return Err(GridError::TooLarge {
+                dims: dims.map(|d| d as u64),
+            });
+        };
+        for a in 0..3 {
+            if (origin[a] as i64 + dims[a] as i64) > i32::MAX as i64 {
+                return Err(GridError::TooLarge {
+                    dims: dims.map(|d| d as u64),
+                });
+            }
+        }
+        let lo = [0, 1, 2].map(|a| origin[a] as f64 * resolution);
+        let hi = [0, 1, 2].map(|a| (origin[a] as i64 + dims[a] as i64) as f64 * resolution);
+        Ok(Grid {
+            resolution,
+            origin,
+            dims,
+            bounds: (lo, hi),
+            cells: vec![fill as u8; total],
+            unknown_is_occupied,
+        })
+    }
+
+    /// A grid covering the metric box `lo..hi` (snapped outwards to the lattice), every
+    /// voxel unknown, then filled from `leaves`: `(centre, edge, occupied)` cubes, which
+    /// may be larger than one voxel (pruned OctoMap leaves) and are expanded. The grid's
+    /// reported bounds are `lo..hi` exactly as given (OctoMap's metric bounds).
+    pub fn from_leaves(
+        resolution: f64,
+        lo: [f64; 3],
+        hi: [f64; 3],
+        leaves: impl IntoIterator<Item = ([f64; 3], f64, bool)>,
+        unknown_is_occupied: bool,
+    ) -> Result<Grid, GridError> {
+        if !(resolution.is_finite() && resolution > 0.0) {
+            return Err(GridError::Resolution(resolution));
+        }
+        if (0..3).any(|a| !(lo[a].is_finite() && hi[a].is_finite() && lo[a] < hi[a])) {
+            return Err(GridError::Bounds(lo, hi));
+        }
+        // Snap outwards, tolerating rounding in bounds that sit on the lattice.
+        let snap = |v: f64, up: bool| -> f64 {
+            let q = v / resolution;
+            let r = q.round();
+            if (q - r).abs() < 1e-6 {
+                r
+            } else if up {
+                q.ceil()
+            } else {
+                q.floor()
+            }
+        };
+        let mut origin = [0i32; 3];
+        let mut dims = [0usize; 3];
+        let mut raw = [0u64; 3];
+        for a in 0..3 {
+            let (i0, i1) = (snap(lo[a], false), snap(hi[a], true));
+            let n = i1 - i0;
+            raw[a] = if n.is_finite() && n > 0.0 {
+                n.min(u64::MAX as f64) as u64
+            } else {
+                0
+            };
+            if !(i0 >= i32::MIN as f64 && i1 <= i32::MAX as f64) || raw[a] == 0 {
+                return Err(GridError::TooLarge { dims: raw });
+            }
+            origin[a] = i0 as i32;
+            dims[a] = raw[a] as usize;
+        }
+        if raw
+            .iter()
+            .try_fold(1u64, |acc, &d| acc.checked_mul(d))
+            .is_none_or(|t| t > MAX_CELLS as u64)
+        {
+            return Err(GridError::TooLarge { dims: raw });
+        }
+        let mut g = Grid::new(resolution, origin, dims, Cell::Unknown, unknown_is_occupied)?;
+        g.bounds = (lo, hi);
+        for (c, size, occ) in leaves {
+            g.fill_cube(c, size, if occ { Cell::Occupied } else { Cell::Free });
+        }
+        Ok(g)
+    }
+
+    /// Sets every voxel of the cube of edge `size` centred at `c` (a lattice-aligned
+    /// OctoMap leaf) to `state`, clipped to the grid.
+    fn fill_cube(&mut self, c: [f64; 3], size: f64, state: Cell) {
+        if !(size.is_finite() && size > 0.0) || c.iter().any(|v| !v.is_finite()) {
+            return;
+        }
+        let mut lo = [0i64; 3];
+        let mut hi = [0i64; 3];
+        for a in 0..3 {
+            // Voxel indices whose centres lie inside the cube.
+            let l = ((c[a] - 0.5 * size) / self.resolution).round() as i64;
+            let h = ((c[a] + 0.5 * size) / self.resolution).round() as i64;
+            lo[a] = (l - self.origin[a] as i64).max(0);
+            hi[a] = (h - self.origin[a] as i64).min(self.dims[a] as i64);
+            if lo[a] >= hi[a] {
+                return;
+            }
+        }
+        for z in lo[2]..hi[2] {
+            for y in lo[1]..hi[1] {
+                let row = self.dims[0] * (y as usize + self.dims[1] * z as usize);
+                self.cells[row + lo[0] as usize..row + hi[0] as usize].fill(state as u8);
+            }
+        }
+    }
+
+    /// Voxel edge `r_v` (m).
+    pub fn resolution(&self) -> f64 {
+        self.resolution
+    }
+
+    /// Lattice index of the grid's voxel `(0, 0, 0)`.
+    pub fn origin(&self) -> [i32; 3] {
+        self.origin
+    }
+
+    /// Voxels per axis.
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
+    /// The map's bounding box `(min, max)` (m): unit centres must lie inside it.
+    pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
+        self.bounds
+    }
+
+    /// Whether `p` lies in the bounding box (closed).
+    pub fn in_bounds(&self, p: [f64; 3]) -> bool {
+        let (lo, hi) = self.bounds;
+        (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a])
+    }
+
+    /// Whether unknown space (inside and outside the grid) counts as an obstacle.
+    pub fn unknown_is_occupied(&self) -> bool {
+        self.unknown_is_occupied
+    }
+
+    /// Changes whether unknown space counts as an obstacle (rebuild any distance field).
+    pub fn set_unknown_is_occupied(&mut self, v: bool) {
+        self.unknown_is_occupied = v;
+    }
+
+    /// The lattice index of the voxel containing `p` (a point on a face belongs to the
+    /// voxel above it). Saturates far outside the `i32` range.
+    pub fn lattice_index(&self, p: [f64; 3]) -> [i32; 3] {
+        p.map(|v| {
+            (v / self.resolution)
+                .floor()
+                .clamp(i32::MIN as f64, i32::MAX as f64) as i32
+        })
+    }
+
+    /// Centre of the voxel with lattice index `i` (m).
+    pub fn voxel_center(&self, i: [i32; 3]) -> [f64; 3] {
+        i.map(|v| (v as f64 + 0.5) * self.resolution)
+    }
+
+    /// The grid-local index of lattice voxel `i`, if it is inside the grid.
+    #[inline]
+    pub fn local(&self, i: [i32; 3]) -> Option<[usize; 3]> {
+        let mut l = [0usize; 3];
+        for a in 0..3 {
+            let d = i[a] as i64 - self.origin[a] as i64;
+            if d < 0 || d >= self.dims[a] as i64 {
+                return None;
+            }
+            l[a] = d as usize;
+        }
+        Some(l)
+    }
+
+    /// Linear index of a grid-local voxel (x fastest).
+    #[inline]
+    pub fn linear(&self, l: [usize; 3]) -> usize {
+        l[0] + self.dims[0] * (l[1] + self.dims[1] * l[2])
+    }
+
+    /// State of lattice voxel `i`; [`Cell::Unknown`] outside the grid.
+    #[inline]
+    pub fn cell(&self, i: [i32; 3]) -> Cell {
+        match self.local(i) {
+            Some(l) => Cell::from_u8(self.cells[self.linear(l)]),
+            None => Cell::Unknown,
+        }
+    }
+
+    /// State of grid-local voxel `l` (must be inside the grid).
+    #[inline]
+    pub(crate) fn cell_local(&self, l: [usize; 3]) -> Cell {
+        Cell::from_u8(self.cells[self.linear(l)])
+    }
+
+    /// Sets lattice voxel `i`; ignored outside the grid.
+    pub fn set(&mut self, i: [i32; 3], state: Cell) {
+        if let Some(l) = self.local(i) {
+            let k = self.linear(l);
+            self.cells[k] = state as u8;
+        }
+    }
+
+    /// Whether lattice voxel `i` is an obstacle: occupied, or unknown when unknown
+    /// space counts as occupied. Outside the grid is unknown.
+    #[inline]
+    pub fn is_obstacle(&self, i: [i32; 3]) -> bool {
+        match self.cell(i) {
+            Cell::Occupied => true,
+            Cell::Free => false,
+            Cell::Unknown => self.unknown_is_occupied,
+        }
+    }
+
+    /// Whether the voxel containing `p` is an obstacle.
+    pub fn is_obstacle_at(&self, p: [f64; 3]) -> bool {
+        self.is_obstacle(self.lattice_index(p))
+    }
+
+    /// The raw states, x fastest, then y, then z.
+    pub fn cells(&self) -> impl ExactSizeIterator<Item = Cell> + '_ {
+        self.cells.iter().map(|&v| Cell::from_u8(v))
+    }
+
+    /// Counts of occupied, free and unknown voxels inside the grid.
+    pub fn counts(&self) -> CellCounts {
+        let mut n = [0usize; 3];
+        for &v in &self.cells {
+            n[(v as usize).min(2)] += 1;
+        }
+        CellCounts {
+            free: n[0],
+            occupied: n[1],
+            unknown: n[2],
+        }
+    }
+
+    /// Sets every voxel whose centre lies in the closed metric box `lo..hi` to `state`
+    /// (clipped to the grid). Used by the scenario generators.
+    pub fn fill_box(&mut self, lo: [f64; 3], hi: [f64; 3], state: Cell) {
+        let mut a0 = [0usize; 3];
+        let mut a1 = [0usize; 3];
+        for a in 0..3 {
+            // centre (i + 0.5) r in [lo, hi]  <=>  i in [lo/r - 0.5, hi/r - 0.5]
+            let i0 = (lo[a] / self.resolution - 0.5 - 1e-9).ceil() as i64 - self.origin[a] as i64;
+            let i1 =
+                (hi[a] / self.resolution - 0.5 + 1e-9).floor() as i64 - self.origin[a] as i64 + 1;
+            let (i0, i1) = (i0.max(0), i1.min(self.dims[a] as i64));
+            if i0 >= i1 {
+                return;
+            }
+            a0[a] = i0 as usize;
+            a1[a] = i1 as usize;
+        }
+        for z in a0[2]..a1[2] {
+            for y in a0[1]..a1[1] {
+                let row = self.dims[0] * (y + self.dims[1] * z);
+                self.cells[row + a0[0]..row + a1[0]].fill(state as u8);
+            }
+        }
+    }
+
+    /// Calls `f(lattice index, centre)` for every voxel of the grid whose centre
+    /// satisfies `inside`; sets those voxels to `state`. Used by the scenario generators
+    /// for curved shapes (cylinders).
+    pub fn fill_where(&mut self, state: Cell, mut inside: impl FnMut([f64; 3]) -> bool) {
+        for z in 0..self.dims[2] {
+            for y in 0..self.dims[1] {
+                for x in 0..self.dims[0] {
+                    let i = [
+                        self.origin[0] + x as i32,
+                        self.origin[1] + y as i32,
+                        self.origin[2] + z as i32,
+                    ];
+                    if inside(self.voxel_center(i)) {
+                        let k = self.linear([x, y, z]);
+                        self.cells[k] = state as u8;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Every known voxel as `(lattice index, occupied)`, for writing an OctoMap.
+    pub fn known_voxels(&self) -> impl Iterator<Item = ([i32; 3], bool)> + '_ {
+        let [nx, ny, _] = self.dims;
+        self.cells
+            .iter()
+            .enumerate()
+            .filter(|(_, &v)| v != Cell::Unknown as u8)
+            .map(move |(k, &v)| {
+                let (x, y, z) = (k % nx, (k / nx) % ny, k / (nx * ny));
+                (
+                    [
+                        self.origin[0] + x as i32,
+                        self.origin[1] + y as i32,
+                        self.origin[2] + z as i32,
+                    ],
+                    v == Cell::Occupied as u8,
+                )
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lattice_and_bounds() {
+        let g = Grid::new(0.1, [-5, 0, 2], [10, 4, 3], Cell::Free, true).unwrap();
+        let (lo, hi) = g.bounds();
+        assert!((lo[0] + 0.5).abs() < 1e-12 && (hi[0] - 0.5).abs() < 1e-12);
+        assert!((lo[2] - 0.2).abs() < 1e-12 && (hi[2] - 0.5).abs() < 1e-12);
+        assert_eq!(g.lattice_index([-0.45, 0.05, 0.25]), [-5, 0, 2]);
+        let c = g.voxel_center([-5, 0, 2]);
+        assert!((c[0] + 0.45).abs() < 1e-12 && (c[2] - 0.25).abs() < 1e-12);
+        assert_eq!(g.cell([-6, 0, 2]), Cell::Unknown);
+        assert!(g.is_obstacle([-6, 0, 2]));
+        assert!(!g.is_obstacle([-5, 0, 2]));
+    }
+
+    #[test]
+    fn pruned_leaves_expand() {
+        // One 0.4 m free leaf (4x4x4 voxels) and one occupied voxel inside the box.
+        let leaves = vec![
+            ([0.2, 0.2, 0.2], 0.4, false),
+            ([0.55, 0.05, 0.05], 0.1, true),
+        ];
+        let g = Grid::from_leaves(0.1, [0.0; 3], [0.6, 0.4, 0.4], leaves, true).unwrap();
+        assert_eq!(g.dims(), [6, 4, 4]);
+        let c = g.counts();
+        assert_eq!(c.free, 64);
+        assert_eq!(c.occupied, 1);
+        assert_eq!(c.unknown, 6 * 16 - 64 - 1);
+        assert_eq!(g.cell([5, 0, 0]), Cell::Occupied);
+        assert_eq!(g.cell([3, 3, 3]), Cell::Free);
+        assert_eq!(g.cell([4, 3, 3]), Cell::Unknown);
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        assert!(matches!(
+            Grid::new(0.0, [0; 3], [1; 3], Cell::Free, true),
+            Err(GridError::Resolution(_))
+        ));
+        assert!(matches!(
+            Grid::new(0.1, [0; 3], [0, 1, 1], Cell::Free, true),
+            Err(GridError::TooLarge { .. })
+        ));
+        assert!(matches!(
+            Grid::from_leaves(0.1, [0.0; 3], [1e9, 1e9, 1e9], Vec::new(), true),
+            Err(GridError::TooLarge { .. })
+        ));
+        assert!(matches!(
+            Grid::from_leaves(0.1, [0.0; 3], [f64::NAN, 1.0, 1.0], Vec::new(), true),
+            Err(GridError::Bounds(..))
+        ));
+    }
+
+    #[test]
+    fn fill_box_uses_centres() {
+        let mut g = Grid::new(0.1, [0; 3], [10, 10, 10], Cell::Free, true).unwrap();
+        g.fill_box([0.2, 0.0, 0.0], [0.4, 1.0, 1.0], Cell::Occupied);
+        // Centres 0.25 and 0.35 are inside [0.2, 0.4].
+        assert_eq!(g.counts().occupied, 200);
+        assert_eq!(g.cell([2, 0, 0]), Cell::Occupied);
+        assert_eq!(g.cell([4, 0, 0]), Cell::Free);
+        let known: Vec<_> = g.known_voxels().filter(|v| v.1).collect();
+        assert_eq!(known.len(), 200);
+    }
+}
