@@ -6,7 +6,8 @@
 //!    `u32` length and the table blob. The blob is the file named by `ARC_TABLE`
 //!    (e.g. the output of `arc tables build`) or, by default, a table generated
 //!    here with arc-core's own generators and encoder for the chain this unit is
-//!    built for. With feature `corrupt-table` one byte in its middle is flipped.
+//!    built for. With feature `corrupt-table` one byte in its middle is flipped;
+//!    with feature `external-table` no table is made (the slot is flashed apart).
 //! 3. Writes `unit_config.rs`: the build-time constants of this unit.
 //!
 //! Environment (all optional):
@@ -54,17 +55,17 @@ fn main() {
         "ARC_UNIT={unit} must lie in 1..=ARC_UNITS={units}"
     );
     println!("cargo:rerun-if-env-changed=ARC_TABLE");
-    let (mut blob, source) = match env::var_os("ARC_TABLE") {
-        Some(path) => {
-            let path = PathBuf::from(path);
-            println!("cargo:rerun-if-changed={}", path.display());
-            let blob =
-                fs::read(&path).unwrap_or_else(|e| panic!("ARC_TABLE={}: {e}", path.display()));
-            (blob, "file")
-        }
-        None => (tables::generate(units, n_srs, seed), "generated"),
+    let (mut blob, source) = if env::var_os("CARGO_FEATURE_EXTERNAL_TABLE").is_some() {
+        (Vec::new(), "external")
+    } else if let Some(path) = env::var_os("ARC_TABLE") {
+        let path = PathBuf::from(path);
+        println!("cargo:rerun-if-changed={}", path.display());
+        let blob = fs::read(&path).unwrap_or_else(|e| panic!("ARC_TABLE={}: {e}", path.display()));
+        (blob, "file")
+    } else {
+        (tables::generate(units, n_srs, seed), "generated")
     };
-    if env::var_os("CARGO_FEATURE_CORRUPT_TABLE").is_some() {
+    if env::var_os("CARGO_FEATURE_CORRUPT_TABLE").is_some() && !blob.is_empty() {
         let mid = blob.len() / 2;
         blob[mid] ^= 0x5A;
     }
@@ -82,8 +83,10 @@ fn main() {
          /// Random shapes requested for a generated table (`ARC_N_SRS`).\n\
          pub const N_SRS_BUILT: u32 = {n_srs};\n\
          /// Bytes of the linked table image (length word + blob).\n\
+         #[allow(dead_code)] // unused with feature `external-table`\n\
          pub const TABLE_IMAGE_LEN: usize = {len};\n\
-         /// Where the linked table came from: \"generated\" or \"file\" (`ARC_TABLE`).\n\
+         /// Where the linked table came from: \"generated\", \"file\" (`ARC_TABLE`)\n\
+         /// or \"external\" (none linked: feature `external-table`).\n\
          pub const TABLE_SOURCE: &str = \"{source}\";\n",
         len = image.len(),
     );

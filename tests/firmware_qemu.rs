@@ -403,7 +403,7 @@ fn corrupted_table_puts_the_unit_in_safe_mode() {
 fn host_table(units: u8, count: usize, name: &str) -> PathBuf {
     let p = ChainParams::new(units);
     let lib = library(&p);
-    let srs = Srs::<64, 8>::generate(p, &SrsSettings::new(count, 7)).expect("srs");
+    let srs = Srs::<128, 8>::generate(p, &SrsSettings::new(count, 7)).expect("srs");
     let mut buf = vec![0u8; 64 * 1024];
     let len = encode_into(&mut buf, &p, &lib.entries, &srs.shapes, &srs.adjacency).expect("encode");
     let dir = workspace_root().join("target/firmware/qemu-tests");
@@ -457,4 +457,27 @@ fn host_written_tables_are_checked_against_the_unit_chain() {
     );
     let r = run(&elf, &dp);
     assert_safe_mode(&r, "ChainMismatch");
+}
+
+#[test]
+fn table_flashed_apart_from_the_program() {
+    let Some(dp) = tools("table_flashed_apart_from_the_program") else {
+        return;
+    };
+    // A program that links no table (its ELF leaves the table slot alone)...
+    let elf = build("external", &["external-table"], &[]);
+    let r = run(&elf, &dp);
+    assert_safe_mode(&r, "Slot(Empty)");
+    // ...and a table image flashed on its own at the slot's address, as
+    // `probe-rs download --binary-format bin --base-address 0x080C0000` would:
+    // a little-endian u32 length, then the table written on the host.
+    let table = std::fs::read(host_table(6, 100, "host-n6-100.table")).expect("read table");
+    let mut image = (table.len() as u32).to_le_bytes().to_vec();
+    image.extend_from_slice(&table);
+    let slot = workspace_root().join("target/firmware/qemu-tests/slot-n6-100.bin");
+    std::fs::write(&slot, &image).expect("write slot image");
+    let loader = format!("loader,file={},addr=0x080C0000", slot.display());
+    let r = run_with(&elf, &dp, &["-device", &loader]);
+    assert!(r.has("table external"), "{}", r.context());
+    assert_mission_success(&r, 100);
 }

@@ -32,7 +32,9 @@ use platform::Outcome;
 
 /// The table image linked into the table slot (`.arc_tables`, memory.x). It is
 /// never read through this name: the program finds the slot through the
-/// linker symbols, exactly as it would a table flashed on its own.
+/// linker symbols, exactly as it would a table flashed on its own. Feature
+/// `external-table` leaves it out so the ELF does not touch the slot.
+#[cfg(not(feature = "external-table"))]
 #[used]
 #[link_section = ".arc_tables"]
 static TABLE_IMAGE: [u8; config::TABLE_IMAGE_LEN] =
