@@ -150,16 +150,21 @@ impl Run {
 
 /// Boots `elf` in QEMU and decodes its defmt frames with `defmt-print`.
 fn run(elf: &Path, defmt_print: &Path) -> Run {
+    run_with(elf, defmt_print, &[])
+}
+
+/// [`run`] with extra QEMU arguments.
+fn run_with(elf: &Path, defmt_print: &Path, qemu_args: &[&str]) -> Run {
     let mut qemu = Command::new("qemu-system-arm")
+        .args(["-cpu", "cortex-m4", "-machine", "netduinoplus2"])
         .args([
-            "-cpu",
-            "cortex-m4",
-            "-machine",
-            "netduinoplus2",
             "-nographic",
+            "-semihosting-config",
+            "enable=on,target=native",
         ])
-        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
+        .arg("-kernel")
         .arg(elf)
+        .args(qemu_args)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
