@@ -100,13 +100,15 @@ mod tables {
     use arc_core::table::encode_into;
     use arc_core::{ChainParams, Shape, MAX_SHAPE_DIM, MAX_UNITS};
 
-    /// Roadmap degree cap of a generated table.
-    const DEGREE: usize = 8;
+    /// Roadmap degree cap of a generated table: the host's
+    /// (`arc_host_sim::tables::DEGREE`), so both make the same bytes.
+    const DEGREE: usize = 12;
 
     /// The table for `units` units (ARC-MODEL.md default parameters): the full
-    /// library, `n_srs` random shapes from `seed` and their roadmap, as
-    /// `arc_core::srs::Srs::generate` would build them (same sampler, same
-    /// settings), but in heap storage so any `n_srs` fits.
+    /// library, `n_srs` random shapes from `seed` and their roadmap, built as
+    /// `arc tables build --units N --srs N_SRS --seed SEED` builds it (same
+    /// sampler, same roadmap radius and degree, same encoder), so the two give
+    /// the same blob.
     pub fn generate(units: u8, n_srs: usize, seed: u64) -> Vec<u8> {
         let params = ChainParams::new(units)
             .validate()

@@ -486,3 +486,19 @@ fn table_flashed_apart_from_the_program() {
     assert!(r.has("table external"), "{}", r.context());
     assert_mission_success(&r, 100);
 }
+
+#[test]
+fn head_and_tail_units_steer_their_links() {
+    let Some(dp) = tools("head_and_tail_units_steer_their_links") else {
+        return;
+    };
+    // Unit 1 (the head) steers link 1; unit 6, the tail, leads no link and
+    // steers link 5, the one it trails.
+    for (unit, link) in [("1", "1"), ("6", "5")] {
+        let elf = build(&format!("unit{unit}"), &[], &[("ARC_UNIT", unit)]);
+        let r = run(&elf, &dp);
+        let up = format!("ARC unit {unit} of 6 up: steers link {link},");
+        assert!(r.has(&up), "expected {up:?}; {}", r.context());
+        assert_mission_success(&r, 100);
+    }
+}

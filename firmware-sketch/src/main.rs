@@ -50,7 +50,7 @@ fn main() -> ! {
     let expected = ChainParams::new(config::UNITS);
     let link = mission::link_index(config::UNIT, config::UNITS);
     defmt::info!(
-        "ARC unit {=u8} of {=u8} up: leads link {=usize}, table {=str} ({=u32} SRS requested)",
+        "ARC unit {=u8} of {=u8} up: steers link {=usize}, table {=str} ({=u32} SRS requested)",
         config::UNIT,
         config::UNITS,
         link + 1,
