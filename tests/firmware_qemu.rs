@@ -130,19 +130,24 @@ fn build(name: &str, features: &[&str], env: &[(&str, &str)]) -> PathBuf {
 
 /// A run's decoded log and exit status.
 struct Run {
+    /// QEMU's exit status (the firmware's semihosting exit code).
     status: ExitStatus,
+    /// defmt-print's output, then anything QEMU wrote on stderr.
     log: String,
 }
 
 impl Run {
+    /// The decoded log lines that contain `needle`.
     fn lines_with<'a>(&'a self, needle: &'a str) -> impl Iterator<Item = &'a str> + 'a {
         self.log.lines().filter(move |l| l.contains(needle))
     }
 
+    /// Whether some decoded log line contains `needle`.
     fn has(&self, needle: &str) -> bool {
         self.lines_with(needle).next().is_some()
     }
 
+    /// Exit status and whole log, for failure messages.
     fn context(&self) -> String {
         format!("exit status {:?}; decoded log:\n{}", self.status, self.log)
     }
