@@ -1,3 +1,4 @@
 //! Maps: OctoMap files, occupancy grids, distance fields and scenario generators.
 pub mod distance;
 pub mod grid;
+pub mod octomap;
