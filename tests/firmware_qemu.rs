@@ -2,7 +2,8 @@
 //! in QEMU (netduinoplus2, an STM32F405), its defmt output decoded by
 //! `defmt-print`:
 //!
-//! - with the table its build script generates: the table is valid, every
+//! - with the table its build script generates (the same bytes as the host's
+//!   `arc tables build`, checked by CRC): the table is valid, every
 //!   scripted "go to shape k" settles within tolerance and time, the stack peak
 //!   is within budget, and the firmware exits with success;
 //! - with that table corrupted (feature `corrupt-table`): safe mode, every shape
@@ -17,13 +18,15 @@
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
+use std::sync::atomic::AtomicUsize;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use arc_core::lsc::library;
 use arc_core::srs::{Srs, SrsSettings};
-use arc_core::table::encode_into;
+use arc_core::table::{encode_into, TableView};
 use arc_core::ChainParams;
+use arc_host_sim::tables::{ShapeTables, TableSettings};
 use arc_tests::{cargo, workspace_root};
 
 /// Builds share one target folder and one output path: one at a time.
@@ -397,6 +400,29 @@ fn firmware_reaches_every_commanded_shape() {
     let elf = build("valid", &[], &[("ARC_N_SRS", "100")]);
     let r = run(&elf, &dp);
     assert_mission_success(&r, 100);
+    // The table the firmware's build script generated is the very table the
+    // host makes (`arc tables build --units 6 --srs 100 --seed 1`): same CRC.
+    let host = ShapeTables::build(
+        ChainParams::new(6),
+        &TableSettings {
+            srs: 100,
+            seed: 1,
+            ..Default::default()
+        },
+        &AtomicUsize::new(0),
+    )
+    .expect("host tables")
+    .encode()
+    .expect("encode");
+    let crc = TableView::open(&host, None)
+        .expect("host table opens")
+        .crc();
+    let expected = format!("CRC {crc:#010x}");
+    assert!(
+        r.lines_with("table valid:").any(|l| l.contains(&expected)),
+        "firmware table differs from the host's ({expected}); {}",
+        r.context()
+    );
 }
 
 #[test]
