@@ -9,4 +9,8 @@ pub mod cli;
 pub mod collision;
 pub mod fsutil;
 pub mod map;
+pub mod picture;
 pub mod plan;
+pub mod plan_picture;
+pub mod planner;
+pub mod tables;

@@ -145,9 +145,16 @@ impl Plan {
     /// length and finiteness.
     pub fn read(path: &Path) -> Result<Self, PlanError> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| PlanError::Io { path: name.clone(), source })?;
-        let plan: Plan = serde_json::from_str(&text).map_err(|source| PlanError::Json { path: name.clone(), source })?;
-        plan.check().map_err(|what| PlanError::Invalid { path: name, what })?;
+        let text = std::fs::read_to_string(path).map_err(|source| PlanError::Io {
+            path: name.clone(),
+            source,
+        })?;
+        let plan: Plan = serde_json::from_str(&text).map_err(|source| PlanError::Json {
+            path: name.clone(),
+            source,
+        })?;
+        plan.check()
+            .map_err(|what| PlanError::Invalid { path: name, what })?;
         Ok(plan)
     }
 
@@ -158,7 +165,10 @@ impl Plan {
         }
         let params = self.chain.to_params()?;
         if !(self.map.resolution.is_finite() && self.map.resolution > 0.0) {
-            return Err(format!("map.resolution = {} must be a positive number", self.map.resolution));
+            return Err(format!(
+                "map.resolution = {} must be a positive number",
+                self.map.resolution
+            ));
         }
         if self.waypoints.is_empty() {
             return Err("waypoints is empty".into());
@@ -166,7 +176,11 @@ impl Plan {
         let dim = 2 * params.n() + 2;
         for (i, w) in self.waypoints.iter().enumerate() {
             if w.zeta.len() != dim {
-                return Err(format!("waypoints[{i}].zeta has {} numbers, expected {dim} for N = {}", w.zeta.len(), params.n()));
+                return Err(format!(
+                    "waypoints[{i}].zeta has {} numbers, expected {dim} for N = {}",
+                    w.zeta.len(),
+                    params.n()
+                ));
             }
             if let Some(j) = w.zeta.iter().position(|v| !v.is_finite()) {
                 return Err(format!("waypoints[{i}].zeta[{j}] is not a finite number"));
@@ -178,8 +192,10 @@ impl Plan {
     /// Writes the plan as pretty JSON, atomically.
     pub fn write(&self, path: &Path) -> Result<(), PlanError> {
         let text = serde_json::to_string_pretty(self).expect("a plan always serialises");
-        crate::fsutil::write_atomic(path, text.as_bytes())
-            .map_err(|source| PlanError::Io { path: path.display().to_string(), source })
+        crate::fsutil::write_atomic(path, text.as_bytes()).map_err(|source| PlanError::Io {
+            path: path.display().to_string(),
+            source,
+        })
     }
 }
 
@@ -192,7 +208,10 @@ mod tests {
         Plan {
             format: FORMAT.into(),
             chain: ChainSection::from_params(&p),
-            map: MapSection { resolution: 0.1, unknown_is_occupied: true },
+            map: MapSection {
+                resolution: 0.1,
+                unknown_is_occupied: true,
+            },
             waypoints: vec![Waypoint::new([1.0, 2.0, 3.0], &Shape::line(3, 0.0))],
             stats: Default::default(),
         }
@@ -211,7 +230,10 @@ mod tests {
     fn bad_plans_are_named() {
         let mut plan = sample();
         plan.waypoints[0].zeta.pop();
-        assert!(plan.check().unwrap_err().contains("waypoints[0].zeta has 7 numbers"));
+        assert!(plan
+            .check()
+            .unwrap_err()
+            .contains("waypoints[0].zeta has 7 numbers"));
         let mut plan = sample();
         plan.format = "x".into();
         assert!(plan.check().unwrap_err().contains("format"));

@@ -8,7 +8,11 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+pub mod common;
+mod map;
+mod plan;
 mod tables;
+mod verify;
 
 /// What went wrong, and which exit code it earns.
 #[derive(Debug)]
@@ -22,11 +26,17 @@ pub struct CliError {
 impl CliError {
     /// Bad input: exit code 2.
     pub fn input(message: impl Into<String>) -> Self {
-        Self { code: 2, message: message.into() }
+        Self {
+            code: 2,
+            message: message.into(),
+        }
     }
     /// The job ran but found no solution: exit code 1.
     pub fn failed(message: impl Into<String>) -> Self {
-        Self { code: 1, message: message.into() }
+        Self {
+            code: 1,
+            message: message.into(),
+        }
     }
 }
 
@@ -56,6 +66,13 @@ enum Command {
     Tables(tables::TablesCommand),
     /// Draw the shape library (LSC) in top and side view.
     Shapes(tables::ShapesArgs),
+    /// Plan a collision-free motion with shape changes (the ARCplanner).
+    Plan(Box<plan::PlanArgs>),
+    /// Check a plan exactly against a map (ARC-MODEL.md), independent of the planner.
+    Verify(verify::VerifyArgs),
+    /// Maps: export built-in scenarios as OctoMap files, inspect and draw maps.
+    #[command(subcommand)]
+    Map(map::MapCommand),
 }
 
 /// Parses `args` (including the program name) and runs the command.
@@ -66,9 +83,15 @@ where
 {
     let cli = Cli::try_parse_from(args).map_err(|e| {
         // --help and --version are not errors.
-        if matches!(e.kind(), clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion) {
+        if matches!(
+            e.kind(),
+            clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion
+        ) {
             let _ = e.print();
-            return CliError { code: 0, message: String::new() };
+            return CliError {
+                code: 0,
+                message: String::new(),
+            };
         }
         CliError::input(e.render().to_string().trim_end().to_string())
     });
@@ -80,6 +103,9 @@ where
     match cli.command {
         Command::Tables(c) => tables::run(c),
         Command::Shapes(a) => tables::run_shapes(a),
+        Command::Plan(a) => plan::run(*a),
+        Command::Verify(a) => verify::run(a),
+        Command::Map(c) => map::run(c),
     }
 }
 

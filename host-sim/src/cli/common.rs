@@ -1,0 +1,152 @@
+//! Arguments and loading shared by the commands that work on a map.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use clap::Args;
+
+use super::CliError;
+use crate::map::distance::DistanceField;
+use crate::map::grid::Grid;
+use crate::map::octomap::OcTree;
+use crate::map::scenarios::{self, Scenario};
+
+/// Chain geometry options shared by every command that makes a chain.
+#[derive(Args, Debug, Clone)]
+pub struct ChainArgs {
+    /// Number of units N (2..=16).
+    #[arg(long, short = 'n')]
+    pub units: Option<u8>,
+    /// Link length l (m).
+    #[arg(long, default_value_t = arc_core::ChainParams::DEFAULT_LINK_LENGTH)]
+    pub link_length: f32,
+    /// Unit collision sphere radius r_u (m).
+    #[arg(long, default_value_t = arc_core::ChainParams::DEFAULT_UNIT_RADIUS)]
+    pub unit_radius: f32,
+    /// Link capsule radius r_l (m).
+    #[arg(long, default_value_t = arc_core::ChainParams::DEFAULT_LINK_RADIUS)]
+    pub link_radius: f32,
+    /// Pitch limit theta_max (degrees).
+    #[arg(long, default_value_t = 60.0)]
+    pub theta_max_deg: f32,
+    /// Bend limit beta_max (degrees).
+    #[arg(long, default_value_t = 120.0)]
+    pub beta_max_deg: f32,
+}
+
+impl ChainArgs {
+    /// Validated chain parameters, with `default_units` when `--units` is absent.
+    pub fn params(&self, default_units: u8) -> Result<arc_core::ChainParams, CliError> {
+        let units = self.units.unwrap_or(default_units);
+        arc_core::ChainParams {
+            units,
+            link_length: self.link_length,
+            unit_radius: self.unit_radius,
+            link_radius: self.link_radius,
+            theta_max: arc_core::angle::deg(self.theta_max_deg),
+            beta_max: arc_core::angle::deg(self.beta_max_deg),
+        }
+        .validate()
+        .map_err(|e| CliError::input(format!("chain parameters (--units {units}, ...): {e}")))
+    }
+}
+
+/// Where the map comes from: an OctoMap file or a built-in scenario.
+#[derive(Args, Debug, Clone)]
+pub struct MapArgs {
+    /// OctoMap binary tree (.bt) to work on.
+    #[arg(
+        long,
+        conflicts_with = "scenario",
+        required_unless_present = "scenario"
+    )]
+    pub map: Option<PathBuf>,
+    /// Built-in scenario: window, maze, silos, corridor or corridor:LENGTH.
+    #[arg(long)]
+    pub scenario: Option<String>,
+    /// Treat unknown space as free (the default treats it as occupied).
+    #[arg(long)]
+    pub unknown_free: bool,
+}
+
+/// A loaded map, and the scenario it came from if any.
+pub struct LoadedMap {
+    /// The occupancy grid (with the user's unknown-space choice applied).
+    pub grid: Grid,
+    /// The scenario, when the map is a built-in one.
+    pub scenario: Option<Scenario>,
+}
+
+impl MapArgs {
+    /// Loads the map: the file is read and checked, or the scenario generated.
+    pub fn load(&self) -> Result<LoadedMap, CliError> {
+        if let Some(name) = &self.scenario {
+            let sc = scenarios::build(name)
+                .map_err(|e| CliError::input(format!("--scenario {name}: {e}")))?;
+            let mut grid = sc.grid.clone();
+            grid.set_unknown_is_occupied(!self.unknown_free);
+            return Ok(LoadedMap {
+                grid,
+                scenario: Some(sc),
+            });
+        }
+        let path = self
+            .map
+            .as_ref()
+            .ok_or_else(|| CliError::input("give --map FILE.bt or --scenario NAME"))?;
+        let tree = OcTree::read_bt(path).map_err(|e| CliError::input(e.to_string()))?;
+        let grid = Grid::from_octree(&tree, !self.unknown_free)
+            .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+        Ok(LoadedMap {
+            grid,
+            scenario: None,
+        })
+    }
+
+    /// The map's name for messages and titles.
+    pub fn name(&self) -> String {
+        match (&self.scenario, &self.map) {
+            (Some(s), _) => format!("scenario {s}"),
+            (None, Some(p)) => p.display().to_string(),
+            (None, None) => "map".into(),
+        }
+    }
+}
+
+impl LoadedMap {
+    /// The distance field over the grid (which it keeps), and the scenario.
+    pub fn into_field(self) -> (Arc<DistanceField>, Option<Scenario>) {
+        (Arc::new(DistanceField::new(self.grid)), self.scenario)
+    }
+}
+
+/// Parses `x,y,z`.
+pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<&str> = s.split(',').map(str::trim).collect();
+    if v.len() != 3 {
+        return Err(format!("expected x,y,z (three numbers), got {s:?}"));
+    }
+    let mut p = [0.0; 3];
+    for (slot, t) in p.iter_mut().zip(&v) {
+        *slot = t
+            .parse::<f64>()
+            .map_err(|_| format!("{t:?} in {s:?} is not a number"))?;
+        if !slot.is_finite() {
+            return Err(format!("{t:?} in {s:?} is not finite"));
+        }
+    }
+    Ok(p)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_parse_or_say_why() {
+        assert_eq!(parse_point("1, -2.5,3").unwrap(), [1.0, -2.5, 3.0]);
+        assert!(parse_point("1,2").unwrap_err().contains("three numbers"));
+        assert!(parse_point("1,x,2").unwrap_err().contains("\"x\""));
+        assert!(parse_point("1,inf,2").unwrap_err().contains("not finite"));
+    }
+}

@@ -1,0 +1,260 @@
+//! `arc plan`: the ARCplanner on a map file or a built-in scenario.
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicUsize;
+use std::time::Duration;
+
+use arc_core::lsc::{library, LscKind};
+use arc_core::{ChainParams, Shape};
+use clap::Args;
+
+use super::common::{parse_point, ChainArgs, MapArgs};
+use super::{CliError, CliResult};
+use crate::collision::{CollisionContext, DEFAULT_CLEARANCE};
+use crate::planner::{motion, Mode, Planner, Preference, Settings, Termination};
+use crate::tables::{ShapeTables, TableSettings};
+
+/// `arc plan`
+#[derive(Args, Debug)]
+pub struct PlanArgs {
+    #[command(flatten)]
+    map: MapArgs,
+    #[command(flatten)]
+    chain: ChainArgs,
+    /// Head start position x,y,z (m); a scenario has its own.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    start: Option<[f64; 3]>,
+    /// Start yaw (degrees); a scenario has its own.
+    #[arg(long, allow_hyphen_values = true)]
+    start_yaw_deg: Option<f64>,
+    /// Start shape: a library name (LI, SE, SM, SV, CA, PN) turned to the start yaw.
+    #[arg(long, default_value = "LI")]
+    start_shape: String,
+    /// Head goal position x,y,z (m); a scenario has its own.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    goal: Option<[f64; 3]>,
+    /// Goal tolerance for the head (m).
+    #[arg(long, default_value_t = 0.3)]
+    goal_tol: f64,
+    /// Shape sources: both (the ARCplanner), lsc or srs (the paper's ablation).
+    #[arg(long, value_enum, default_value_t = Mode::Both)]
+    mode: Mode,
+    /// Shape preference: least (change only when needed) or coverage (PN where it fits).
+    #[arg(long, value_enum, default_value_t = Preference::Least)]
+    prefer: Preference,
+    /// Seed of the head roadmap.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Head roadmap vertices M_VT.
+    #[arg(long, default_value_t = 1500)]
+    vertices: usize,
+    /// Head roadmap radius r_T (m).
+    #[arg(long, default_value_t = 1.5)]
+    r_t: f64,
+    /// Headings tried per shape (n_psi).
+    #[arg(long, default_value_t = 8)]
+    n_psi: usize,
+    /// G_Val connection radius d_c (C_T metric).
+    #[arg(long, default_value_t = 4.0)]
+    d_c: f32,
+    /// Random shapes N_SRS (when the tables are generated).
+    #[arg(long, default_value_t = 500)]
+    srs: usize,
+    /// Seed of the random shapes (when the tables are generated).
+    #[arg(long, default_value_t = 1)]
+    srs_seed: u64,
+    /// Shape tables from `arc tables build` (instead of generating them).
+    #[arg(long)]
+    tables: Option<PathBuf>,
+    /// Clearance margin added to every body's radius (m): plans keep this far from walls.
+    #[arg(long, default_value_t = DEFAULT_CLEARANCE)]
+    clearance: f64,
+    /// Head edges the planner may drop before it gives up.
+    #[arg(long, default_value_t = 200)]
+    max_replans: usize,
+    /// Give up after this many seconds.
+    #[arg(long)]
+    time_limit: Option<f64>,
+    /// Output plan (JSON, arc-plan/1).
+    #[arg(long)]
+    out: PathBuf,
+    /// Picture of the plan (.svg or .png).
+    #[arg(long)]
+    picture: Option<PathBuf>,
+}
+
+/// Checks the numeric options.
+fn check(a: &PlanArgs) -> Result<(), CliError> {
+    let bad = |flag: &str, v: String, want: &str| {
+        Err(CliError::input(format!("{flag} {v}: must be {want}")))
+    };
+    if a.vertices == 0 {
+        return bad("--vertices", a.vertices.to_string(), "at least 1");
+    }
+    if !(a.r_t.is_finite() && a.r_t > 0.0) {
+        return bad("--r-t", a.r_t.to_string(), "a positive number");
+    }
+    if a.n_psi == 0 || a.n_psi > 360 {
+        return bad("--n-psi", a.n_psi.to_string(), "between 1 and 360");
+    }
+    if !(a.d_c.is_finite() && a.d_c > 0.0) {
+        return bad("--d-c", a.d_c.to_string(), "a positive number");
+    }
+    if !(a.goal_tol.is_finite() && a.goal_tol >= 0.0) {
+        return bad("--goal-tol", a.goal_tol.to_string(), "a number >= 0");
+    }
+    if !(a.clearance.is_finite() && a.clearance >= 0.0) {
+        return bad("--clearance", a.clearance.to_string(), "a number >= 0");
+    }
+    if a.time_limit.is_some_and(|t| !(t.is_finite() && t > 0.0)) {
+        return bad(
+            "--time-limit",
+            format!("{:?}", a.time_limit),
+            "a positive number of seconds",
+        );
+    }
+    if a.srs > u16::MAX as usize {
+        return bad("--srs", a.srs.to_string(), "at most 65535");
+    }
+    Ok(())
+}
+
+/// The start shape: a library shape turned so the head looks along `yaw`.
+pub fn start_shape(params: &ChainParams, name: &str, yaw: f32) -> Result<Shape, CliError> {
+    let kind = LscKind::from_name(name).ok_or_else(|| {
+        CliError::input(format!(
+            "--start-shape {name}: not one of LI SE SM SV CA PN"
+        ))
+    })?;
+    let lib = library(params);
+    let e = lib.get(kind).ok_or_else(|| {
+        CliError::input(format!(
+            "--start-shape {name}: not in the library for N = {}",
+            params.units
+        ))
+    })?;
+    Ok(e.shape
+        .rotated(arc_core::angle::diff(e.shape.head_yaw(), yaw)))
+}
+
+/// The tables: read from `--tables` (and checked against the chain) or generated.
+pub fn load_tables(
+    path: Option<&PathBuf>,
+    params: ChainParams,
+    srs: usize,
+    seed: u64,
+) -> Result<ShapeTables, CliError> {
+    match path {
+        Some(p) => {
+            let t = ShapeTables::read(p).map_err(|e| CliError::input(e.to_string()))?;
+            if t.params != params {
+                return Err(CliError::input(format!(
+                    "{}: the table is for another chain (N = {}, l = {}) than asked (N = {}, l = {})",
+                    p.display(),
+                    t.params.units,
+                    t.params.link_length,
+                    params.units,
+                    params.link_length
+                )));
+            }
+            Ok(t)
+        }
+        None => {
+            let s = TableSettings {
+                srs,
+                seed,
+                ..Default::default()
+            };
+            ShapeTables::build(params, &s, &AtomicUsize::new(0))
+                .map_err(|e| CliError::failed(e.to_string()))
+        }
+    }
+}
+
+/// Runs `arc plan`.
+pub fn run(a: PlanArgs) -> CliResult {
+    check(&a)?;
+    let loaded = a.map.load()?;
+    let sc = loaded.scenario.as_ref();
+    let units = a
+        .chain
+        .units
+        .or(sc.map(|s| s.default_units))
+        .ok_or_else(|| CliError::input("--units is required with --map"))?;
+    let params = a.chain.params(units)?;
+    let start = a
+        .start
+        .or(sc.map(|s| s.start))
+        .ok_or_else(|| CliError::input("--start is required with --map"))?;
+    let goal = a
+        .goal
+        .or(sc.map(|s| s.goal))
+        .ok_or_else(|| CliError::input("--goal is required with --map"))?;
+    let yaw = a
+        .start_yaw_deg
+        .map(f64::to_radians)
+        .or(sc.map(|s| s.start_yaw))
+        .unwrap_or(0.0);
+    let shape = start_shape(&params, &a.start_shape, yaw as f32)?;
+    let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
+    let (resolution, unknown_occ) = (loaded.grid.resolution(), loaded.grid.unknown_is_occupied());
+    let (field, _) = loaded.into_field();
+    let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;
+    let settings = Settings {
+        vertices: a.vertices,
+        r_t: a.r_t,
+        n_psi: a.n_psi,
+        d_c: a.d_c,
+        mode: a.mode,
+        prefer: a.prefer,
+        seed: a.seed,
+        max_replans: a.max_replans,
+        goal_tol: a.goal_tol,
+    };
+    let mut planner =
+        Planner::new(ctx, tables, settings).map_err(|e| CliError::input(e.to_string()))?;
+    let stop = Termination {
+        time_limit: a.time_limit.map(Duration::from_secs_f64),
+    };
+    let solution = planner
+        .solve(start, shape, goal, stop)
+        .map_err(|e| CliError::failed(format!("no plan: {e}")))?;
+    let plan = motion::to_plan(&solution, &params, resolution, unknown_occ);
+    plan.write(&a.out)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    let s = &solution.stats;
+    println!(
+        "{}: solved on {} with N = {}: {} waypoints, {} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations), {} replans",
+        a.out.display(),
+        a.map.name(),
+        params.units,
+        plan.waypoints.len(),
+        s.edges,
+        s.shape_changes,
+        s.lsc_uses,
+        s.srs_uses,
+        s.rotations,
+        s.replans
+    );
+    println!(
+        "  roadmap {:.1} ms ({} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
+        s.roadmap_s * 1e3,
+        s.roadmap_vertices,
+        s.planning_s * 1e3,
+        s.collision_s * 1e3,
+        s.collision_checks
+    );
+    if let Some(pic) = &a.picture {
+        let grid = planner.context().field().grid();
+        crate::plan_picture::draw(
+            grid,
+            &plan,
+            &format!("ARCplanner on {}", a.map.name()),
+            Some(goal),
+        )
+        .save(pic)
+        .map_err(CliError::input)?;
+        println!("  picture: {}", pic.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,545 @@
+//! The ARCplanner (paper Sec. 3): a head roadmap, then per head edge the cheapest
+//! shape that gets the whole chain along it.
+//!
+//! Lifecycle, as OMPL's planners: [`Planner::new`] (map, chain, tables, settings),
+//! [`Planner::setup`] (build the head roadmap `G_T`, once), [`Planner::solve`]
+//! (one query, with a termination condition; many queries may share a roadmap),
+//! [`Planner::clear`] (forget the roadmap).
+//!
+//! Online construction (paper Alg. 4), for each edge `v -> u` of the head path:
+//! (a) keep the current shape if the edge is admissible with it; (b) else try its
+//! `n_psi` yaw rotations; (c) else the library's shapes at `n_psi` headings, cheapest
+//! to reach first; (d) else SRSConnect ([`srs_connect`]); (e) else drop the edge and
+//! ask the head roadmap for another path from `v`. Every accepted step includes the
+//! shape change itself, checked at `v`: a plan is "change shape, then translate".
+
+pub mod candidates;
+pub mod motion;
+pub mod roadmap;
+pub mod srs_connect;
+
+use std::collections::BTreeSet;
+use std::time::{Duration, Instant};
+
+use arc_core::lsc::LscKind;
+use arc_core::Shape;
+use rand::SeedableRng;
+use rand_pcg::Pcg64;
+
+use crate::collision::CollisionContext;
+use crate::tables::ShapeTables;
+use candidates::{Candidate, Source};
+use roadmap::{Roadmap, RouteError, VertexId};
+
+/// Which shape sources the planner may use (the paper's ablation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Mode {
+    /// Library and random shapes (the full ARCplanner).
+    Both,
+    /// Library shapes only.
+    Lsc,
+    /// Random shapes only (plus yaw rotations of the current shape).
+    Srs,
+}
+
+/// What the planner prefers when several shapes fit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Preference {
+    /// Keep the shape as long as it fits; cheapest change otherwise.
+    Least,
+    /// Fly the sensor-coverage polygon PN wherever it fits (the silo demo).
+    Coverage,
+}
+
+/// Planner parameters; every one has a command-line flag.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Head roadmap vertices `M_VT`.
+    pub vertices: usize,
+    /// Head roadmap connection radius `r_T` (m).
+    pub r_t: f64,
+    /// Discrete headings per library shape and rotations of the current shape.
+    pub n_psi: usize,
+    /// `G_Val` connection radius `d_c` (`C_T` metric).
+    pub d_c: f32,
+    /// Shape sources.
+    pub mode: Mode,
+    /// Shape preference.
+    pub prefer: Preference,
+    /// Seed of the roadmap sampler.
+    pub seed: u64,
+    /// Replans (dropped head edges) allowed before giving up.
+    pub max_replans: usize,
+    /// Goal tolerance for the head (m).
+    pub goal_tol: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            vertices: 1500,
+            r_t: 1.5,
+            n_psi: 8,
+            d_c: 4.0,
+            mode: Mode::Both,
+            prefer: Preference::Least,
+            seed: 1,
+            max_replans: 200,
+            goal_tol: 0.3,
+        }
+    }
+}
+
+/// When to stop a query early.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Termination {
+    /// Give up after this long.
+    pub time_limit: Option<Duration>,
+}
+
+/// One waypoint of a solution.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Step {
+    /// Head position (m).
+    pub xi: [f64; 3],
+    /// Shape.
+    pub shape: Shape,
+    /// Where the shape came from (for translations: the shape kept).
+    pub source: Source,
+    /// Whether this waypoint ends a shape change (else a translation or the start).
+    pub shape_change: bool,
+}
+
+/// Counters and timings of one query.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Roadmap build time (s).
+    pub roadmap_s: f64,
+    /// Query time (s).
+    pub planning_s: f64,
+    /// Of the query time, spent in collision checks (s).
+    pub collision_s: f64,
+    /// Head edges flown.
+    pub edges: usize,
+    /// Shape-change waypoints.
+    pub shape_changes: usize,
+    /// Yaw rotations of the current shape used.
+    pub rotations: usize,
+    /// Library shapes used.
+    pub lsc_uses: usize,
+    /// Random shapes used.
+    pub srs_uses: usize,
+    /// SRSConnect calls.
+    pub srs_connects: usize,
+    /// Head edges dropped and routes asked again.
+    pub replans: usize,
+    /// Full-chain collision checks (configurations, translations, shape changes).
+    pub collision_checks: u64,
+    /// Roadmap vertices and candidate edges.
+    pub roadmap_vertices: usize,
+    /// Candidate edges of the roadmap.
+    pub roadmap_edges: usize,
+}
+
+/// A solved query.
+#[derive(Clone, Debug)]
+pub struct Solution {
+    /// Waypoints, the start first.
+    pub steps: Vec<Step>,
+    /// What it took.
+    pub stats: Stats,
+}
+
+/// Why a query has no solution, or cannot be asked.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    /// The tables are for another chain than the map context.
+    #[error("the shape tables are for N = {tables} units, the chain has N = {chain}")]
+    TablesMismatch {
+        /// Units in the tables.
+        tables: u8,
+        /// Units of the chain.
+        chain: u8,
+    },
+    /// The start configuration is not valid.
+    #[error("start is invalid: {0}")]
+    StartInvalid(String),
+    /// The goal cannot hold the head.
+    #[error("goal is invalid: {0}")]
+    GoalInvalid(String),
+    /// The head cannot reach the goal in the roadmap at all.
+    #[error("goal is not reachable by the head (no roadmap path from the start to within {tol} m of the goal)")]
+    Unreachable {
+        /// Goal tolerance (m).
+        tol: f64,
+    },
+    /// The head could be routed, but the chain found no shape for some edge.
+    #[error("no shape fits head edge {from:?} -> {to:?} after {replans} replans")]
+    NoShape {
+        /// The last edge tried.
+        from: [f64; 3],
+        /// Its end.
+        to: [f64; 3],
+        /// Replans made.
+        replans: usize,
+    },
+    /// The termination condition stopped the query.
+    #[error("time limit reached after {replans} replans")]
+    TimeLimit {
+        /// Replans made.
+        replans: usize,
+    },
+}
+
+/// Collision checks with time and count bookkeeping.
+pub struct Checker<'a> {
+    ctx: &'a CollisionContext,
+    time: Duration,
+}
+
+impl Checker<'_> {
+    fn timed<T>(&mut self, f: impl FnOnce(&CollisionContext) -> T) -> T {
+        let t = Instant::now();
+        let r = f(self.ctx);
+        self.time += t.elapsed();
+        r
+    }
+
+    /// The shape is collision-free with the head at `xi` (shape known valid).
+    pub fn placement(&mut self, xi: [f64; 3], s: &Shape) -> bool {
+        self.timed(|c| c.check_placement(xi, s).is_ok())
+    }
+
+    /// The chain in shape `s` can translate from `a` to `b`.
+    pub fn translation(&mut self, a: [f64; 3], b: [f64; 3], s: &Shape) -> bool {
+        self.timed(|c| c.check_translation(a, b, s).is_ok())
+    }
+
+    /// The chain can change shape from `s` to `t` with the head at `xi`.
+    pub fn shape_change(&mut self, xi: [f64; 3], s: &Shape, t: &Shape) -> bool {
+        self.timed(|c| c.check_shape_change(xi, s, t).is_ok())
+    }
+}
+
+/// The planner: a map context, a chain's shape tables, settings, and the roadmap.
+pub struct Planner {
+    ctx: CollisionContext,
+    tables: ShapeTables,
+    settings: Settings,
+    roadmap: Option<Roadmap>,
+    roadmap_s: f64,
+}
+
+impl Planner {
+    /// A planner for the chain of `ctx`; `tables` must be for the same chain.
+    pub fn new(
+        ctx: CollisionContext,
+        tables: ShapeTables,
+        settings: Settings,
+    ) -> Result<Self, PlanError> {
+        if tables.params != *ctx.params() {
+            return Err(PlanError::TablesMismatch {
+                tables: tables.params.units,
+                chain: ctx.params().units,
+            });
+        }
+        Ok(Self {
+            ctx,
+            tables,
+            settings,
+            roadmap: None,
+            roadmap_s: 0.0,
+        })
+    }
+
+    /// Builds the head roadmap (once; later calls do nothing).
+    pub fn setup(&mut self) {
+        if self.roadmap.is_none() {
+            let t = Instant::now();
+            let mut rng = Pcg64::seed_from_u64(self.settings.seed);
+            self.roadmap = Some(Roadmap::build(
+                &self.ctx,
+                self.settings.vertices,
+                self.settings.r_t,
+                &mut rng,
+            ));
+            self.roadmap_s = t.elapsed().as_secs_f64();
+        }
+    }
+
+    /// Forgets the roadmap.
+    pub fn clear(&mut self) {
+        self.roadmap = None;
+    }
+
+    /// The collision context.
+    pub fn context(&self) -> &CollisionContext {
+        &self.ctx
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Plans from `start` (head position and shape) to within the goal tolerance of
+    /// `goal`. Calls [`Self::setup`] if needed.
+    pub fn solve(
+        &mut self,
+        start: [f64; 3],
+        start_shape: Shape,
+        goal: [f64; 3],
+        stop: Termination,
+    ) -> Result<Solution, PlanError> {
+        self.setup();
+        let began = Instant::now();
+        let checks_before = self.ctx.stats();
+        self.ctx
+            .check_config(start, &start_shape)
+            .map_err(|c| PlanError::StartInvalid(c.to_string()))?;
+        if !self.ctx.is_head_free(goal) {
+            let why = if self.ctx.field().grid().in_bounds(goal) {
+                format!("the head's sphere (radius + clearance) collides at {goal:?}")
+            } else {
+                format!("{goal:?} is outside the map's bounds")
+            };
+            return Err(PlanError::GoalInvalid(why));
+        }
+        let mut roadmap = self.roadmap.take().expect("setup built the roadmap");
+        let result =
+            Construction::new(self, &mut roadmap, start, start_shape, goal, stop, began).run();
+        roadmap.clear_query();
+        let size = (roadmap.vertex_count(), roadmap.edge_count());
+        self.roadmap = Some(roadmap);
+        let (steps, mut stats) = result?;
+        let after = self.ctx.stats();
+        stats.collision_checks = (after.configs + after.translations + after.shape_changes)
+            - (checks_before.configs + checks_before.translations + checks_before.shape_changes);
+        stats.roadmap_s = self.roadmap_s;
+        stats.planning_s = began.elapsed().as_secs_f64();
+        (stats.roadmap_vertices, stats.roadmap_edges) = size;
+        Ok(Solution { steps, stats })
+    }
+}
+
+/// One query's online construction (Alg. 4).
+struct Construction<'p> {
+    planner: &'p Planner,
+    roadmap: &'p mut Roadmap,
+    checker: Checker<'p>,
+    start: VertexId,
+    goals: Vec<VertexId>,
+    banned: BTreeSet<(VertexId, VertexId)>,
+    current: Candidate,
+    steps: Vec<Step>,
+    stats: Stats,
+    stop: Termination,
+    began: Instant,
+}
+
+impl<'p> Construction<'p> {
+    fn new(
+        planner: &'p Planner,
+        roadmap: &'p mut Roadmap,
+        start: [f64; 3],
+        shape: Shape,
+        goal: [f64; 3],
+        stop: Termination,
+        began: Instant,
+    ) -> Self {
+        let s = roadmap.add_query_vertex(start);
+        let g = roadmap.add_query_vertex(goal);
+        let tol = planner.settings.goal_tol;
+        let mut goals = vec![g];
+        goals.extend((0..roadmap.vertex_count()).filter(|&v| {
+            let p = roadmap.point(v);
+            (p[0] - goal[0]).powi(2) + (p[1] - goal[1]).powi(2) + (p[2] - goal[2]).powi(2)
+                <= tol * tol
+        }));
+        let current = Candidate {
+            shape,
+            source: Source::Start,
+        };
+        Self {
+            planner,
+            roadmap,
+            checker: Checker {
+                ctx: &planner.ctx,
+                time: Duration::ZERO,
+            },
+            start: s,
+            goals,
+            banned: BTreeSet::new(),
+            current,
+            steps: vec![Step {
+                xi: start,
+                shape,
+                source: Source::Start,
+                shape_change: false,
+            }],
+            stats: Stats::default(),
+            stop,
+            began,
+        }
+    }
+
+    fn route(&self, from: VertexId) -> Result<Vec<VertexId>, PlanError> {
+        let banned = |a: VertexId, b: VertexId| self.banned.contains(&(a.min(b), a.max(b)));
+        self.roadmap
+            .route(&self.planner.ctx, from, &self.goals, &banned)
+            .map_err(|e| match e {
+                RouteError::StartIsolated | RouteError::Unreachable => PlanError::Unreachable {
+                    tol: self.planner.settings.goal_tol,
+                },
+            })
+    }
+
+    fn run(mut self) -> Result<(Vec<Step>, Stats), PlanError> {
+        let mut path = self.route(self.start)?;
+        let mut i = 0;
+        while i + 1 < path.len() {
+            if self
+                .stop
+                .time_limit
+                .is_some_and(|t| self.began.elapsed() > t)
+            {
+                return Err(PlanError::TimeLimit {
+                    replans: self.stats.replans,
+                });
+            }
+            let (v, u) = (path[i], path[i + 1]);
+            match self.connect(v, u) {
+                Some(changes) => {
+                    self.accept(v, u, changes);
+                    i += 1;
+                }
+                None => {
+                    self.banned.insert((v.min(u), v.max(u)));
+                    self.stats.replans += 1;
+                    let (from, to) = (self.roadmap.point(v), self.roadmap.point(u));
+                    if self.stats.replans > self.planner.settings.max_replans {
+                        return Err(PlanError::NoShape {
+                            from,
+                            to,
+                            replans: self.stats.replans,
+                        });
+                    }
+                    path = self.route(v).map_err(|_| PlanError::NoShape {
+                        from,
+                        to,
+                        replans: self.stats.replans,
+                    })?;
+                    i = 0;
+                }
+            }
+        }
+        self.stats.collision_s = self.checker.time.as_secs_f64();
+        Ok((self.steps, self.stats))
+    }
+
+    /// Appends the shape changes at `v`, then the translation to `u`.
+    fn accept(&mut self, v: VertexId, u: VertexId, changes: Vec<Candidate>) {
+        let xi = self.roadmap.point(v);
+        for c in changes {
+            match c.source {
+                Source::Rotation => self.stats.rotations += 1,
+                Source::Lsc(_) => self.stats.lsc_uses += 1,
+                Source::Srs(_) => self.stats.srs_uses += 1,
+                Source::Start => {}
+            }
+            self.stats.shape_changes += 1;
+            self.steps.push(Step {
+                xi,
+                shape: c.shape,
+                source: c.source,
+                shape_change: true,
+            });
+            self.current = c;
+        }
+        self.stats.edges += 1;
+        let cur = self.current;
+        self.steps.push(Step {
+            xi: self.roadmap.point(u),
+            shape: cur.shape,
+            source: cur.source,
+            shape_change: false,
+        });
+    }
+
+    /// The shape changes at `v` that let the chain fly `v -> u`, or None.
+    fn connect(&mut self, v: VertexId, u: VertexId) -> Option<Vec<Candidate>> {
+        let s = &self.planner.settings;
+        let (a, b) = (self.roadmap.point(v), self.roadmap.point(u));
+        let cur = self.current;
+        let edge_yaw = if (b[0] - a[0]).hypot(b[1] - a[1]) > 1e-6 {
+            (b[1] - a[1]).atan2(b[0] - a[0]) as f32
+        } else {
+            cur.shape.head_yaw()
+        };
+        let lsc = &self.planner.tables.lsc;
+        let use_lsc = s.mode != Mode::Srs;
+        let is_pn = matches!(cur.source, Source::Lsc(LscKind::Pn));
+        // Coverage: move into the polygon wherever it fits.
+        if s.prefer == Preference::Coverage && use_lsc && !is_pn {
+            let pn = candidates::library(&cur.shape, lsc, edge_yaw, s.n_psi, Some(LscKind::Pn));
+            if let Some(c) = self.first_direct(a, b, &pn) {
+                return Some(vec![c]);
+            }
+        }
+        // (a) keep the shape.
+        if self.checker.translation(a, b, &cur.shape) {
+            return Some(Vec::new());
+        }
+        // (b) yaw rotations.
+        let rot = candidates::rotations(&cur.shape, edge_yaw, s.n_psi);
+        if let Some(c) = self.first_direct(a, b, &rot) {
+            return Some(vec![c]);
+        }
+        // (c) library shapes, cheapest first.
+        let lib = if use_lsc {
+            candidates::library(&cur.shape, lsc, edge_yaw, s.n_psi, None)
+        } else {
+            Vec::new()
+        };
+        if let Some(c) = self.first_direct(a, b, &lib) {
+            return Some(vec![c]);
+        }
+        // (d) SRSConnect.
+        if s.mode == Mode::Lsc {
+            return None;
+        }
+        self.stats.srs_connects += 1;
+        let mut pool: Vec<Candidate> = self
+            .planner
+            .tables
+            .srs
+            .iter()
+            .enumerate()
+            .map(|(k, &shape)| Candidate {
+                shape,
+                source: Source::Srs(k as u16),
+            })
+            .collect();
+        pool.extend(lib);
+        srs_connect::connect(
+            &mut self.checker,
+            a,
+            b,
+            &cur,
+            &pool,
+            &self.planner.tables.adjacency,
+            s.d_c,
+        )
+    }
+
+    /// The first candidate that fits at `a`, flies `a -> b`, and is reachable from the
+    /// current shape by one shape change at `a`.
+    fn first_direct(&mut self, a: [f64; 3], b: [f64; 3], cands: &[Candidate]) -> Option<Candidate> {
+        let cur = self.current.shape;
+        cands.iter().copied().find(|c| {
+            self.checker.placement(a, &c.shape)
+                && self.checker.translation(a, b, &c.shape)
+                && self.checker.shape_change(a, &cur, &c.shape)
+        })
+    }
+}

@@ -1,0 +1,78 @@
+//! MotionPlan: a solution as an `arc-plan/1` file (ARC-MODEL.md "Files").
+//!
+//! Waypoint 0 is the start; each head edge becomes its shape changes (head fixed)
+//! then one translation (shape fixed). Timings go under `stats.timing`, the only
+//! part of a plan that differs between two runs with the same seed.
+
+use arc_core::ChainParams;
+use serde_json::{json, Map, Value};
+
+use super::candidates::Source;
+use super::Solution;
+use crate::plan::{ChainSection, MapSection, Plan, Waypoint, FORMAT};
+
+/// A short label of where a waypoint's shape came from.
+pub fn source_label(s: &Source, shape_change: bool) -> String {
+    match (s, shape_change) {
+        (Source::Start, _) => "start".into(),
+        (_, false) => "translate".into(),
+        (Source::Rotation, true) => "rotation".into(),
+        (Source::Lsc(k), true) => format!("LSC:{}", k.name()),
+        (Source::Srs(i), true) => format!("SRS:{i}"),
+    }
+}
+
+/// The plan file for `solution`.
+pub fn to_plan(
+    solution: &Solution,
+    params: &ChainParams,
+    resolution: f64,
+    unknown_is_occupied: bool,
+) -> Plan {
+    let st = &solution.stats;
+    let mut stats = Map::new();
+    let counts = [
+        ("edges", st.edges as u64),
+        ("shape_changes", st.shape_changes as u64),
+        ("rotations", st.rotations as u64),
+        ("lsc_uses", st.lsc_uses as u64),
+        ("srs_uses", st.srs_uses as u64),
+        ("srs_connects", st.srs_connects as u64),
+        ("replans", st.replans as u64),
+        ("collision_checks", st.collision_checks),
+        ("roadmap_vertices", st.roadmap_vertices as u64),
+        ("roadmap_edges", st.roadmap_edges as u64),
+    ];
+    for (k, v) in counts {
+        stats.insert(k.into(), json!(v));
+    }
+    stats.insert(
+        "timing".into(),
+        json!({
+            "roadmap_build_s": st.roadmap_s,
+            "planning_s": st.planning_s,
+            "collision_checks_s": st.collision_s,
+            "shape_search_s": (st.planning_s - st.collision_s).max(0.0),
+        }),
+    );
+    let labels: Vec<Value> = solution
+        .steps
+        .iter()
+        .map(|s| Value::String(source_label(&s.source, s.shape_change)))
+        .collect();
+    stats.insert("waypoint_sources".into(), Value::Array(labels));
+    Plan {
+        format: FORMAT.into(),
+        chain: ChainSection::from_params(params),
+        map: MapSection {
+            resolution,
+            unknown_is_occupied,
+        },
+        waypoints: solution
+            .steps
+            .iter()
+            .map(|s| Waypoint::new(s.xi, &s.shape))
+            .collect(),
+        stats,
+    }
+}

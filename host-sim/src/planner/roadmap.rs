@@ -1,0 +1,316 @@
+//! The translation planner (paper Alg. 1): a probabilistic roadmap over the head's
+//! position only, queried lazily.
+//!
+//! `M_VT` head positions are sampled uniformly in the map's box where the head's
+//! sphere is free; every vertex is joined to the others within `r_T` (a k-d tree,
+//! kiddo). Edges are NOT checked when the roadmap is built: a query runs A* on the
+//! unchecked graph, then checks the edges of the path it found, marks the bad ones
+//! and searches again (lazy PRM). Checked edges stay checked, so later queries on
+//! the same roadmap get cheaper (multi-query).
+
+use std::cell::Cell;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use kiddo::ImmutableKdTree;
+use kiddo::SquaredEuclidean;
+use rand::Rng;
+use rand_pcg::Pcg64;
+
+use crate::collision::CollisionContext;
+
+/// Vertex index in the roadmap; queries add the start and goal after the sampled ones.
+pub type VertexId = usize;
+
+/// Lazy state of one edge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum EdgeState {
+    Unchecked,
+    Free,
+    Blocked,
+}
+
+#[derive(Clone, Debug)]
+struct Edge {
+    to: VertexId,
+    length: f64,
+    state: Cell<EdgeState>,
+}
+
+/// The head roadmap `G_T`.
+#[derive(Debug)]
+pub struct Roadmap {
+    points: Vec<[f64; 3]>,
+    edges: Vec<Vec<Edge>>,
+    tree: ImmutableKdTree<f64, 3>,
+    r_t: f64,
+    sampled: usize,
+}
+
+/// How a query ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RouteError {
+    /// The start could not be joined to any vertex.
+    StartIsolated,
+    /// No path to the goal region exists in the roadmap.
+    Unreachable,
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+impl Roadmap {
+    /// Samples `vertices` free head positions (at most `vertices * 200` tries) and
+    /// joins each to every other within `r_t`.
+    pub fn build(ctx: &CollisionContext, vertices: usize, r_t: f64, rng: &mut Pcg64) -> Self {
+        let (lo, hi) = ctx.field().grid().bounds();
+        let mut points = Vec::with_capacity(vertices);
+        let mut tries = 0usize;
+        while points.len() < vertices && tries < vertices.saturating_mul(200).max(1000) {
+            tries += 1;
+            let p = [
+                rng.gen_range(lo[0]..hi[0]),
+                rng.gen_range(lo[1]..hi[1]),
+                rng.gen_range(lo[2]..hi[2]),
+            ];
+            if ctx.is_head_free(p) {
+                points.push(p);
+            }
+        }
+        let tree = ImmutableKdTree::new_from_slice(&points);
+        let mut edges: Vec<Vec<Edge>> = vec![Vec::new(); points.len()];
+        for (i, p) in points.iter().enumerate() {
+            let mut near = tree.within_unsorted::<SquaredEuclidean>(p, r_t * r_t);
+            // Sorted for determinism (the tree returns neighbours in no set order).
+            near.sort_by_key(|n| n.item);
+            for n in near {
+                let j = n.item as usize;
+                if j != i {
+                    edges[i].push(Edge {
+                        to: j,
+                        length: n.distance.sqrt(),
+                        state: Cell::new(EdgeState::Unchecked),
+                    });
+                }
+            }
+        }
+        let sampled = points.len();
+        Self {
+            points,
+            edges,
+            tree,
+            r_t,
+            sampled,
+        }
+    }
+
+    /// Number of sampled vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.sampled
+    }
+
+    /// Number of (undirected) candidate edges between sampled vertices.
+    pub fn edge_count(&self) -> usize {
+        self.edges
+            .iter()
+            .take(self.sampled)
+            .map(Vec::len)
+            .sum::<usize>()
+            / 2
+    }
+
+    /// Position of vertex `v`.
+    pub fn point(&self, v: VertexId) -> [f64; 3] {
+        self.points[v]
+    }
+
+    /// Adds a query vertex (start or goal) joined to the sampled vertices within
+    /// `r_T`; removed again by [`Self::clear_query`].
+    pub fn add_query_vertex(&mut self, p: [f64; 3]) -> VertexId {
+        let id = self.points.len();
+        self.points.push(p);
+        self.edges.push(Vec::new());
+        let mut near = self
+            .tree
+            .within_unsorted::<SquaredEuclidean>(&p, self.r_t * self.r_t);
+        near.sort_by_key(|n| n.item);
+        for n in near {
+            let j = n.item as usize;
+            let length = n.distance.sqrt();
+            self.edges[id].push(Edge {
+                to: j,
+                length,
+                state: Cell::new(EdgeState::Unchecked),
+            });
+            self.edges[j].push(Edge {
+                to: id,
+                length,
+                state: Cell::new(EdgeState::Unchecked),
+            });
+        }
+        // Query vertices see each other too (a start next to the goal).
+        for q in self.sampled..id {
+            let length = dist(self.points[q], p);
+            if length <= self.r_t {
+                self.edges[id].push(Edge {
+                    to: q,
+                    length,
+                    state: Cell::new(EdgeState::Unchecked),
+                });
+                self.edges[q].push(Edge {
+                    to: id,
+                    length,
+                    state: Cell::new(EdgeState::Unchecked),
+                });
+            }
+        }
+        id
+    }
+
+    /// Removes the query vertices and their edges; the sampled roadmap and what is
+    /// known about its edges stay.
+    pub fn clear_query(&mut self) {
+        self.points.truncate(self.sampled);
+        self.edges.truncate(self.sampled);
+        let n = self.sampled;
+        for e in self.edges.iter_mut() {
+            e.retain(|x| x.to < n);
+        }
+    }
+
+    fn edge(&self, a: VertexId, b: VertexId) -> Option<&Edge> {
+        self.edges[a].iter().find(|e| e.to == b)
+    }
+
+    fn set_state(&self, a: VertexId, b: VertexId, s: EdgeState) {
+        for (x, y) in [(a, b), (b, a)] {
+            if let Some(e) = self.edge(x, y) {
+                e.state.set(s);
+            }
+        }
+    }
+
+    /// Marks an edge as unusable (for the head, or for the whole chain in this query).
+    pub fn block(&self, a: VertexId, b: VertexId) {
+        self.set_state(a, b, EdgeState::Blocked);
+    }
+
+    /// The shortest head path from `from` to any vertex of `goals`, every edge on it
+    /// checked for the head's sphere. `banned` edges are skipped.
+    ///
+    /// Lazy Weighted A* (Cohen, Phillips, Likhachev 2014): a vertex enters the open
+    /// list with the edge that reached it unchecked; the edge is checked only when
+    /// that entry is popped. So one search returns a checked path, and only edges
+    /// leading to expanded vertices are ever checked.
+    pub fn route(
+        &self,
+        ctx: &CollisionContext,
+        from: VertexId,
+        goals: &[VertexId],
+        banned: &dyn Fn(VertexId, VertexId) -> bool,
+    ) -> Result<Vec<VertexId>, RouteError> {
+        if self.edges[from].is_empty() {
+            return Err(RouteError::StartIsolated);
+        }
+        let target = self.points[goals[0]];
+        let slack = goals
+            .iter()
+            .map(|&g| dist(self.points[g], target))
+            .fold(0.0, f64::max);
+        let h = |v: VertexId| (dist(self.points[v], target) - slack).max(0.0);
+        let n = self.points.len();
+        let mut closed = vec![false; n];
+        let mut parent = vec![usize::MAX; n];
+        let mut is_goal = vec![false; n];
+        for &q in goals {
+            is_goal[q] = true;
+        }
+        let mut open = BinaryHeap::new();
+        open.push(Open {
+            f: h(from),
+            g: 0.0,
+            v: from,
+            via: usize::MAX,
+        });
+        while let Some(Open { g, v, via, .. }) = open.pop() {
+            if closed[v] {
+                continue;
+            }
+            if via != usize::MAX && !self.edge_free(ctx, via, v) {
+                continue;
+            }
+            closed[v] = true;
+            parent[v] = via;
+            if is_goal[v] {
+                let mut path = vec![v];
+                while parent[path[path.len() - 1]] != usize::MAX {
+                    path.push(parent[path[path.len() - 1]]);
+                }
+                path.reverse();
+                return Ok(path);
+            }
+            for e in &self.edges[v] {
+                if closed[e.to] || e.state.get() == EdgeState::Blocked || banned(v, e.to) {
+                    continue;
+                }
+                let ng = g + e.length;
+                open.push(Open {
+                    f: ng + h(e.to),
+                    g: ng,
+                    v: e.to,
+                    via: v,
+                });
+            }
+        }
+        Err(RouteError::Unreachable)
+    }
+
+    /// Checks (once) whether the head's sphere can fly the edge `a b`.
+    fn edge_free(&self, ctx: &CollisionContext, a: VertexId, b: VertexId) -> bool {
+        let e = self.edge(a, b).expect("search follows edges");
+        match e.state.get() {
+            EdgeState::Free => true,
+            EdgeState::Blocked => false,
+            EdgeState::Unchecked => {
+                let free = ctx.is_head_segment_free(self.points[a], self.points[b]);
+                self.set_state(
+                    a,
+                    b,
+                    if free {
+                        EdgeState::Free
+                    } else {
+                        EdgeState::Blocked
+                    },
+                );
+                free
+            }
+        }
+    }
+}
+
+/// Open-list entry: vertex `v` reached from `via` at cost `g`; lowest `f` first,
+/// ties broken by vertex id for determinism.
+#[derive(PartialEq)]
+struct Open {
+    f: f64,
+    g: f64,
+    v: VertexId,
+    via: VertexId,
+}
+
+impl Eq for Open {}
+
+impl Ord for Open {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.f.total_cmp(&self.f)
+            .then_with(|| o.v.cmp(&self.v))
+            .then_with(|| o.via.cmp(&self.via))
+    }
+}
+
+impl PartialOrd for Open {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}

@@ -1,0 +1,205 @@
+//! SRS-based edge connection (paper Alg. 3).
+//!
+//! For a head edge `xi_i -> xi_j` and the chain's current shape:
+//! 1. ValidShapes: the SRS shapes (and the library's shapes at every heading)
+//!    that are collision-free with the head at `xi_i`;
+//! 2. AdmissibleShapes: those that stay collision-free along the whole edge;
+//! 3. ConstructGraph `G_Val` over the current shape and the valid shapes: two valid
+//!    random shapes are joined when `G_SRS` joins them (within `r_S`, and known
+//!    offline to change into each other without self-collision); the current shape
+//!    and the library shapes are joined to every valid shape within `d_c` in the
+//!    `C_T` metric. Neighbour lists are made when a vertex is first expanded, so
+//!    the parts of `G_Val` the search never reaches cost nothing;
+//! 4. OptAdmissibleTransition: Dijkstra by `C_T` from the current shape to the
+//!    nearest admissible one;
+//! 5. CollisionFreeE: every shape change on that path is checked at `xi_i`
+//!    (limits, self-collision, map); a failing edge is pruned from `G_Val` and the
+//!    search repeats until a path holds or none is left.
+
+use std::cmp::Ordering;
+use std::collections::{BTreeMap, BTreeSet, BinaryHeap};
+
+use arc_core::cost::transition_cost;
+
+use super::candidates::{Candidate, Source};
+use super::Checker;
+
+/// What SRSConnect found: the shapes to pass through at `xi_i` (the last one
+/// admissible along the edge), or nothing.
+pub fn connect(
+    checker: &mut Checker<'_>,
+    from: [f64; 3],
+    to: [f64; 3],
+    current: &Candidate,
+    pool: &[Candidate],
+    srs_adjacency: &[Vec<u16>],
+    d_c: f32,
+) -> Option<Vec<Candidate>> {
+    // 1-2. Valid and admissible shapes; vertex 0 of G_Val is the current shape.
+    let mut nodes = vec![*current];
+    let mut admissible = vec![false];
+    for c in pool {
+        if checker.placement(from, &c.shape) {
+            nodes.push(*c);
+            admissible.push(false);
+        }
+    }
+    let mut any = false;
+    for (i, c) in nodes.iter().enumerate().skip(1) {
+        if checker.translation(from, to, &c.shape) {
+            admissible[i] = true;
+            any = true;
+        }
+    }
+    if !any {
+        return None;
+    }
+    // 3-5. Cheapest transition to an admissible shape, pruning failed edges.
+    let mut graph = Graph::new(&nodes, srs_adjacency, d_c);
+    let mut pruned: BTreeSet<(usize, usize)> = BTreeSet::new();
+    let mut checked: BTreeMap<(usize, usize), bool> = BTreeMap::new();
+    loop {
+        let path = cheapest(&mut graph, &admissible, &pruned)?;
+        let mut ok = true;
+        for w in path.windows(2) {
+            let key = (w[0].min(w[1]), w[0].max(w[1]));
+            let free = *checked.entry(key).or_insert_with(|| {
+                checker.shape_change(from, &nodes[w[0]].shape, &nodes[w[1]].shape)
+            });
+            if !free {
+                pruned.insert(key);
+                ok = false;
+                break;
+            }
+        }
+        if ok {
+            return Some(path[1..].iter().map(|&i| nodes[i]).collect());
+        }
+    }
+}
+
+/// `G_Val` with neighbour lists made on first use.
+struct Graph<'a> {
+    nodes: &'a [Candidate],
+    /// Node index of each valid SRS shape (by SRS index).
+    srs_node: Vec<Option<usize>>,
+    srs_adjacency: &'a [Vec<u16>],
+    /// The current shape and the library shapes: joined by `d_c`.
+    hubs: Vec<usize>,
+    d_c: f32,
+    lists: Vec<Option<Vec<(usize, f32)>>>,
+}
+
+impl<'a> Graph<'a> {
+    fn new(nodes: &'a [Candidate], srs_adjacency: &'a [Vec<u16>], d_c: f32) -> Self {
+        let mut srs_node = vec![None; srs_adjacency.len()];
+        let mut hubs = Vec::new();
+        for (i, c) in nodes.iter().enumerate() {
+            match c.source {
+                Source::Srs(k) if i > 0 => srs_node[k as usize] = Some(i),
+                _ => hubs.push(i),
+            }
+        }
+        Self {
+            nodes,
+            srs_node,
+            srs_adjacency,
+            hubs,
+            d_c,
+            lists: vec![None; nodes.len()],
+        }
+    }
+
+    fn within(&self, v: usize, u: usize) -> Option<(usize, f32)> {
+        let c = transition_cost(&self.nodes[v].shape, &self.nodes[u].shape);
+        (u != v && c <= self.d_c).then_some((u, c))
+    }
+
+    /// Neighbours of `v` with their `C_T`.
+    fn neighbours(&mut self, v: usize) -> &[(usize, f32)] {
+        if self.lists[v].is_none() {
+            let list: Vec<(usize, f32)> = match self.nodes[v].source {
+                Source::Srs(k) if v > 0 => {
+                    let mut l: Vec<(usize, f32)> = self.srs_adjacency[k as usize]
+                        .iter()
+                        .filter_map(|&j| self.srs_node[j as usize])
+                        .map(|u| {
+                            (
+                                u,
+                                transition_cost(&self.nodes[v].shape, &self.nodes[u].shape),
+                            )
+                        })
+                        .collect();
+                    l.extend(self.hubs.iter().filter_map(|&u| self.within(v, u)));
+                    l
+                }
+                _ => (0..self.nodes.len())
+                    .filter_map(|u| self.within(v, u))
+                    .collect(),
+            };
+            self.lists[v] = Some(list);
+        }
+        self.lists[v].as_deref().unwrap_or(&[])
+    }
+}
+
+/// Dijkstra over `G_Val` (minus `pruned` edges) from vertex 0 to the nearest
+/// admissible vertex.
+fn cheapest(
+    graph: &mut Graph<'_>,
+    admissible: &[bool],
+    pruned: &BTreeSet<(usize, usize)>,
+) -> Option<Vec<usize>> {
+    let n = graph.nodes.len();
+    let mut dist = vec![f32::INFINITY; n];
+    let mut parent = vec![usize::MAX; n];
+    let mut done = vec![false; n];
+    let mut open = BinaryHeap::new();
+    dist[0] = 0.0;
+    open.push(Entry { d: 0.0, v: 0 });
+    while let Some(Entry { d, v }) = open.pop() {
+        if done[v] {
+            continue;
+        }
+        done[v] = true;
+        if admissible[v] && v != 0 {
+            let mut path = vec![v];
+            while path[path.len() - 1] != 0 {
+                path.push(parent[path[path.len() - 1]]);
+            }
+            path.reverse();
+            return Some(path);
+        }
+        for &(u, c) in graph.neighbours(v) {
+            if done[u] || pruned.contains(&(v.min(u), v.max(u))) {
+                continue;
+            }
+            if d + c < dist[u] {
+                dist[u] = d + c;
+                parent[u] = v;
+                open.push(Entry { d: d + c, v: u });
+            }
+        }
+    }
+    None
+}
+
+#[derive(PartialEq)]
+struct Entry {
+    d: f32,
+    v: usize,
+}
+
+impl Eq for Entry {}
+
+impl Ord for Entry {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.d.total_cmp(&self.d).then_with(|| o.v.cmp(&self.v))
+    }
+}
+
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
