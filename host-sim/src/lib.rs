@@ -5,6 +5,8 @@
 //! simulation, plan files and pictures, and the `arc` command line.
 //! The contract everything here follows is `shared/ARC-MODEL.md`.
 
+pub mod baseline;
+pub mod bench;
 pub mod cli;
 pub mod collision;
 pub mod fsutil;

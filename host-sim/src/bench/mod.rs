@@ -1,0 +1,1 @@
+//! Benchmark runs (placeholder while it is written).
