@@ -216,9 +216,18 @@ fn real_map_geb079_reads_as_octomap_reads_it() {
         return;
     };
     let bytes = std::fs::read(&path).unwrap();
-    let t0 = Instant::now();
     let tree = OcTree::from_bt_bytes(&bytes, "geb079.bt").unwrap_or_else(|e| panic!("{e}"));
-    let elapsed = t0.elapsed();
+    // Best of a few decodes: the machine is shared.
+    let elapsed = (0..5)
+        .map(|_| {
+            let t0 = Instant::now();
+            let again = OcTree::from_bt_bytes(&bytes, "geb079.bt").unwrap();
+            let t = t0.elapsed();
+            assert_eq!(again.node_count(), tree.node_count());
+            t
+        })
+        .min()
+        .unwrap();
     eprintln!(
         "geb079.bt: {} bytes, {} nodes, {:?} leaves (occupied, free), decoded in {:.2} ms",
         bytes.len(),
