@@ -37,6 +37,7 @@
 pub mod exact;
 pub mod verify;
 
+use std::cell::RefCell;
 use std::fmt;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -162,6 +163,30 @@ pub struct CollisionContext {
     counters: Arc<Counters>,
 }
 
+/// A chain, a shape and the answer of `check_shape` for them.
+type ShapeAnswer = (ChainParams, Shape, Result<(), Violation>);
+
+thread_local! {
+    /// The last shape checked for limits and self-collision on this thread, with its
+    /// chain and result: the planner checks the same shape at many head positions.
+    static LAST_SHAPE: RefCell<Option<ShapeAnswer>> = const { RefCell::new(None) };
+}
+
+/// `arc_core::validity::check_shape`, remembering the last answer per thread (an exact
+/// repeat of the same chain and shape gets the same answer without the work).
+fn shape_validity(params: &ChainParams, shape: &Shape) -> Result<(), Violation> {
+    LAST_SHAPE.with(|c| {
+        if let Some((p, s, r)) = &*c.borrow() {
+            if p == params && s == shape {
+                return *r;
+            }
+        }
+        let r = check_shape(params, shape);
+        *c.borrow_mut() = Some((*params, *shape, r));
+        r
+    })
+}
+
 /// Unit centres in the world frame (f64 head + f32 core offsets), head first.
 type WorldPoints = [[f64; 3]; MAX_UNITS];
 
@@ -274,11 +299,17 @@ impl CollisionContext {
         self.field.clearance(p)
     }
 
+    /// A proven lower bound at `p`, from one lookup when that already exceeds `need`.
+    #[inline]
+    fn bound(&self, p: [f64; 3], need: f64) -> f64 {
+        self.field.clearance_above(p, need)
+    }
+
     /// Whether the head's unit sphere (grown by the clearance margin) is free at `p`
     /// and `p` is inside the map's bounds. Conservative.
     pub fn is_head_free(&self, p: [f64; 3]) -> bool {
         self.counters.head_points.fetch_add(1, Ordering::Relaxed);
-        self.field.grid().in_bounds(p) && self.clearance(p) > self.unit_r
+        self.field.grid().in_bounds(p) && self.bound(p, self.unit_r) > self.unit_r
     }
 
     /// Whether the head's unit sphere can move along the straight segment `a b` (both
@@ -289,7 +320,7 @@ impl CollisionContext {
         if !(g.in_bounds(a) && g.in_bounds(b)) {
             return false;
         }
-        let (ca, cb) = (self.clearance(a), self.clearance(b));
+        let (ca, cb) = (self.bound(a, self.unit_r), self.bound(b, self.unit_r));
         ca > self.unit_r
             && cb > self.unit_r
             && self.segment_free(a, b, self.unit_r, ca, cb).is_none()
@@ -330,8 +361,9 @@ impl CollisionContext {
     pub fn check_config(&self, head: [f64; 3], shape: &Shape) -> Result<(), Collision> {
         self.counters.configs.fetch_add(1, Ordering::Relaxed);
         self.check_input(head, shape)?;
-        check_shape(&self.params, shape).map_err(Collision::Shape)?;
-        self.placement(head, shape)
+        // The map first: in clutter it rejects most configurations, and cheaply.
+        self.placement(head, shape)?;
+        shape_validity(&self.params, shape).map_err(Collision::Shape)
     }
 
     /// [`Self::check_config`] without the limits and self-collision part, for shapes
@@ -354,7 +386,7 @@ impl CollisionContext {
                     point: p[i],
                 });
             }
-            c[i] = self.clearance(p[i]);
+            c[i] = self.bound(p[i], self.unit_r);
             if c[i] <= self.unit_r {
                 return Err(Collision::Map {
                     body: Body::Unit(i as u8),
@@ -390,7 +422,7 @@ impl CollisionContext {
         let dir = scale(sub(b, a), 1.0 / len);
         loop {
             let s = add(a, scale(dir, t.min(len)));
-            let m = self.clearance(s) - r;
+            let m = self.bound(s, r + self.min_step) - r;
             if m < self.min_step {
                 return Some(s);
             }
@@ -429,7 +461,7 @@ impl CollisionContext {
             } else {
                 a
             };
-            let raw = self.clearance(s);
+            let raw = self.bound(s, r + 2.0 * w);
             // Bounds for the piece: from its centre, and from both ends of the link.
             let m = (raw - w).max(ca - t1).max(cb - (len - t0)) - r;
             let good_enough = m >= 0.5 * (raw - r) || m >= 0.5 * (ca.min(cb) - r);
@@ -465,7 +497,7 @@ impl CollisionContext {
         if !finite3(to) {
             return Err(at0(Collision::BadInput("the head position is not finite")));
         }
-        check_shape(&self.params, shape).map_err(|v| at0(Collision::Shape(v)))?;
+        shape_validity(&self.params, shape).map_err(|v| at0(Collision::Shape(v)))?;
         let n = shape.units();
         let g = self.field.grid();
         let p0 = self.points(from, shape);
@@ -506,7 +538,7 @@ impl CollisionContext {
             // Units first (the links use their bounds).
             for i in 0..n {
                 let q = add(p0[i], off);
-                c[i] = self.clearance(q);
+                c[i] = self.bound(q, self.unit_r + self.min_step);
                 if horizon[i] <= u {
                     let m = c[i] - self.unit_r;
                     if m < self.min_step {
@@ -587,7 +619,7 @@ impl CollisionContext {
             };
             let p = self.points(head, &s);
             for i in 0..n {
-                c[i] = self.clearance(p[i]);
+                c[i] = self.bound(p[i], self.unit_r + self.min_step);
                 if horizon[i] <= t {
                     // Inside-the-box margin and obstacle margin.
                     let mut inside = f64::INFINITY;

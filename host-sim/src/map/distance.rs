@@ -343,6 +343,47 @@ impl DistanceField {
         (best - ROUND_EPS).max(0.0)
     }
 
+    /// A cheaper, looser PROVEN lower bound than [`Self::clearance`]: the bound from the
+    /// centre of the voxel holding `p` only (one lookup). Use it first and fall back to
+    /// [`Self::clearance`] when it is not enough.
+    #[inline]
+    pub fn clearance_coarse(&self, p: [f64; 3]) -> f64 {
+        let g = &self.grid;
+        let r = g.resolution();
+        let origin = g.origin();
+        let dims = g.dims();
+        let mut l = [0usize; 3];
+        let mut d2 = 0.0;
+        for a in 0..3 {
+            let q = p[a] / r;
+            if q.is_nan() {
+                return 0.0;
+            }
+            let rel = (q - origin[a] as f64).floor();
+            if (rel < 0.0 || rel >= dims[a] as f64) && g.unknown_is_occupied() {
+                return 0.0;
+            }
+            let li = rel.clamp(0.0, (dims[a] - 1) as f64);
+            l[a] = li as usize;
+            let c = (origin[a] as f64 + li + 0.5) * r;
+            d2 += (p[a] - c) * (p[a] - c);
+        }
+        let v = self.lb[l[0] + dims[0] * (l[1] + dims[1] * l[2])] as f64;
+        (v - d2.sqrt() - ROUND_EPS).max(0.0)
+    }
+
+    /// [`Self::clearance_coarse`] when it exceeds `need`, else [`Self::clearance`]: a
+    /// proven lower bound, as tight as the fine query wherever it matters for `need`.
+    #[inline]
+    pub fn clearance_above(&self, p: [f64; 3], need: f64) -> f64 {
+        let c = self.clearance_coarse(p);
+        if c > need {
+            c
+        } else {
+            self.clearance(p)
+        }
+    }
+
     /// Bytes held by the grid and the field.
     pub fn memory_bytes(&self) -> usize {
         self.lb.len() * 4 + self.grid.dims().iter().product::<usize>()
@@ -493,6 +534,8 @@ mod tests {
                 let truth = cubes.iter().map(|&c| point_cube(p, c, r)).fold(f64::INFINITY, f64::min);
                 let lb = f.clearance(p);
                 prop_assert!(lb <= truth, "p {:?}: bound {} > true {}", p, lb, truth);
+                let coarse = f.clearance_coarse(p);
+                prop_assert!(coarse <= lb + 1e-12, "p {:?}: coarse {} > fine {}", p, coarse, lb);
                 if truth.is_finite() && g.local(g.lattice_index(p)).is_some() {
                     // And it is not useless: within the worst-case slack.
                     prop_assert!(lb >= truth - 3f64.sqrt() * r - 1e-6, "p {:?}: bound {} true {}", p, lb, truth);

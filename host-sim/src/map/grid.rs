@@ -196,6 +196,27 @@ impl Grid {
         Ok(g)
     }
 
+    /// The grid of an OctoMap tree: its metric bounds at its resolution, pruned leaves
+    /// expanded, nodes absent from the tree unknown.
+    pub fn from_octree(
+        tree: &super::octomap::OcTree,
+        unknown_is_occupied: bool,
+    ) -> Result<Grid, GridError> {
+        let (lo, hi) = tree.metric_bounds().ok_or(GridError::Empty)?;
+        Grid::from_leaves(
+            tree.resolution(),
+            lo,
+            hi,
+            tree.leaves().map(|l| (l.center, l.size, l.occupied)),
+            unknown_is_occupied,
+        )
+    }
+
+    /// The known voxels as an OctoMap tree (pruned), for writing a `.bt` file.
+    pub fn to_octree(&self) -> Result<super::octomap::OcTree, super::octomap::MapFileError> {
+        super::octomap::OcTree::from_voxels(self.resolution, self.known_voxels())
+    }
+
     /// Sets every voxel of the cube of edge `size` centred at `c` (a lattice-aligned
     /// OctoMap leaf) to `state`, clipped to the grid.
     fn fill_cube(&mut self, c: [f64; 3], size: f64, state: Cell) {
@@ -451,6 +472,21 @@ mod tests {
         assert_eq!(g.cell([5, 0, 0]), Cell::Occupied);
         assert_eq!(g.cell([3, 3, 3]), Cell::Free);
         assert_eq!(g.cell([4, 3, 3]), Cell::Unknown);
+    }
+
+    #[test]
+    fn octree_round_trip() {
+        let mut g = Grid::new(0.1, [-3, 0, 1], [7, 5, 4], Cell::Free, true).unwrap();
+        g.fill_box([-0.3, 0.0, 0.1], [0.05, 0.2, 0.3], Cell::Occupied);
+        g.set([0, 4, 4], Cell::Unknown);
+        g.set([3, 4, 4], Cell::Unknown);
+        let t = g.to_octree().unwrap();
+        let h = Grid::from_octree(&t, true).unwrap();
+        assert_eq!(h.origin(), g.origin());
+        assert_eq!(h.dims(), g.dims());
+        assert!(h.cells().eq(g.cells()));
+        let (lo, hi) = h.bounds();
+        assert!((lo[0] + 0.3).abs() < 1e-9 && (hi[2] - 0.5).abs() < 1e-9);
     }
 
     #[test]

@@ -1,0 +1,163 @@
+//! Map and collision benchmarks: loading a 20 m x 20 m x 5 m map at 0.1 m from a `.bt`
+//! file into a grid and distance field, and the planner's conservative checks of a
+//! 6-unit chain in clutter.
+
+use std::hint::black_box;
+use std::sync::Arc;
+
+use arc_core::{ChainParams, Shape};
+use arc_host_sim::collision::CollisionContext;
+use arc_host_sim::map::distance::DistanceField;
+use arc_host_sim::map::grid::{Cell, Grid};
+use arc_host_sim::map::octomap::OcTree;
+use criterion::{criterion_group, criterion_main, Criterion};
+
+/// A small deterministic generator (no dependency needed for a benchmark's clutter).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// 20 x 20 x 5 m at 0.1 m: floor, ceiling, outer walls, 60 pillars and 40 floating
+/// boxes; everything else free.
+fn clutter() -> Grid {
+    let mut g = Grid::new(0.1, [0, 0, 0], [200, 200, 50], Cell::Free, true).unwrap();
+    g.fill_box([0.0, 0.0, 0.0], [20.0, 20.0, 0.2], Cell::Occupied);
+    g.fill_box([0.0, 0.0, 4.8], [20.0, 20.0, 5.0], Cell::Occupied);
+    for (lo, hi) in [
+        ([0.0, 0.0, 0.0], [0.2, 20.0, 5.0]),
+        ([19.8, 0.0, 0.0], [20.0, 20.0, 5.0]),
+        ([0.0, 0.0, 0.0], [20.0, 0.2, 5.0]),
+        ([0.0, 19.8, 0.0], [20.0, 20.0, 5.0]),
+    ] {
+        g.fill_box(lo, hi, Cell::Occupied);
+    }
+    let mut r = Lcg(7);
+    for k in 0..100 {
+        let (x, y) = (1.0 + 18.0 * r.next(), 1.0 + 18.0 * r.next());
+        let (w, d) = (0.3 + 0.7 * r.next(), 0.3 + 0.7 * r.next());
+        let (z0, z1) = if k < 60 {
+            (0.0, 5.0)
+        } else {
+            let z = 0.5 + 3.5 * r.next();
+            (z, z + 0.3 + 0.5 * r.next())
+        };
+        g.fill_box([x, y, z0], [x + w, y + d, z1], Cell::Occupied);
+    }
+    g
+}
+
+fn bench(c: &mut Criterion) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("clutter.bt");
+    let grid = clutter();
+    grid.to_octree().unwrap().write_bt(&path).unwrap();
+
+    let mut g = c.benchmark_group("map");
+    g.sample_size(20);
+    g.bench_function("load_20x20x5_bt_grid_and_field", |b| {
+        b.iter(|| {
+            let tree = OcTree::read_bt(&path).unwrap();
+            let grid = Grid::from_octree(&tree, true).unwrap();
+            black_box(DistanceField::new(grid))
+        })
+    });
+    g.finish();
+
+    let field = Arc::new(DistanceField::new(grid));
+    let ctx = CollisionContext::new(field, ChainParams::new(6), 0.05).unwrap();
+    // A bent 6-unit chain (valid shape) and places for it in the clutter.
+    let shape = Shape::from_slice(
+        6,
+        &[0.3, 0.0, 0.3, 0.2, 0.8, -0.1, 0.2, 0.0, -0.5, 0.1, 0.1],
+    )
+    .unwrap();
+    assert!(arc_core::validity::check_shape(ctx.params(), &shape).is_ok());
+    let mut r = Lcg(11);
+    let mut configs = Vec::new();
+    let mut edges = Vec::new();
+    while configs.len() < 64 || edges.len() < 64 {
+        let h = [
+            1.0 + 18.0 * r.next(),
+            1.0 + 18.0 * r.next(),
+            0.8 + 3.4 * r.next(),
+        ];
+        if ctx.check_config(h, &shape).is_err() {
+            continue;
+        }
+        if configs.len() < 64 {
+            configs.push(h);
+        }
+        // A 2 m translation in a random horizontal direction.
+        let a = std::f64::consts::TAU * r.next();
+        let to = [h[0] + 2.0 * a.cos(), h[1] + 2.0 * a.sin(), h[2]];
+        if edges.len() < 64 && ctx.check_translation(h, to, &shape).is_ok() {
+            edges.push((h, to));
+        }
+    }
+    let mut g = c.benchmark_group("collision");
+    let mut i = 0;
+    g.bench_function("check_config_6_units", |b| {
+        b.iter(|| {
+            i = (i + 1) % configs.len();
+            black_box(ctx.check_config(black_box(configs[i]), &shape))
+        })
+    });
+    // Alternating between two shapes defeats the per-thread cache of the last shape's
+    // limits/self-collision answer: the full cost of a first check.
+    let other = shape.rotated(0.5);
+    let both: Vec<[f64; 3]> = configs
+        .iter()
+        .copied()
+        .filter(|h| ctx.check_config(*h, &other).is_ok())
+        .collect();
+    assert!(both.len() > 8);
+    let mut i3 = 0;
+    g.bench_function("check_config_6_units_new_shape_each_call", |b| {
+        b.iter(|| {
+            i3 += 1;
+            let s = if i3 % 2 == 0 { &shape } else { &other };
+            black_box(ctx.check_config(black_box(both[(i3 / 2) % both.len()]), s))
+        })
+    });
+    let mut i2 = 0;
+    g.bench_function("check_placement_6_units", |b| {
+        b.iter(|| {
+            i2 = (i2 + 1) % configs.len();
+            black_box(ctx.check_placement(black_box(configs[i2]), &shape))
+        })
+    });
+    g.bench_function("head_segment_2m", |b| {
+        b.iter(|| {
+            i2 = (i2 + 1) % edges.len();
+            let (a, t) = edges[i2];
+            black_box(ctx.is_head_segment_free(black_box(a), t))
+        })
+    });
+    let mut j = 0;
+    g.bench_function("check_translation_2m_6_units_clutter", |b| {
+        b.iter(|| {
+            j = (j + 1) % edges.len();
+            let (a, t) = edges[j];
+            black_box(ctx.check_translation(black_box(a), t, &shape))
+        })
+    });
+    let bent = shape.rotated(1.0);
+    let mut k = 0;
+    g.bench_function("check_shape_change_6_units_clutter", |b| {
+        b.iter(|| {
+            k = (k + 1) % configs.len();
+            black_box(ctx.check_shape_change(black_box(configs[k]), &shape, &bent))
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

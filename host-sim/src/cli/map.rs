@@ -1,0 +1,343 @@
+//! `arc map export|info|picture`: built-in scenarios as OctoMap files, facts about a
+//! map file, and pictures of maps.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Args, Subcommand};
+
+use super::{CliError, CliResult};
+use crate::map::grid::Grid;
+use crate::map::octomap::OcTree;
+use crate::map::picture::{map_figure, MapPictureOptions};
+use crate::map::scenarios::{self, Scenario};
+
+/// `arc map ...`
+#[derive(Subcommand, Debug)]
+pub enum MapCommand {
+    /// Write a built-in scenario's map as an OctoMap binary file (.bt).
+    Export(ExportArgs),
+    /// Print a map file's resolution, bounds and voxel counts.
+    Info(InfoArgs),
+    /// Draw a map (file or scenario): a top view and horizontal slices, SVG or PNG.
+    Picture(PictureArgs),
+}
+
+/// `arc map export`
+#[derive(Args, Debug)]
+pub struct ExportArgs {
+    /// Scenario: window, maze, silos, corridor, or corridor:LENGTH (10 to 100 m).
+    #[arg(long)]
+    pub scenario: String,
+    /// Output file (.bt).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `arc map info`
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// The map (.bt).
+    pub file: PathBuf,
+}
+
+/// `arc map picture`
+#[derive(Args, Debug)]
+pub struct PictureArgs {
+    /// The map (.bt); or give --scenario.
+    #[arg(required_unless_present = "scenario", conflicts_with = "scenario")]
+    pub file: Option<PathBuf>,
+    /// A built-in scenario instead of a file (window, maze, silos, corridor[:LENGTH]).
+    #[arg(long)]
+    pub scenario: Option<String>,
+    /// Output picture: .svg or .png.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Lowest height of the top view's band (m); default: a quarter up the box.
+    #[arg(long, allow_negative_numbers = true)]
+    pub band_min: Option<f64>,
+    /// Highest height of the top view's band (m); default: three quarters up the box.
+    #[arg(long, allow_negative_numbers = true)]
+    pub band_max: Option<f64>,
+    /// Heights of the horizontal slices (m), comma-separated; default: 1/4, 1/2, 3/4 up.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub slices: Vec<f64>,
+}
+
+/// Runs `arc map ...`.
+pub fn run(c: MapCommand) -> CliResult {
+    match c {
+        MapCommand::Export(a) => export(a),
+        MapCommand::Info(a) => info(a),
+        MapCommand::Picture(a) => picture(a),
+    }
+}
+
+fn scenario(name: &str) -> Result<Scenario, CliError> {
+    scenarios::build(name).map_err(|e| CliError::input(format!("--scenario: {e}")))
+}
+
+fn read_tree(path: &Path) -> Result<OcTree, CliError> {
+    OcTree::read_bt(path).map_err(|e| CliError::input(e.to_string()))
+}
+
+fn grid_of(tree: &OcTree, path: &Path) -> Result<Grid, CliError> {
+    Grid::from_octree(tree, true).map_err(|e| CliError::input(format!("{}: {e}", path.display())))
+}
+
+fn export(a: ExportArgs) -> CliResult {
+    let s = scenario(&a.scenario)?;
+    let tree = s.octree().map_err(|e| CliError::input(e.to_string()))?;
+    tree.write_bt(&a.out)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    let c = s.grid.counts();
+    println!(
+        "{}: wrote {} ({} x {} x {} voxels at {} m: {} occupied, {} free; {} tree nodes)",
+        s.name,
+        a.out.display(),
+        s.grid.dims()[0],
+        s.grid.dims()[1],
+        s.grid.dims()[2],
+        s.grid.resolution(),
+        c.occupied,
+        c.free,
+        tree.node_count()
+    );
+    println!(
+        "start ({:.2}, {:.2}, {:.2}) yaw {:.1} deg, goal ({:.2}, {:.2}, {:.2}), {} units",
+        s.start[0],
+        s.start[1],
+        s.start[2],
+        s.start_yaw.to_degrees(),
+        s.goal[0],
+        s.goal[1],
+        s.goal[2],
+        s.default_units
+    );
+    Ok(())
+}
+
+fn info(a: InfoArgs) -> CliResult {
+    let t0 = Instant::now();
+    let tree = read_tree(&a.file)?;
+    let t1 = Instant::now();
+    let grid = grid_of(&tree, &a.file)?;
+    let t2 = Instant::now();
+    let (lo, hi) = grid.bounds();
+    let c = grid.counts();
+    let d = grid.dims();
+    let (occ_leaves, free_leaves) = tree.counts();
+    println!("file        {}", a.file.display());
+    println!("resolution  {} m", grid.resolution());
+    println!(
+        "bounds      ({:.3}, {:.3}, {:.3}) .. ({:.3}, {:.3}, {:.3}) m",
+        lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]
+    );
+    println!(
+        "size        {:.2} x {:.2} x {:.2} m",
+        hi[0] - lo[0],
+        hi[1] - lo[1],
+        hi[2] - lo[2]
+    );
+    println!(
+        "voxels      {} x {} x {} = {}",
+        d[0],
+        d[1],
+        d[2],
+        d[0] * d[1] * d[2]
+    );
+    println!("occupied    {}", c.occupied);
+    println!("free        {}", c.free);
+    println!("unknown     {}", c.unknown);
+    println!(
+        "tree        {} nodes, {} occupied and {} free leaves",
+        tree.node_count(),
+        occ_leaves,
+        free_leaves
+    );
+    println!(
+        "timing      read {:.1} ms, grid {:.1} ms",
+        (t1 - t0).as_secs_f64() * 1e3,
+        (t2 - t1).as_secs_f64() * 1e3
+    );
+    Ok(())
+}
+
+fn picture(a: PictureArgs) -> CliResult {
+    let ext = a
+        .out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("svg") | Some("png")) {
+        return Err(CliError::input(format!(
+            "--out {}: a picture must end in .svg or .png",
+            a.out.display()
+        )));
+    }
+    let (grid, sc, title) = match (&a.file, &a.scenario) {
+        (Some(f), None) => {
+            let tree = read_tree(f)?;
+            (grid_of(&tree, f)?, None, format!("map {}", f.display()))
+        }
+        (None, Some(n)) => {
+            let s = scenario(n)?;
+            let t = format!("scenario {}: {} units", s.name, s.default_units);
+            (s.grid.clone(), Some(s), t)
+        }
+        _ => {
+            return Err(CliError::input(
+                "give a map file or --scenario NAME, not both",
+            ))
+        }
+    };
+    let (lo, hi) = grid.bounds();
+    let band = match (a.band_min, a.band_max) {
+        (None, None) => None,
+        (b0, b1) => {
+            let h = hi[2] - lo[2];
+            let b0 = b0.unwrap_or(lo[2] + 0.25 * h);
+            let b1 = b1.unwrap_or(hi[2] - 0.25 * h);
+            if !(b0.is_finite() && b1.is_finite() && b0 <= b1) {
+                return Err(CliError::input(format!(
+                    "--band-min {b0} must not be above --band-max {b1}"
+                )));
+            }
+            Some((b0, b1))
+        }
+    };
+    if let Some(z) = a.slices.iter().find(|z| !z.is_finite()) {
+        return Err(CliError::input(format!("--slices: {z} is not a height")));
+    }
+    let opts = MapPictureOptions {
+        band,
+        slices: a.slices.clone(),
+        title,
+    };
+    let fig = map_figure(&grid, sc.as_ref(), &opts);
+    fig.save(&a.out).map_err(CliError::input)?;
+    println!("wrote {}", a.out.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::run as arc;
+
+    #[test]
+    fn export_info_picture_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let bt = dir.path().join("w.bt");
+        let bt_s = bt.to_str().unwrap();
+        arc([
+            "arc",
+            "map",
+            "export",
+            "--scenario",
+            "window",
+            "--out",
+            bt_s,
+        ])
+        .unwrap();
+        arc(["arc", "map", "info", bt_s]).unwrap();
+        let svg = dir.path().join("w.svg");
+        arc([
+            "arc",
+            "map",
+            "picture",
+            bt_s,
+            "--out",
+            svg.to_str().unwrap(),
+            "--slices",
+            "1.5",
+        ])
+        .unwrap();
+        assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
+        let svg2 = dir.path().join("c.svg");
+        arc([
+            "arc",
+            "map",
+            "picture",
+            "--scenario",
+            "corridor:12",
+            "--out",
+            svg2.to_str().unwrap(),
+        ])
+        .unwrap();
+        assert!(svg2.exists());
+    }
+
+    #[test]
+    fn bad_input_exits_with_2() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("x.bt");
+        let out_s = out.to_str().unwrap();
+        let code = |args: &[&str]| arc(args.iter().copied()).unwrap_err().code;
+        assert_eq!(
+            code(&["arc", "map", "export", "--scenario", "nope", "--out", out_s]),
+            2
+        );
+        assert_eq!(
+            code(&[
+                "arc",
+                "map",
+                "export",
+                "--scenario",
+                "corridor:500",
+                "--out",
+                out_s
+            ]),
+            2
+        );
+        assert_eq!(code(&["arc", "map", "info", "/nonexistent/map.bt"]), 2);
+        let junk = dir.path().join("junk.bt");
+        std::fs::write(&junk, b"not an octomap").unwrap();
+        let e = arc(["arc", "map", "info", junk.to_str().unwrap()]).unwrap_err();
+        assert_eq!(e.code, 2);
+        assert!(e.message.contains("junk.bt"), "{}", e.message);
+        let pic = dir.path().join("p.jpg");
+        assert_eq!(
+            code(&[
+                "arc",
+                "map",
+                "picture",
+                "--scenario",
+                "maze",
+                "--out",
+                pic.to_str().unwrap()
+            ]),
+            2
+        );
+        assert_eq!(code(&["arc", "map", "picture", "--out", "x.svg"]), 2);
+        let svg = dir.path().join("p.svg");
+        let svg_s = svg.to_str().unwrap();
+        assert_eq!(
+            code(&[
+                "arc",
+                "map",
+                "picture",
+                "--scenario",
+                "maze",
+                "--out",
+                svg_s,
+                "--band-min",
+                "2",
+                "--band-max",
+                "1"
+            ]),
+            2
+        );
+        assert_eq!(
+            code(&[
+                "arc",
+                "map",
+                "export",
+                "--scenario",
+                "maze",
+                "--out",
+                "/nonexistent-dir/x.bt"
+            ]),
+            2
+        );
+    }
+}
