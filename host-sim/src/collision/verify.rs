@@ -23,6 +23,9 @@ use crate::plan::Plan;
 /// Tolerance for "stays" when classifying an edge (ARC-MODEL.md).
 pub const STAY_TOLERANCE: f64 = 1e-9;
 
+/// Most sample intervals one edge may need (a 2.5 km translation at 0.1 m).
+pub const MAX_INTERVALS: usize = 100_000;
+
 /// Default search horizon for the clearance report (m).
 pub const DEFAULT_HORIZON: f64 = 0.5;
 
@@ -352,6 +355,27 @@ pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> Verif
             }
             EdgeKind::Translation | EdgeKind::ShapeChange => {
                 let n = edge_intervals(kind, params.link_length as f64, a, b, grid.resolution());
+                if n > MAX_INTERVALS {
+                    // Only a translation that leaves any real map gets here (a shape
+                    // change moves no point more than 15 * l * 4.5 m): check its end,
+                    // which is outside the bounds, instead of sampling for ever.
+                    let before = rep.violation.is_none();
+                    check(&mut rep, b, end);
+                    if before && rep.violation.is_none() {
+                        let site = Site {
+                            waypoint: e,
+                            edge: Some(e),
+                            sample: 0,
+                            t: 0.0,
+                        };
+                        let what = format!("the edge needs {n} samples, more than {MAX_INTERVALS}");
+                        rep.violation = Some(PlanViolation {
+                            site,
+                            problem: PlanProblem::Format(what),
+                        });
+                    }
+                    continue;
+                }
                 for j in 1..=n {
                     let t = j as f64 / n as f64;
                     let z = edge_sample(kind, a, b, t);
@@ -394,6 +418,12 @@ pub fn check_edge_exact(
         return Err((0.0, ExactViolation::BadShape));
     }
     let n = edge_intervals(kind, params.link_length as f64, a, b, grid.resolution());
+    if n > MAX_INTERVALS {
+        // Too long for any map: report its end (outside the bounds) or give up.
+        check_config_exact(grid, params, [b[0], b[1], b[2]], &b[3..], horizon)
+            .map_err(|v| (1.0, v))?;
+        return Err((0.0, ExactViolation::BadShape));
+    }
     let mut best = f64::INFINITY;
     for j in 0..=n {
         let t = if n == 0 { 0.0 } else { j as f64 / n as f64 };
@@ -404,4 +434,96 @@ pub fn check_edge_exact(
         }
     }
     Ok(best)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::map::grid::{Cell, Grid};
+    use crate::plan::{ChainSection, MapSection, Waypoint, FORMAT};
+    use arc_core::Shape;
+
+    fn plan(points: &[([f64; 3], Shape)]) -> Plan {
+        Plan {
+            format: FORMAT.into(),
+            chain: ChainSection::from_params(&ChainParams::new(3)),
+            map: MapSection {
+                resolution: 0.1,
+                unknown_is_occupied: true,
+            },
+            waypoints: points.iter().map(|(h, s)| Waypoint::new(*h, s)).collect(),
+            stats: Default::default(),
+        }
+    }
+
+    fn room() -> Grid {
+        let mut g = Grid::new(0.1, [0, 0, 0], [40, 40, 20], Cell::Free, true).unwrap();
+        g.fill_box([2.05, 0.0, 0.0], [2.15, 4.0, 2.0], Cell::Occupied);
+        g
+    }
+
+    #[test]
+    fn wrap_and_classify() {
+        assert_eq!(wrap(PI), PI);
+        assert!((wrap(-PI) - PI).abs() < 1e-12);
+        assert!((wrap(3.0 * PI) - PI).abs() < 1e-9);
+        let a = [0.0, 0.0, 0.0, PI, 0.0, PI];
+        let b = [0.0, 0.0, 0.0, -PI, 0.0, -PI];
+        assert_eq!(classify_edge(&a, &b), EdgeKind::Stay);
+        let c = [1.0, 0.0, 0.0, PI, 0.0, PI];
+        assert_eq!(classify_edge(&a, &c), EdgeKind::Translation);
+        let d = [0.0, 0.0, 0.0, PI, 0.1, PI];
+        assert_eq!(classify_edge(&a, &d), EdgeKind::ShapeChange);
+        let e = [1.0, 0.0, 0.0, PI, 0.1, PI];
+        assert_eq!(classify_edge(&a, &e), EdgeKind::Both);
+    }
+
+    #[test]
+    fn reports_first_violation_and_clearance() {
+        let g = room();
+        let s = Shape::line(3, 0.0);
+        let ok = plan(&[
+            ([1.6, 1.0, 1.0], s),
+            ([1.6, 3.0, 1.0], s),
+            ([1.6, 3.0, 1.0], s.rotated(1.0)),
+        ]);
+        let r = verify_plan(&g, &ok);
+        assert!(r.ok, "{:?}", r.violation);
+        assert_eq!(r.edges, vec![EdgeKind::Translation, EdgeKind::ShapeChange]);
+        // The head sphere's closest approach: 2.0 - 1.6 - 0.15.
+        assert!((r.min_clearance - 0.25).abs() < 1e-6, "{}", r.min_clearance);
+        assert!(r.samples > 80);
+        let bad = plan(&[([1.6, 1.0, 1.0], s), ([3.0, 1.0, 1.0], s)]);
+        let r = verify_plan(&g, &bad);
+        let v = r.violation.unwrap();
+        assert_eq!(v.site.edge, Some(0));
+        assert!(
+            matches!(
+                v.problem,
+                PlanProblem::Invalid(ExactViolation::Map {
+                    body: Body::Unit(0),
+                    ..
+                })
+            ),
+            "{v}"
+        );
+        assert!(v.site.t > 0.1 && v.site.t < 0.3, "{v}");
+        assert!(r.min_clearance <= 0.0);
+        let both = plan(&[([1.6, 1.0, 1.0], s), ([1.6, 2.0, 1.0], s.rotated(0.5))]);
+        let r = verify_plan(&g, &both);
+        assert_eq!(r.violation.unwrap().problem, PlanProblem::BothChange);
+        // A plan that leaves for the far end of the world does not hang the verifier.
+        let far = plan(&[([1.6, 1.0, 1.0], s), ([1e12, 1.0, 1.0], s)]);
+        let r = verify_plan(&g, &far);
+        assert!(matches!(
+            r.violation.unwrap().problem,
+            PlanProblem::Invalid(ExactViolation::OutOfBounds { .. })
+        ));
+        let mut broken = ok.clone();
+        broken.waypoints[1].zeta.pop();
+        assert!(matches!(
+            verify_plan(&g, &broken).violation.unwrap().problem,
+            PlanProblem::Format(_)
+        ));
+    }
 }
