@@ -15,4 +15,5 @@ pub mod picture;
 pub mod plan;
 pub mod plan_picture;
 pub mod planner;
+pub mod sim;
 pub mod tables;

@@ -1,0 +1,522 @@
+//! Flying a plan: the simulation loop, the recorded flight and its report.
+//!
+//! Physics and every controller loop run at [`SimConfig::rate`] (default 500 Hz);
+//! the head MPC is re-solved every [`ControllerConfig::mpc_period`]. Every body's
+//! state is recorded at every step. The flight ends when the chain has stayed at the
+//! goal (head within [`SimConfig::goal_tolerance`], every link within
+//! [`SimConfig::angle_tolerance`] of the final shape) for [`SimConfig::settle_hold`]
+//! after the reference has ended, or [`SimConfig::settle_time`] after the reference
+//! has ended, or when it diverges.
+
+use std::time::Instant;
+
+use arc_core::control::{desired_attitude, Vec3};
+use arc_core::kinematics::Points;
+use arc_core::validity::visit_pairs;
+use arc_core::{ChainParams, MAX_UNITS};
+use nalgebra::{UnitQuaternion, Vector3};
+use serde::Serialize;
+
+use super::controller::{ChainController, ControllerConfig};
+use super::dynamics::{Actuator, BodyState, ChainDynamics, DynamicsError, V3};
+use super::model::ChainModel;
+use super::reference::{Reference, ReferenceLimits};
+
+/// A disturbance force held on units for a while.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gust {
+    /// Start time (s).
+    pub start: f64,
+    /// Duration (s).
+    pub duration: f64,
+    /// The unit (0-based) it acts on; `None`: every unit.
+    pub unit: Option<usize>,
+    /// Force on each affected unit (world, N).
+    pub force: V3,
+}
+
+/// Everything a simulation run needs besides the plan.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimConfig {
+    /// Physics and control rate (Hz), at least 500.
+    pub rate: f64,
+    /// The control stack.
+    pub controller: ControllerConfig,
+    /// How the plan's edges are timed.
+    pub limits: ReferenceLimits,
+    /// Longest time after the reference ends to reach and hold the goal (s).
+    pub settle_time: f64,
+    /// How long the chain must stay at the goal to count as arrived (s).
+    pub settle_hold: f64,
+    /// Distance of the head from the last waypoint's head that counts as arrived (m).
+    pub goal_tolerance: f64,
+    /// Angle of every link from its final direction that counts as arrived (rad).
+    pub angle_tolerance: f64,
+    /// A flight whose head strays farther than this from its reference diverged (m).
+    pub divergence: f64,
+    /// Disturbances.
+    pub gusts: Vec<Gust>,
+    /// Fly at least this long (s), e.g. to watch a hover or a gust after the plan ends.
+    pub min_time: f64,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        Self {
+            rate: 500.0,
+            controller: ControllerConfig::default(),
+            limits: ReferenceLimits::default(),
+            settle_time: 10.0,
+            settle_hold: 1.0,
+            goal_tolerance: 0.1,
+            angle_tolerance: 5f64.to_radians(),
+            divergence: 3.0,
+            gusts: Vec::new(),
+            min_time: 0.0,
+        }
+    }
+}
+
+impl SimConfig {
+    /// Checks the numbers.
+    pub fn validate(&self) -> Result<(), String> {
+        let pos = |v: f64| v.is_finite() && v > 0.0;
+        if !(self.rate.is_finite() && (500.0..=20_000.0).contains(&self.rate)) {
+            return Err(format!("rate {} Hz must lie in [500, 20000]", self.rate));
+        }
+        if !(pos(self.settle_time)
+            && pos(self.settle_hold)
+            && pos(self.goal_tolerance)
+            && pos(self.angle_tolerance)
+            && pos(self.divergence))
+        {
+            return Err(
+                "settle times, tolerances and the divergence bound must be positive".into(),
+            );
+        }
+        if !(self.min_time.is_finite() && (0.0..=3600.0).contains(&self.min_time)) {
+            return Err("minimum flight time must lie in [0, 3600] s".into());
+        }
+        for g in &self.gusts {
+            if !(g.start.is_finite() && pos(g.duration) && g.force.iter().all(|v| v.is_finite())) {
+                return Err(
+                    "gusts need a finite start, a positive duration and a finite force".into(),
+                );
+            }
+        }
+        self.controller.validate()?;
+        self.limits.validate()
+    }
+}
+
+/// The map side of a flight: the exact clearance of the flown chain.
+pub trait Obstacles {
+    /// The smallest (distance to an obstacle - body radius) over every unit sphere and
+    /// link capsule of the chain with unit centres `units` (m; `<= 0` is contact),
+    /// and a description of the body and obstacle concerned.
+    fn clearance(&self, units: &[V3]) -> (f64, String);
+    /// Largest motion of any unit centre between two clearance checks (m).
+    fn check_spacing(&self) -> f64;
+}
+
+/// A recorded body state, compact (`f32`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct BodySample {
+    /// Position (m).
+    pub p: [f32; 3],
+    /// Attitude quaternion `[w, x, y, z]`.
+    pub q: [f32; 4],
+    /// Velocity (m/s).
+    pub v: [f32; 3],
+    /// Angular velocity, world frame (rad/s).
+    pub w: [f32; 3],
+}
+
+impl BodySample {
+    fn new(s: &BodyState) -> Self {
+        let q = UnitQuaternion::from_matrix(&s.r);
+        let f = |v: &V3| [v.x as f32, v.y as f32, v.z as f32];
+        Self {
+            p: f(&s.p),
+            q: [q.w as f32, q.i as f32, q.j as f32, q.k as f32],
+            v: f(&s.v),
+            w: f(&s.w),
+        }
+    }
+}
+
+/// Everything recorded at one step.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Sample {
+    /// Time (s).
+    pub t: f64,
+    /// Every unit, head first.
+    pub units: Vec<BodySample>,
+    /// Every link.
+    pub links: Vec<BodySample>,
+    /// Reference head position (m).
+    pub head_ref: [f32; 3],
+    /// Reference `(pitch, yaw)` of every link (rad).
+    pub links_ref: Vec<[f32; 2]>,
+    /// Measured `(pitch, yaw)` of every link (rad).
+    pub links_meas: Vec<[f32; 2]>,
+    /// Commanded thrust of every unit (N).
+    pub thrust: Vec<f32>,
+    /// Commanded `[roll, pitch, yaw]` of every unit (rad).
+    pub attitude_cmd: Vec<[f32; 3]>,
+    /// Commanded head acceleration (m/s^2).
+    pub head_accel: [f32; 3],
+}
+
+/// Joint-limit excursions of the flown chain.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct LimitExcursions {
+    /// Largest `|theta_i| - theta_max` seen, if positive (deg).
+    pub max_pitch_excess_deg: f64,
+    /// Largest bend - `beta_max` seen, if positive (deg).
+    pub max_bend_excess_deg: f64,
+    /// Time during which some limit was exceeded (s).
+    pub time_beyond: f64,
+}
+
+/// The flight's summary.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FlightReport {
+    /// Number of units.
+    pub units: usize,
+    /// Physics and control rate (Hz).
+    pub rate_hz: f64,
+    /// When the reference ends (s).
+    pub planned_duration: f64,
+    /// When the chain arrived at the goal and stayed (s), if it did.
+    pub time_to_complete: Option<f64>,
+    /// Whether it arrived.
+    pub reached_goal: bool,
+    /// Simulated time (s).
+    pub simulated_time: f64,
+    /// RMS of the head's distance to its reference (m).
+    pub head_rms: f64,
+    /// Largest head distance to its reference (m).
+    pub head_max: f64,
+    /// RMS over time and links of the angle between each link and its reference (deg).
+    pub link_rms_deg: f64,
+    /// Largest such angle (deg).
+    pub link_max_deg: f64,
+    /// Smallest exact clearance of the flown chain to the map (m), when a map was given.
+    pub min_clearance: Option<f64>,
+    /// Where the smallest clearance was found.
+    pub min_clearance_at: Option<String>,
+    /// Time of the smallest clearance (s).
+    pub min_clearance_time: Option<f64>,
+    /// Whether any body touched the map.
+    pub contact: bool,
+    /// Smallest gap between bodies of the chain that share no joint (m).
+    pub min_self_gap: f64,
+    /// Whether the chain touched itself.
+    pub self_contact: bool,
+    /// Joint-limit excursions.
+    pub limits: LimitExcursions,
+    /// MPC solves and failures (fallback to a PD law).
+    pub mpc_solves: usize,
+    /// MPC solves that failed.
+    pub mpc_failures: usize,
+    /// Whether the flight diverged (left the reference by more than the bound).
+    pub diverged: bool,
+    /// Wall-clock seconds spent.
+    pub wall_seconds: f64,
+    /// Simulated seconds per wall-clock second.
+    pub realtime_factor: f64,
+}
+
+impl FlightReport {
+    /// Whether the flight succeeded: arrived, no contact with the map or itself, did
+    /// not diverge.
+    pub fn success(&self) -> bool {
+        self.reached_goal && !self.contact && !self.self_contact && !self.diverged
+    }
+}
+
+/// A simulated flight.
+#[derive(Clone, Debug)]
+pub struct Flight {
+    /// The chain.
+    pub params: ChainParams,
+    /// The timed reference flown.
+    pub reference: Reference,
+    /// Every step.
+    pub samples: Vec<Sample>,
+    /// The summary.
+    pub report: FlightReport,
+}
+
+/// Why a flight could not be run at all (a flight that runs and fails is a
+/// [`Flight`] whose report says so).
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// The configuration is invalid.
+    #[error("simulation settings: {0}")]
+    Config(String),
+    /// The plan cannot be flown (edge kinds, sizes).
+    #[error("plan: {0}")]
+    Plan(String),
+    /// The dynamics cannot be built.
+    #[error(transparent)]
+    Dynamics(#[from] DynamicsError),
+}
+
+/// Angle between two unit vectors (rad), robust near 0 and pi.
+fn angle_between(a: &V3, b: &V3) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// Flies the plan `waypoints` (`zeta` vectors) of chain `params` with the default
+/// bodies of [`ChainModel::new`], checking clearance against `obstacles` if given.
+pub fn simulate(
+    params: &ChainParams,
+    waypoints: &[Vec<f64>],
+    cfg: &SimConfig,
+    obstacles: Option<&dyn Obstacles>,
+) -> Result<Flight, SimError> {
+    simulate_model(ChainModel::new(*params), waypoints, cfg, obstacles)
+}
+
+/// [`simulate`] with explicit bodies.
+pub fn simulate_model(
+    model: ChainModel,
+    waypoints: &[Vec<f64>],
+    cfg: &SimConfig,
+    obstacles: Option<&dyn Obstacles>,
+) -> Result<Flight, SimError> {
+    cfg.validate().map_err(SimError::Config)?;
+    model.validate().map_err(SimError::Config)?;
+    let params = model.params;
+    let n = model.units();
+    let l = model.link_length();
+    let reference = Reference::new(n, l, waypoints, &cfg.limits).map_err(SimError::Plan)?;
+    let start = &waypoints[0];
+    let dt = 1.0 / cfg.rate;
+    let mut dynamics = ChainDynamics::new(
+        model,
+        V3::new(start[0], start[1], start[2]),
+        &start[3..],
+        dt,
+    )?;
+    let mut controller_probe =
+        ChainController::new(model, cfg.controller).map_err(SimError::Config)?;
+    // Start in trim: each unit tilted as the controller wants it at rest and its motors
+    // already producing what it asks (a chain hovering in its start configuration).
+    let first = controller_probe.step(0.0, &dynamics.unit_states(), &reference);
+    for (i, f) in first.forces.iter().enumerate() {
+        let r = desired_attitude(
+            &Vec3::new(f.x as f32, f.y as f32, f.z as f32),
+            first.attitude_cmd[i][2] as f32,
+        );
+        dynamics.set_unit_attitude(i, &r.map(|x| x as f64));
+    }
+    let mut controller = ChainController::new(model, cfg.controller).map_err(SimError::Config)?;
+    let trim = controller.step(0.0, &dynamics.unit_states(), &reference);
+    let act: Vec<Actuator> = trim
+        .commands
+        .iter()
+        .map(|c| Actuator {
+            thrust: c.thrust,
+            moment: c.moment,
+        })
+        .collect();
+    dynamics.set_actuators(&act);
+    controller = ChainController::new(model, cfg.controller).map_err(SimError::Config)?;
+
+    let end_zeta = reference.end().to_vec();
+    let goal = V3::new(end_zeta[0], end_zeta[1], end_zeta[2]);
+    let goal_dirs: Vec<V3> = (0..n - 1)
+        .map(|k| super::dynamics::link_direction(end_zeta[4 + 2 * k], end_zeta[5 + 2 * k]))
+        .collect();
+    let t_ref = reference.duration();
+    let t_max = t_ref.max(cfg.min_time) + cfg.settle_time;
+    let theta_max = params.theta_max as f64;
+    let beta_max = params.beta_max as f64;
+
+    let wall = Instant::now();
+    let mut samples = Vec::with_capacity(((t_max + 1.0) * cfg.rate) as usize);
+    let (mut head_sq, mut head_max, mut link_sq, mut link_max) = (0.0, 0.0f64, 0.0, 0.0f64);
+    let mut link_count = 0usize;
+    let mut limits = LimitExcursions::default();
+    let mut min_clear: Option<(f64, String, f64)> = None;
+    let mut last_check: Option<Vec<V3>> = None;
+    let mut min_self_gap = f64::INFINITY;
+    let mut at_goal_since: Option<f64> = None;
+    let mut completed: Option<f64> = None;
+    let mut diverged = false;
+    let mut step = 0usize;
+    loop {
+        let t = step as f64 * dt;
+        let units = dynamics.unit_states();
+        let links = dynamics.link_states();
+        let out = controller.step(t, &units, &reference);
+        let r = reference.sample(t);
+        // Tracking errors.
+        let e_head = (units[0].p - r.p).norm();
+        head_sq += e_head * e_head;
+        head_max = head_max.max(e_head);
+        let dirs: Vec<V3> = (0..n - 1)
+            .map(|k| (units[k].p - units[k + 1].p).normalize())
+            .collect();
+        let mut at_goal = (units[0].p - goal).norm() <= cfg.goal_tolerance;
+        for k in 0..n - 1 {
+            let lr = &r.links[k];
+            let e = angle_between(&dirs[k], &super::dynamics::link_direction(lr.pitch, lr.yaw));
+            link_sq += e * e;
+            link_count += 1;
+            link_max = link_max.max(e);
+            at_goal &= angle_between(&dirs[k], &goal_dirs[k]) <= cfg.angle_tolerance;
+        }
+        // Limits of the flown chain.
+        let mut beyond = false;
+        for k in 0..n - 1 {
+            let pitch = (-dirs[k].z).clamp(-1.0, 1.0).asin();
+            let ex = pitch.abs() - theta_max;
+            if ex > 0.0 {
+                beyond = true;
+                limits.max_pitch_excess_deg = limits.max_pitch_excess_deg.max(ex.to_degrees());
+            }
+            if k + 1 < n - 1 {
+                let ex = angle_between(&dirs[k], &dirs[k + 1]) - beta_max;
+                if ex > 0.0 {
+                    beyond = true;
+                    limits.max_bend_excess_deg = limits.max_bend_excess_deg.max(ex.to_degrees());
+                }
+            }
+        }
+        if beyond {
+            limits.time_beyond += dt;
+        }
+        // Self-contact of the flown chain (core's exact pair test, relative positions).
+        let mut pts: Points = [Vector3::zeros(); MAX_UNITS];
+        for (i, u) in units.iter().enumerate() {
+            let d = u.p - units[0].p;
+            pts[i] = Vector3::new(d.x as f32, d.y as f32, d.z as f32);
+        }
+        visit_pairs(&params, n, &pts, |_, _, gap| {
+            min_self_gap = min_self_gap.min(gap as f64);
+            true
+        });
+        // Clearance to the map, whenever some unit has moved enough.
+        if let Some(obs) = obstacles {
+            let centres: Vec<V3> = units.iter().map(|u| u.p).collect();
+            let due = match &last_check {
+                None => true,
+                Some(prev) => prev
+                    .iter()
+                    .zip(&centres)
+                    .any(|(a, b)| (a - b).norm() >= obs.check_spacing()),
+            };
+            if due {
+                let (c, at) = obs.clearance(&centres);
+                if min_clear.as_ref().is_none_or(|m| c < m.0) {
+                    min_clear = Some((c, at, t));
+                }
+                last_check = Some(centres);
+            }
+        }
+        samples.push(Sample {
+            t,
+            units: units.iter().map(BodySample::new).collect(),
+            links: links.iter().map(BodySample::new).collect(),
+            head_ref: [r.p.x as f32, r.p.y as f32, r.p.z as f32],
+            links_ref: r
+                .links
+                .iter()
+                .map(|l| [l.pitch as f32, l.yaw as f32])
+                .collect(),
+            links_meas: out
+                .link_angles
+                .iter()
+                .map(|&(p, y)| [p as f32, y as f32])
+                .collect(),
+            thrust: out.commands.iter().map(|c| c.thrust as f32).collect(),
+            attitude_cmd: out
+                .attitude_cmd
+                .iter()
+                .map(|a| [a[0] as f32, a[1] as f32, a[2] as f32])
+                .collect(),
+            head_accel: [
+                out.head_accel.x as f32,
+                out.head_accel.y as f32,
+                out.head_accel.z as f32,
+            ],
+        });
+        // Arrival.
+        if at_goal && t >= t_ref - cfg.settle_hold {
+            let since = *at_goal_since.get_or_insert(t);
+            if t >= t_ref.max(cfg.min_time) && t - since >= cfg.settle_hold {
+                completed = Some(since);
+                break;
+            }
+        } else {
+            at_goal_since = None;
+        }
+        if e_head > cfg.divergence || !units.iter().all(|u| u.p.iter().all(|v| v.is_finite())) {
+            diverged = true;
+            break;
+        }
+        if t >= t_max {
+            break;
+        }
+        // Gusts.
+        for i in 0..n {
+            let f: V3 = cfg
+                .gusts
+                .iter()
+                .filter(|g| {
+                    t >= g.start && t < g.start + g.duration && g.unit.is_none_or(|u| u == i)
+                })
+                .map(|g| g.force)
+                .sum();
+            dynamics.set_external_force(i, f);
+        }
+        if !dynamics.step(&out.commands) {
+            diverged = true;
+            break;
+        }
+        step += 1;
+    }
+    let wall_seconds = wall.elapsed().as_secs_f64();
+    let count = samples.len().max(1) as f64;
+    let simulated_time = samples.last().map_or(0.0, |s| s.t);
+    let (solves, failures) = controller.mpc_counts();
+    let contact = min_clear.as_ref().is_some_and(|m| m.0 <= 0.0);
+    let report = FlightReport {
+        units: n,
+        rate_hz: cfg.rate,
+        planned_duration: t_ref,
+        time_to_complete: completed,
+        reached_goal: completed.is_some(),
+        simulated_time,
+        head_rms: (head_sq / count).sqrt(),
+        head_max,
+        link_rms_deg: (link_sq / link_count.max(1) as f64).sqrt().to_degrees(),
+        link_max_deg: link_max.to_degrees(),
+        min_clearance: min_clear.as_ref().map(|m| m.0),
+        min_clearance_at: min_clear.as_ref().map(|m| m.1.clone()),
+        min_clearance_time: min_clear.as_ref().map(|m| m.2),
+        contact,
+        min_self_gap,
+        self_contact: min_self_gap <= 0.0,
+        limits,
+        mpc_solves: solves,
+        mpc_failures: failures,
+        diverged,
+        wall_seconds,
+        realtime_factor: if wall_seconds > 0.0 {
+            simulated_time / wall_seconds
+        } else {
+            f64::INFINITY
+        },
+    };
+    Ok(Flight {
+        params,
+        reference,
+        samples,
+        report,
+    })
+}

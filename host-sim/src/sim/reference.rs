@@ -1,0 +1,473 @@
+//! Reference generation from a plan: every edge timed within speed and angular-rate
+//! limits, with a minimum-jerk (quintic) time scaling so that position, velocity and
+//! acceleration (and the link angles, rates and angular accelerations) are continuous
+//! and the chain is at rest at every waypoint.
+//!
+//! Edges follow ARC-MODEL.md "Motion between two configurations": a translation
+//! moves the head along the straight segment with the shape fixed; a shape change
+//! moves every angle of `eta` linearly along its shortest signed difference with the
+//! head fixed. An edge that changes both is refused.
+
+use std::f64::consts::PI;
+
+use super::dynamics::{unit_positions, V3};
+
+/// ARC-MODEL.md: "stays" means equal within this (angles compared after wrapping).
+pub const STAY_TOLERANCE: f64 = 1e-9;
+
+/// Peak of `ds/dtau` of the quintic time scaling.
+const QUINTIC_PEAK_RATE: f64 = 1.875;
+/// Peak of `|d2s/dtau2|` of the quintic time scaling (`10 / sqrt(3)`).
+const QUINTIC_PEAK_ACCEL: f64 = 5.773_502_691_896_258;
+
+/// Wraps an angle to `(-pi, pi]`.
+pub fn wrap(a: f64) -> f64 {
+    let w = a.rem_euclid(2.0 * PI);
+    if w > PI {
+        w - 2.0 * PI
+    } else {
+        w
+    }
+}
+
+/// The limits every edge is timed within.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferenceLimits {
+    /// Largest speed of any unit centre (m/s).
+    pub speed: f64,
+    /// Largest acceleration of the head on a translation (m/s^2).
+    pub accel: f64,
+    /// Largest rate of any angle of `eta` (rad/s).
+    pub angular_rate: f64,
+    /// Largest angular acceleration of any angle of `eta` (rad/s^2).
+    pub angular_accel: f64,
+    /// Time at rest at the start before the first edge (s).
+    pub start_hold: f64,
+}
+
+impl Default for ReferenceLimits {
+    fn default() -> Self {
+        Self {
+            speed: 0.5,
+            accel: 0.5,
+            angular_rate: 0.4,
+            angular_accel: 0.5,
+            start_hold: 1.0,
+        }
+    }
+}
+
+impl ReferenceLimits {
+    /// Checks that every limit is finite and positive (the hold may be zero).
+    pub fn validate(&self) -> Result<(), String> {
+        let pos = |v: f64| v.is_finite() && v > 0.0;
+        if !(pos(self.speed)
+            && pos(self.accel)
+            && pos(self.angular_rate)
+            && pos(self.angular_accel))
+        {
+            return Err("speed, acceleration and angular limits must be positive".into());
+        }
+        if !(self.start_hold.is_finite() && self.start_hold >= 0.0) {
+            return Err("start hold must be a non-negative number of seconds".into());
+        }
+        Ok(())
+    }
+}
+
+/// The kind of a timed segment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SegmentKind {
+    /// At rest (the start hold, or an edge that changes nothing).
+    Hold,
+    /// Only the head moves.
+    Translation,
+    /// Only the shape changes.
+    ShapeChange,
+}
+
+/// One timed edge.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Segment {
+    /// What moves.
+    pub kind: SegmentKind,
+    /// Start time (s).
+    pub t0: f64,
+    /// Duration (s).
+    pub duration: f64,
+    /// Start configuration `zeta` (angles as in the plan).
+    pub from: Vec<f64>,
+    /// Change of every coordinate of `zeta` over the segment (angles: shortest signed
+    /// difference).
+    pub delta: Vec<f64>,
+    /// Index of the waypoint the segment ends at.
+    pub to_waypoint: usize,
+}
+
+/// The reference of one link at one time.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LinkRef {
+    /// Pitch theta (rad).
+    pub pitch: f64,
+    /// Yaw psi (rad).
+    pub yaw: f64,
+    /// Pitch rate (rad/s).
+    pub pitch_rate: f64,
+    /// Yaw rate (rad/s).
+    pub yaw_rate: f64,
+    /// Pitch acceleration (rad/s^2).
+    pub pitch_acc: f64,
+    /// Yaw acceleration (rad/s^2).
+    pub yaw_acc: f64,
+}
+
+/// The reference at one time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefPoint {
+    /// Head position (m).
+    pub p: V3,
+    /// Head velocity (m/s).
+    pub v: V3,
+    /// Head acceleration (m/s^2).
+    pub a: V3,
+    /// Head yaw psi1_r (rad).
+    pub head_yaw: f64,
+    /// Head yaw rate (rad/s).
+    pub head_yaw_rate: f64,
+    /// Every link.
+    pub links: Vec<LinkRef>,
+}
+
+/// The timed reference of a whole plan.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reference {
+    units: usize,
+    segments: Vec<Segment>,
+    end: Vec<f64>,
+    duration: f64,
+}
+
+/// Minimum-jerk time scaling: `(s, ds/dt, d2s/dt2)` at `t` in a segment of length `d`.
+fn quintic(t: f64, d: f64) -> (f64, f64, f64) {
+    if d <= 0.0 || t >= d {
+        return (1.0, 0.0, 0.0);
+    }
+    if t <= 0.0 {
+        return (0.0, 0.0, 0.0);
+    }
+    let x = t / d;
+    let s = x * x * x * (10.0 - 15.0 * x + 6.0 * x * x);
+    let ds = 30.0 * x * x * (1.0 - x) * (1.0 - x) / d;
+    let dds = 60.0 * x * (1.0 - 3.0 * x + 2.0 * x * x) / (d * d);
+    (s, ds, dds)
+}
+
+impl Reference {
+    /// Times the plan's waypoints (`zeta` vectors of `2N + 2` numbers) within `limits`
+    /// for a chain of `units` units with link length `link_length`.
+    pub fn new(
+        units: usize,
+        link_length: f64,
+        waypoints: &[Vec<f64>],
+        limits: &ReferenceLimits,
+    ) -> Result<Self, String> {
+        limits.validate()?;
+        let dim = 2 * units + 2;
+        if waypoints.is_empty() {
+            return Err("the plan has no waypoints".into());
+        }
+        for (i, w) in waypoints.iter().enumerate() {
+            if w.len() != dim || w.iter().any(|v| !v.is_finite()) {
+                return Err(format!("waypoint {i} is not {dim} finite numbers"));
+            }
+        }
+        let mut segments = Vec::new();
+        let mut t = 0.0;
+        if limits.start_hold > 0.0 {
+            segments.push(Segment {
+                kind: SegmentKind::Hold,
+                t0: 0.0,
+                duration: limits.start_hold,
+                from: waypoints[0].clone(),
+                delta: vec![0.0; dim],
+                to_waypoint: 0,
+            });
+            t = limits.start_hold;
+        }
+        for (i, pair) in waypoints.windows(2).enumerate() {
+            let (a, b) = (&pair[0], &pair[1]);
+            let mut delta: Vec<f64> = (0..dim)
+                .map(|j| {
+                    if j < 3 {
+                        b[j] - a[j]
+                    } else {
+                        wrap(b[j] - a[j])
+                    }
+                })
+                .collect();
+            let moves_head = delta[..3].iter().any(|d| d.abs() > STAY_TOLERANCE);
+            let moves_shape = delta[3..].iter().any(|d| d.abs() > STAY_TOLERANCE);
+            let (kind, duration) = match (moves_head, moves_shape) {
+                (true, true) => {
+                    return Err(format!(
+                        "edge {i} -> {} changes both the head position and the shape (ARC-MODEL.md allows one kind per edge)",
+                        i + 1
+                    ))
+                }
+                (false, false) => {
+                    delta.iter_mut().for_each(|d| *d = 0.0);
+                    (SegmentKind::Hold, 0.0)
+                }
+                (true, false) => {
+                    let len = V3::new(delta[0], delta[1], delta[2]).norm();
+                    let d = (QUINTIC_PEAK_RATE * len / limits.speed).max((QUINTIC_PEAK_ACCEL * len / limits.accel).sqrt());
+                    delta[3..].iter_mut().for_each(|d| *d = 0.0);
+                    (SegmentKind::Translation, d)
+                }
+                (false, true) => {
+                    let max_angle = delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()));
+                    // Unit i moves at most at l * sum_{k<i} |d(dir_k)/ds| * ds/dt, and a
+                    // link direction moves at most at sqrt(dtheta^2 + dpsi^2).
+                    let sweep: f64 = (0..units - 1)
+                        .map(|k| (delta[4 + 2 * k].powi(2) + delta[5 + 2 * k].powi(2)).sqrt())
+                        .sum::<f64>()
+                        * link_length;
+                    let d = (QUINTIC_PEAK_RATE * max_angle / limits.angular_rate)
+                        .max((QUINTIC_PEAK_ACCEL * max_angle / limits.angular_accel).sqrt())
+                        .max(QUINTIC_PEAK_RATE * sweep / limits.speed);
+                    delta[..3].iter_mut().for_each(|d| *d = 0.0);
+                    (SegmentKind::ShapeChange, d)
+                }
+            };
+            if duration > 0.0 {
+                segments.push(Segment {
+                    kind,
+                    t0: t,
+                    duration,
+                    from: a.clone(),
+                    delta,
+                    to_waypoint: i + 1,
+                });
+                t += duration;
+            }
+        }
+        let mut end = waypoints[waypoints.len() - 1].clone();
+        // The end as reached by following the segments (angles unwrapped consistently).
+        if let Some(last) = segments.last() {
+            end = last
+                .from
+                .iter()
+                .zip(&last.delta)
+                .map(|(a, d)| a + d)
+                .collect();
+        }
+        Ok(Self {
+            units,
+            segments,
+            end,
+            duration: t,
+        })
+    }
+
+    /// Number of units.
+    pub fn units(&self) -> usize {
+        self.units
+    }
+
+    /// Time when the last edge ends (s).
+    pub fn duration(&self) -> f64 {
+        self.duration
+    }
+
+    /// The timed segments.
+    pub fn segments(&self) -> &[Segment] {
+        &self.segments
+    }
+
+    /// The final configuration `zeta`.
+    pub fn end(&self) -> &[f64] {
+        &self.end
+    }
+
+    /// The configuration `zeta` at time `t` (the end after the last edge).
+    pub fn zeta(&self, t: f64) -> Vec<f64> {
+        match self.segment_at(t) {
+            Some(seg) => {
+                let (s, _, _) = quintic(t - seg.t0, seg.duration);
+                seg.from
+                    .iter()
+                    .zip(&seg.delta)
+                    .map(|(a, d)| a + s * d)
+                    .collect()
+            }
+            None => self.end.clone(),
+        }
+    }
+
+    fn segment_at(&self, t: f64) -> Option<&Segment> {
+        if t >= self.duration {
+            return None;
+        }
+        let i = self.segments.partition_point(|s| s.t0 <= t);
+        self.segments.get(i.saturating_sub(1))
+    }
+
+    /// The reference at time `t` (clamped to `[0, duration]`: at rest before and after).
+    pub fn sample(&self, t: f64) -> RefPoint {
+        let (z, dz, ddz) = match self.segment_at(t) {
+            Some(seg) => {
+                let (s, ds, dds) = quintic(t - seg.t0, seg.duration);
+                let z: Vec<f64> = seg
+                    .from
+                    .iter()
+                    .zip(&seg.delta)
+                    .map(|(a, d)| a + s * d)
+                    .collect();
+                let dz: Vec<f64> = seg.delta.iter().map(|d| d * ds).collect();
+                let ddz: Vec<f64> = seg.delta.iter().map(|d| d * dds).collect();
+                (z, dz, ddz)
+            }
+            None => {
+                let n = self.end.len();
+                (self.end.clone(), vec![0.0; n], vec![0.0; n])
+            }
+        };
+        let links = (0..self.units - 1)
+            .map(|k| LinkRef {
+                pitch: z[4 + 2 * k],
+                yaw: z[5 + 2 * k],
+                pitch_rate: dz[4 + 2 * k],
+                yaw_rate: dz[5 + 2 * k],
+                pitch_acc: ddz[4 + 2 * k],
+                yaw_acc: ddz[5 + 2 * k],
+            })
+            .collect();
+        RefPoint {
+            p: V3::new(z[0], z[1], z[2]),
+            v: V3::new(dz[0], dz[1], dz[2]),
+            a: V3::new(ddz[0], ddz[1], ddz[2]),
+            head_yaw: z[3],
+            head_yaw_rate: dz[3],
+            links,
+        }
+    }
+
+    /// Unit centres of the reference at time `t`.
+    pub fn unit_positions(&self, link_length: f64, t: f64) -> Vec<V3> {
+        let z = self.zeta(t);
+        unit_positions(link_length, V3::new(z[0], z[1], z[2]), &z[3..])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn zeta(xi: [f64; 3], eta: &[f64]) -> Vec<f64> {
+        let mut z = xi.to_vec();
+        z.extend_from_slice(eta);
+        z
+    }
+
+    #[test]
+    fn translation_respects_speed_and_acceleration() {
+        let lim = ReferenceLimits::default();
+        let eta = [0.0; 5];
+        let r = Reference::new(
+            3,
+            0.5,
+            &[zeta([0.0; 3], &eta), zeta([3.0, 4.0, 0.0], &eta)],
+            &lim,
+        )
+        .unwrap();
+        assert_eq!(r.segments().len(), 2);
+        let mut vmax = 0.0f64;
+        let mut amax = 0.0f64;
+        let mut t = 0.0;
+        while t < r.duration() + 1.0 {
+            let s = r.sample(t);
+            vmax = vmax.max(s.v.norm());
+            amax = amax.max(s.a.norm());
+            t += 0.001;
+        }
+        assert!(vmax <= lim.speed + 1e-9 && vmax > 0.9 * lim.speed, "{vmax}");
+        assert!(amax <= lim.accel + 1e-6, "{amax}");
+        let end = r.sample(r.duration() + 5.0);
+        assert!((end.p - V3::new(3.0, 4.0, 0.0)).norm() < 1e-12 && end.v.norm() == 0.0);
+        assert!((r.sample(0.5).p).norm() == 0.0, "held at the start");
+    }
+
+    #[test]
+    fn shape_change_takes_the_short_way_and_respects_the_rate() {
+        let lim = ReferenceLimits {
+            start_hold: 0.0,
+            ..Default::default()
+        };
+        let a = zeta([1.0, 1.0, 1.0], &[3.0, 0.0, 3.0, 0.0, 0.0]);
+        let b = zeta([1.0, 1.0, 1.0], &[-3.0, 0.2, -3.0, 0.0, 0.0]);
+        let r = Reference::new(3, 0.5, &[a, b], &lim).unwrap();
+        assert_eq!(r.segments()[0].kind, SegmentKind::ShapeChange);
+        // 3 -> -3 the short way is +0.283.., not -6.
+        let d = r.segments()[0].delta[3];
+        assert!((d - (2.0 * PI - 6.0)).abs() < 1e-12);
+        let mut t = 0.0;
+        while t < r.duration() {
+            let s = r.sample(t);
+            for l in &s.links {
+                assert!(
+                    l.pitch_rate.abs() <= lim.angular_rate + 1e-9
+                        && l.yaw_rate.abs() <= lim.angular_rate + 1e-9
+                );
+            }
+            assert!(s.v.norm() == 0.0);
+            t += 0.001;
+        }
+        assert!((wrap(r.sample(r.duration()).links[0].yaw - (-3.0))).abs() < 1e-12);
+    }
+
+    #[test]
+    fn edges_changing_both_are_refused_and_bad_waypoints_too() {
+        let lim = ReferenceLimits::default();
+        let a = zeta([0.0; 3], &[0.0; 5]);
+        let b = zeta([1.0, 0.0, 0.0], &[0.0, 0.1, 0.0, 0.0, 0.0]);
+        assert!(Reference::new(3, 0.5, &[a.clone(), b], &lim).is_err());
+        assert!(Reference::new(3, 0.5, &[a[..5].to_vec()], &lim).is_err());
+        assert!(Reference::new(3, 0.5, &[], &lim).is_err());
+        let mut nan = a.clone();
+        nan[2] = f64::NAN;
+        assert!(Reference::new(3, 0.5, &[nan], &lim).is_err());
+        let bad = ReferenceLimits { speed: 0.0, ..lim };
+        assert!(Reference::new(3, 0.5, &[a], &bad).is_err());
+    }
+
+    #[test]
+    fn velocity_is_the_derivative_of_position() {
+        let lim = ReferenceLimits::default();
+        let w = [
+            zeta([0.0; 3], &[0.0; 7]),
+            zeta([0.0; 3], &[0.5, 0.3, 0.5, -0.2, 0.1, 0.0, -0.4]),
+            zeta([1.0, -1.0, 0.5], &[0.5, 0.3, 0.5, -0.2, 0.1, 0.0, -0.4]),
+        ];
+        let r = Reference::new(4, 0.5, &w, &lim).unwrap();
+        let h = 1e-5;
+        let mut t = 0.3;
+        while t < r.duration() {
+            let (a, b, c) = (r.sample(t - h), r.sample(t), r.sample(t + h));
+            assert!(((c.p - a.p) / (2.0 * h) - b.v).norm() < 1e-5);
+            assert!(((c.v - a.v) / (2.0 * h) - b.a).norm() < 1e-4);
+            for k in 0..3 {
+                assert!(
+                    ((c.links[k].yaw - a.links[k].yaw) / (2.0 * h) - b.links[k].yaw_rate).abs()
+                        < 1e-5
+                );
+                assert!(
+                    ((c.links[k].pitch_rate - a.links[k].pitch_rate) / (2.0 * h)
+                        - b.links[k].pitch_acc)
+                        .abs()
+                        < 1e-4
+                );
+            }
+            t += 0.0937;
+        }
+    }
+}

@@ -1,0 +1,199 @@
+//! Closed-loop flights on hand-made plans: the whole stack (MPC, link controllers,
+//! mixer, unit attitude loops) on the multibody dynamics.
+
+use arc_core::ChainParams;
+
+use super::dynamics::V3;
+use super::flight::{simulate, Gust, SimConfig};
+
+fn zeta(xi: [f64; 3], eta: &[f64]) -> Vec<f64> {
+    let mut z = xi.to_vec();
+    z.extend_from_slice(eta);
+    z
+}
+
+fn line(n: usize) -> Vec<f64> {
+    vec![0.0; 2 * n - 1]
+}
+
+/// A bent shape within the limits: alternating pitches, fanning yaws.
+fn bent(n: usize) -> Vec<f64> {
+    let mut e = line(n);
+    e[0] = 0.3;
+    for k in 0..n - 1 {
+        e[1 + 2 * k] = if k % 2 == 0 { 0.4 } else { -0.3 };
+        e[2 + 2 * k] = 0.45 * k as f64 - 0.3;
+    }
+    e
+}
+
+#[test]
+fn hover_equilibrium_holds() {
+    let p = ChainParams::new(5);
+    let cfg = SimConfig {
+        min_time: 5.0,
+        ..Default::default()
+    };
+    let f = simulate(&p, &[zeta([1.0, 2.0, 3.0], &bent(5))], &cfg, None).unwrap();
+    let r = &f.report;
+    assert!(r.success(), "{r:?}");
+    assert!(r.simulated_time >= 5.0);
+    // Started in trim: nothing moves by more than a millimetre or a tenth of a degree.
+    assert!(r.head_max < 1e-3, "head moved {} m", r.head_max);
+    assert!(r.link_max_deg < 0.1, "links moved {} deg", r.link_max_deg);
+}
+
+#[test]
+fn a_step_in_head_position_settles() {
+    let p = ChainParams::new(4);
+    let w = [
+        zeta([0.0, 0.0, 2.0], &line(4)),
+        zeta([1.0, -0.5, 2.4], &line(4)),
+    ];
+    let f = simulate(&p, &w, &SimConfig::default(), None).unwrap();
+    let r = &f.report;
+    assert!(r.success(), "{r:?}");
+    let done = r.time_to_complete.unwrap();
+    assert!(
+        done <= r.planned_duration + 1.0,
+        "settled at {done} s, plan ends at {}",
+        r.planned_duration
+    );
+    assert!(
+        r.head_max < 0.05,
+        "head strayed {} m from its reference",
+        r.head_max
+    );
+    let last = f.samples.last().unwrap();
+    let head = V3::new(
+        last.units[0].p[0] as f64,
+        last.units[0].p[1] as f64,
+        last.units[0].p[2] as f64,
+    );
+    assert!((head - V3::new(1.0, -0.5, 2.4)).norm() < 0.02);
+}
+
+#[test]
+fn a_shape_change_settles() {
+    let p = ChainParams::new(5);
+    let w = [
+        zeta([0.0, 0.0, 2.0], &line(5)),
+        zeta([0.0, 0.0, 2.0], &bent(5)),
+    ];
+    let f = simulate(&p, &w, &SimConfig::default(), None).unwrap();
+    let r = &f.report;
+    assert!(r.success(), "{r:?}");
+    assert!(
+        r.link_max_deg < 3.0,
+        "a link strayed {} deg",
+        r.link_max_deg
+    );
+    assert!(
+        r.head_max < 0.02,
+        "the head moved {} m during a shape change",
+        r.head_max
+    );
+    assert_eq!(r.limits.time_beyond, 0.0);
+    let last = f.samples.last().unwrap();
+    for (k, (m, rf)) in last.links_meas.iter().zip(&last.links_ref).enumerate() {
+        assert!(
+            (m[0] - rf[0]).abs() < 0.02 && (m[1] - rf[1]).abs() < 0.02,
+            "link {k}: {m:?} vs {rf:?}"
+        );
+    }
+}
+
+#[test]
+fn a_gust_is_rejected() {
+    // 2 N sideways and 1 N down on every unit for 0.5 s (about a fifth of each unit's
+    // weight): the chain is pushed, then returns.
+    let p = ChainParams::new(4);
+    let gust = Gust {
+        start: 2.0,
+        duration: 0.5,
+        unit: None,
+        force: V3::new(2.0, 1.0, -1.0),
+    };
+    let cfg = SimConfig {
+        min_time: 8.0,
+        gusts: vec![gust],
+        ..Default::default()
+    };
+    let f = simulate(&p, &[zeta([0.0, 0.0, 2.0], &bent(4))], &cfg, None).unwrap();
+    let r = &f.report;
+    assert!(r.success(), "{r:?}");
+    assert!(r.head_max > 0.005, "the gust did push ({} m)", r.head_max);
+    assert!(r.head_max < 0.3, "but not far ({} m)", r.head_max);
+    // Back within 2 cm and 2 degrees two seconds after the gust.
+    for s in f.samples.iter().filter(|s| s.t > 4.5) {
+        let h = s.units[0].p;
+        let e = ((h[0] - s.head_ref[0]).powi(2)
+            + (h[1] - s.head_ref[1]).powi(2)
+            + (h[2] - s.head_ref[2]).powi(2))
+        .sqrt();
+        assert!(e < 0.02, "t = {}: head {e} m off", s.t);
+        for (m, rf) in s.links_meas.iter().zip(&s.links_ref) {
+            assert!(
+                (m[0] - rf[0]).abs() < 0.035 && (m[1] - rf[1]).abs() < 0.035,
+                "t = {}: {m:?} vs {rf:?}",
+                s.t
+            );
+        }
+    }
+}
+
+#[test]
+fn a_steady_wind_is_rejected_without_offset() {
+    // A constant 1.5 N push on the head from t = 1 s: the disturbance observer removes
+    // the steady-state error the MPC alone would keep.
+    let p = ChainParams::new(3);
+    let gust = Gust {
+        start: 1.0,
+        duration: 100.0,
+        unit: Some(0),
+        force: V3::new(1.5, 0.0, 0.0),
+    };
+    let cfg = SimConfig {
+        min_time: 10.0,
+        gusts: vec![gust],
+        ..Default::default()
+    };
+    let f = simulate(&p, &[zeta([0.0, 0.0, 2.0], &line(3))], &cfg, None).unwrap();
+    let last = f.samples.last().unwrap();
+    assert!(f.report.success(), "{:?}", f.report);
+    assert!(
+        (last.units[0].p[0] - last.head_ref[0]).abs() < 0.01,
+        "offset {}",
+        last.units[0].p[0]
+    );
+}
+
+#[test]
+fn a_translation_with_a_bent_shape_keeps_the_shape() {
+    let p = ChainParams::new(6);
+    let b = bent(6);
+    let w = [
+        zeta([0.0, 0.0, 2.0], &line(6)),
+        zeta([0.0, 0.0, 2.0], &b),
+        zeta([2.0, 1.0, 2.5], &b),
+    ];
+    let f = simulate(&p, &w, &SimConfig::default(), None).unwrap();
+    let r = &f.report;
+    assert!(r.success(), "{r:?}");
+    assert!(r.head_max < 0.05 && r.link_max_deg < 3.0, "{r:?}");
+}
+
+#[test]
+fn unflyable_plans_are_errors_not_panics() {
+    let p = ChainParams::new(3);
+    let cfg = SimConfig::default();
+    assert!(simulate(&p, &[], &cfg, None).is_err());
+    assert!(simulate(&p, &[vec![0.0; 5]], &cfg, None).is_err());
+    let both = [zeta([0.0; 3], &line(3)), zeta([1.0, 0.0, 0.0], &bent(3))];
+    assert!(simulate(&p, &both, &cfg, None).is_err());
+    let bad = SimConfig {
+        rate: 100.0,
+        ..Default::default()
+    };
+    assert!(simulate(&p, &[zeta([0.0; 3], &line(3))], &bad, None).is_err());
+}
