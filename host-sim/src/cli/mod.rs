@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand};
 pub mod common;
 mod map;
 mod plan;
+mod sim;
 mod tables;
 mod verify;
 
@@ -73,6 +74,8 @@ enum Command {
     /// Maps: export built-in scenarios as OctoMap files, inspect and draw maps.
     #[command(subcommand)]
     Map(map::MapCommand),
+    /// Fly a plan: chain dynamics, head MPC, link SO(3) controllers, unit attitude loops.
+    Sim(sim::SimArgs),
 }
 
 /// Parses `args` (including the program name) and runs the command.
@@ -106,6 +109,7 @@ where
         Command::Plan(a) => plan::run(*a),
         Command::Verify(a) => verify::run(a),
         Command::Map(c) => map::run(c),
+        Command::Sim(a) => sim::run(a),
     }
 }
 

@@ -7,8 +7,10 @@
 //! - [`mpc`]: the head's position MPC (a second-order-cone QP solved by clarabel);
 //! - [`controller`]: link controllers, mixer and unit attitude loops (paper Fig. 3);
 //! - [`flight`]: [`simulate`], the recorded flight and its report;
+//! - [`clearance`]: the exact clearance of the flown chain to a map;
 //! - [`plot`]: SVG plots of a flight.
 
+pub mod clearance;
 pub mod controller;
 pub mod dynamics;
 pub mod flight;

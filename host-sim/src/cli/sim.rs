@@ -1,0 +1,216 @@
+//! `arc sim`: fly a plan with the chain's dynamics and control stack, on a map.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use serde::Serialize;
+
+use super::common::MapArgs;
+use super::{CliError, CliResult};
+use crate::plan::Plan;
+use crate::sim::clearance::{footprint, MapClearance};
+use crate::sim::flight::{simulate, FlightReport, Gust, Sample, SimConfig};
+use crate::sim::plot::flight_svg;
+use crate::sim::V3;
+
+/// `arc sim`
+#[derive(Args, Debug)]
+pub struct SimArgs {
+    #[command(flatten)]
+    map: MapArgs,
+    /// The plan to fly (JSON, arc-plan/1).
+    #[arg(long)]
+    plan: PathBuf,
+    /// Write the flight (report and recorded states) as JSON.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Write plots of the flight: SVG, or PNG when the name ends in .png.
+    #[arg(long)]
+    picture: Option<PathBuf>,
+    /// Physics and control rate (Hz, at least 500).
+    #[arg(long, default_value_t = 500.0)]
+    rate: f64,
+    /// Largest speed of any unit on the plan's edges (m/s).
+    #[arg(long, default_value_t = 0.5)]
+    speed: f64,
+    /// Largest head acceleration on translations (m/s^2).
+    #[arg(long, default_value_t = 0.5)]
+    accel: f64,
+    /// Largest rate of any shape angle (degrees/s).
+    #[arg(long, default_value_t = 0.4f64.to_degrees())]
+    angular_rate_deg: f64,
+    /// Distance of the head from the plan's last waypoint that counts as arrived (m).
+    #[arg(long, default_value_t = 0.1)]
+    goal_tol: f64,
+    /// Longest time after the plan's end to arrive (s).
+    #[arg(long, default_value_t = 10.0)]
+    settle_time: f64,
+    /// A gust `START,DURATION,FX,FY,FZ` (s, s, N) on every unit; repeatable.
+    #[arg(long, allow_hyphen_values = true)]
+    gust: Vec<String>,
+    /// Keep one recorded step in this many in the JSON output.
+    #[arg(long, default_value_t = 10)]
+    record_every: usize,
+}
+
+/// The JSON written by `--out`.
+#[derive(Serialize)]
+struct SimFile<'a> {
+    format: &'static str,
+    plan: String,
+    map: String,
+    report: &'a FlightReport,
+    record_every: usize,
+    samples: Vec<&'a Sample>,
+}
+
+fn parse_gust(s: &str) -> Result<Gust, CliError> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| CliError::input(format!("--gust {s:?}: {e}")))?;
+    if v.len() != 5 || v.iter().any(|x| !x.is_finite()) || v[1] <= 0.0 {
+        return Err(CliError::input(format!(
+            "--gust {s:?}: expected START,DURATION,FX,FY,FZ with a positive duration"
+        )));
+    }
+    Ok(Gust {
+        start: v[0],
+        duration: v[1],
+        unit: None,
+        force: V3::new(v[2], v[3], v[4]),
+    })
+}
+
+/// Runs `arc sim`: exit 0 only when the chain reaches the plan's goal without touching
+/// the map or itself.
+pub fn run(a: SimArgs) -> CliResult {
+    let plan = Plan::read(&a.plan).map_err(|e| CliError::input(e.to_string()))?;
+    let params = plan
+        .check()
+        .map_err(|e| CliError::input(format!("{}: {e}", a.plan.display())))?;
+    let mut map = a.map.clone();
+    // Check the flight under what the plan assumed of unknown space.
+    map.unknown_free |= !plan.map.unknown_is_occupied;
+    let loaded = map.load()?;
+    let gusts = a
+        .gust
+        .iter()
+        .map(|g| parse_gust(g))
+        .collect::<Result<Vec<_>, _>>()?;
+    if a.record_every == 0 {
+        return Err(CliError::input("--record-every must be at least 1"));
+    }
+    let mut cfg = SimConfig {
+        rate: a.rate,
+        goal_tolerance: a.goal_tol,
+        settle_time: a.settle_time,
+        gusts,
+        ..Default::default()
+    };
+    cfg.limits.speed = a.speed;
+    cfg.limits.accel = a.accel;
+    cfg.limits.angular_rate = a.angular_rate_deg.to_radians();
+    cfg.validate()
+        .map_err(|e| CliError::input(format!("simulation settings: {e}")))?;
+    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
+    let obstacles = MapClearance::new(&loaded.grid, &params);
+    let flight = simulate(&params, &waypoints, &cfg, Some(&obstacles))
+        .map_err(|e| CliError::input(format!("{}: {e}", a.plan.display())))?;
+    let r = &flight.report;
+    println!(
+        "{}: N = {}, {} waypoints, plan {:.2} s, flown {:.2} s at {} Hz ({:.1}x real time, MPC {} solves, {} fallbacks)",
+        a.plan.display(),
+        r.units,
+        plan.waypoints.len(),
+        r.planned_duration,
+        r.simulated_time,
+        r.rate_hz,
+        r.realtime_factor,
+        r.mpc_solves,
+        r.mpc_failures
+    );
+    match r.time_to_complete {
+        Some(t) => println!("  reached the goal at {t:.2} s"),
+        None => println!("  did not reach the goal"),
+    }
+    println!(
+        "  head tracking error: RMS {:.4} m, max {:.4} m",
+        r.head_rms, r.head_max
+    );
+    println!(
+        "  link angle error:    RMS {:.3} deg, max {:.3} deg",
+        r.link_rms_deg, r.link_max_deg
+    );
+    match (r.min_clearance, &r.min_clearance_at, r.min_clearance_time) {
+        (Some(c), Some(at), Some(t)) => {
+            println!("  minimum clearance to the map: {c:.4} m at {t:.2} s ({at})")
+        }
+        _ => println!("  minimum clearance to the map: not measured"),
+    }
+    println!("  smallest gap inside the chain: {:.4} m", r.min_self_gap);
+    println!(
+        "  joint-limit excursions: pitch {:.3} deg, bend {:.3} deg, {:.3} s beyond",
+        r.limits.max_pitch_excess_deg, r.limits.max_bend_excess_deg, r.limits.time_beyond
+    );
+    if let Some(path) = &a.out {
+        let file = SimFile {
+            format: "arc-sim/1",
+            plan: a.plan.display().to_string(),
+            map: a.map.name(),
+            report: r,
+            record_every: a.record_every,
+            samples: flight.samples.iter().step_by(a.record_every).collect(),
+        };
+        let text = serde_json::to_string(&file)
+            .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+        crate::fsutil::write_atomic(path, text.as_bytes())
+            .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+        println!("  wrote {}", path.display());
+    }
+    if let Some(path) = &a.picture {
+        let zs = flight
+            .samples
+            .iter()
+            .flat_map(|s| s.units.iter().map(|u| u.p[2] as f64));
+        let (lo, hi) = zs.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), z| {
+            (l.min(z), h.max(z))
+        });
+        let band = params.unit_radius as f64;
+        let obs = footprint(&loaded.grid, lo - band, hi + band);
+        let title = format!("arc sim: {} on {}", a.plan.display(), a.map.name());
+        let svg = flight_svg(&flight, &obs, &title).map_err(CliError::failed)?;
+        let bytes = match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("png") => crate::picture::rasterise(&svg).map_err(CliError::failed)?,
+            _ => svg.into_bytes(),
+        };
+        crate::fsutil::write_atomic(path, &bytes)
+            .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+        println!("  wrote {}", path.display());
+    }
+    if r.success() {
+        return Ok(());
+    }
+    let why = if r.diverged {
+        "the flight diverged".to_string()
+    } else if r.contact {
+        format!(
+            "the chain touched the map ({})",
+            r.min_clearance_at.clone().unwrap_or_default()
+        )
+    } else if r.self_contact {
+        "the chain touched itself".to_string()
+    } else {
+        format!(
+            "the chain did not reach the goal within {:.1} s of the plan's end",
+            cfg.settle_time
+        )
+    };
+    Err(CliError::failed(format!("{}: {why}", a.plan.display())))
+}

@@ -1,0 +1,133 @@
+//! The exact clearance of the flown chain to a map, with the project's exact checker
+//! ([`crate::collision::exact::nearest_obstacle`]: point and segment to voxel-cube
+//! distances), for [`super::flight::Obstacles`].
+
+use arc_core::ChainParams;
+
+use super::dynamics::V3;
+use super::flight::Obstacles;
+use crate::collision::exact::nearest_obstacle;
+use crate::map::grid::Grid;
+
+/// How far beyond a body's radius obstacles are searched (m): the clearance reported is
+/// `min(true clearance, HORIZON)`.
+pub const HORIZON: f64 = 0.5;
+
+/// A map and a chain: exact clearance of unit spheres and link capsules.
+pub struct MapClearance<'a> {
+    grid: &'a Grid,
+    unit_radius: f64,
+    link_radius: f64,
+}
+
+impl<'a> MapClearance<'a> {
+    /// Clearance of the chain `params` in `grid` (unknown space as the grid says).
+    pub fn new(grid: &'a Grid, params: &ChainParams) -> Self {
+        Self {
+            grid,
+            unit_radius: params.unit_radius as f64,
+            link_radius: params.link_radius as f64,
+        }
+    }
+}
+
+fn arr(v: &V3) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+impl Obstacles for MapClearance<'_> {
+    fn clearance(&self, units: &[V3]) -> (f64, String) {
+        let mut best = (HORIZON, String::from("nothing within the search horizon"));
+        for (i, p) in units.iter().enumerate() {
+            if !self.grid.in_bounds(arr(p)) {
+                return (
+                    -self.unit_radius,
+                    format!(
+                        "unit {} centre ({:.3}, {:.3}, {:.3}) is outside the map's bounds",
+                        i + 1,
+                        p.x,
+                        p.y,
+                        p.z
+                    ),
+                );
+            }
+            if let Some(n) = nearest_obstacle(self.grid, arr(p), arr(p), HORIZON + self.unit_radius)
+            {
+                let c = n.distance - self.unit_radius;
+                if c < best.0 {
+                    let v = n.voxel;
+                    best = (
+                        c,
+                        format!(
+                            "unit {} near the voxel at ({:.2}, {:.2}, {:.2})",
+                            i + 1,
+                            v[0],
+                            v[1],
+                            v[2]
+                        ),
+                    );
+                }
+            }
+        }
+        for (k, w) in units.windows(2).enumerate() {
+            if let Some(n) = nearest_obstacle(
+                self.grid,
+                arr(&w[0]),
+                arr(&w[1]),
+                HORIZON + self.link_radius,
+            ) {
+                let c = n.distance - self.link_radius;
+                if c < best.0 {
+                    let v = n.voxel;
+                    best = (
+                        c,
+                        format!(
+                            "link {} near the voxel at ({:.2}, {:.2}, {:.2})",
+                            k + 1,
+                            v[0],
+                            v[1],
+                            v[2]
+                        ),
+                    );
+                }
+            }
+        }
+        best
+    }
+
+    fn check_spacing(&self) -> f64 {
+        // ARC-MODEL.md's edge sampling rule: no body point moves more than r_v / 4.
+        self.grid.resolution() / 4.0
+    }
+}
+
+/// Obstacles seen from above for pictures: every column of voxels with an obstacle
+/// between heights `z_lo` and `z_hi` (m), merged into runs along x, as
+/// `[x0, y0, x1, y1]` rectangles.
+pub fn footprint(grid: &Grid, z_lo: f64, z_hi: f64) -> Vec<super::plot::Footprint> {
+    let r = grid.resolution();
+    let o = grid.origin();
+    let d = grid.dims();
+    let k0 = ((z_lo / r).floor() as i64).max(o[2] as i64);
+    let k1 = ((z_hi / r).floor() as i64).min(o[2] as i64 + d[2] as i64 - 1);
+    let mut out = Vec::new();
+    if k0 > k1 {
+        return out;
+    }
+    for j in o[1]..o[1] + d[1] as i32 {
+        let mut run: Option<i32> = None;
+        for i in o[0]..=o[0] + d[0] as i32 {
+            let occupied =
+                i < o[0] + d[0] as i32 && (k0..=k1).any(|k| grid.is_obstacle([i, j, k as i32]));
+            match (occupied, run) {
+                (true, None) => run = Some(i),
+                (false, Some(s)) => {
+                    out.push([s as f64 * r, j as f64 * r, i as f64 * r, (j + 1) as f64 * r]);
+                    run = None;
+                }
+                _ => {}
+            }
+        }
+    }
+    out
+}
