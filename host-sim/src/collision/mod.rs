@@ -309,21 +309,28 @@ impl CollisionContext {
     /// and `p` is inside the map's bounds. Conservative.
     pub fn is_head_free(&self, p: [f64; 3]) -> bool {
         self.counters.head_points.fetch_add(1, Ordering::Relaxed);
-        self.field.grid().in_bounds(p) && self.bound(p, self.unit_r) > self.unit_r
+        self.inside(p) && self.bound(p, self.unit_r) > self.unit_r
     }
 
     /// Whether the head's unit sphere can move along the straight segment `a b` (both
     /// ends inside the bounds, the swept sphere free). Conservative.
     pub fn is_head_segment_free(&self, a: [f64; 3], b: [f64; 3]) -> bool {
         self.counters.head_segments.fetch_add(1, Ordering::Relaxed);
-        let g = self.field.grid();
-        if !(g.in_bounds(a) && g.in_bounds(b)) {
+        if !(self.inside(a) && self.inside(b)) {
             return false;
         }
         let (ca, cb) = (self.bound(a, self.unit_r), self.bound(b, self.unit_r));
         ca > self.unit_r
             && cb > self.unit_r
             && self.segment_free(a, b, self.unit_r, ca, cb).is_none()
+    }
+
+    /// Whether `p` is inside the map's bounds by at least [`FK_TOLERANCE`] (so that the
+    /// exact `f64` kinematics agree).
+    #[inline]
+    fn inside(&self, p: [f64; 3]) -> bool {
+        let (lo, hi) = self.field.grid().bounds();
+        (0..3).all(|a| p[a] >= lo[a] + FK_TOLERANCE && p[a] <= hi[a] - FK_TOLERANCE)
     }
 
     /// Unit centres for `head` and `shape`.
@@ -377,10 +384,9 @@ impl CollisionContext {
     fn placement(&self, head: [f64; 3], shape: &Shape) -> Result<(), Collision> {
         let n = shape.units();
         let p = self.points(head, shape);
-        let g = self.field.grid();
         let mut c = [0.0f64; MAX_UNITS];
         for i in 0..n {
-            if !g.in_bounds(p[i]) {
+            if !self.inside(p[i]) {
                 return Err(Collision::OutOfBounds {
                     body: Body::Unit(i as u8),
                     point: p[i],
@@ -499,7 +505,6 @@ impl CollisionContext {
         }
         shape_validity(&self.params, shape).map_err(|v| at0(Collision::Shape(v)))?;
         let n = shape.units();
-        let g = self.field.grid();
         let p0 = self.points(from, shape);
         let delta = sub(to, from);
         let dist = norm(delta);
@@ -507,7 +512,7 @@ impl CollisionContext {
             let off = sub(q, from);
             for (i, u) in p0.iter().enumerate().take(n) {
                 let w = add(*u, off);
-                if !g.in_bounds(w) {
+                if !self.inside(w) {
                     return Err(EdgeCollision {
                         t,
                         collision: Collision::OutOfBounds {
@@ -626,7 +631,7 @@ impl CollisionContext {
                     for a in 0..3 {
                         inside = inside.min(p[i][a] - lo[a]).min(hi[a] - p[i][a]);
                     }
-                    if inside < 0.0 {
+                    if inside < FK_TOLERANCE {
                         let collision = Collision::OutOfBounds {
                             body: Body::Unit(i as u8),
                             point: p[i],
