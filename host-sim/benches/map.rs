@@ -68,6 +68,20 @@ fn bench(c: &mut Criterion) {
             black_box(DistanceField::new(grid))
         })
     });
+    // The largest map the issue names: 100 m x 20 m x 5 m at 0.1 m (10 M voxels).
+    let mut big = Grid::new(0.1, [0, 0, 0], [1000, 200, 50], Cell::Free, true).unwrap();
+    for k in 0..50 {
+        let x = 1.0 + 2.0 * k as f64;
+        big.fill_box(
+            [x, 0.0, 0.0],
+            [x + 0.2, 15.0 - (k % 3) as f64 * 2.0, 5.0],
+            Cell::Occupied,
+        );
+    }
+    g.sample_size(10);
+    g.bench_function("field_100x20x5", |b| {
+        b.iter(|| black_box(DistanceField::new(big.clone())))
+    });
     g.finish();
 
     let field = Arc::new(DistanceField::new(grid));
