@@ -1,0 +1,162 @@
+//! End to end: the planner's plans for the built-in scenarios, flown by `arc sim`
+//! (multibody dynamics, head MPC, link SO(3) controllers, unit attitude loops) and
+//! checked for contact with the map by the exact checker.
+//!
+//! Bounds, and why:
+//! - the head never strays more than 0.05 m from its reference: that is the clearance
+//!   margin the planner keeps around every body (`collision::DEFAULT_CLEARANCE`), so a
+//!   flight within it cannot turn a planned clearance into a contact (measured: at most
+//!   0.017 m on every scenario, N = 4..6);
+//! - every link stays within 2 degrees of its planned direction (measured: below 1
+//!   degree); with 0.5 m links that moves a unit at most 1.7 cm per link;
+//! - the flown chain keeps a positive exact clearance and reaches the plan's goal.
+
+use std::path::Path;
+
+use arc_host_sim::cli;
+use arc_host_sim::collision::DEFAULT_CLEARANCE;
+
+fn arc(args: &[&str]) -> Result<(), cli::CliError> {
+    let mut v = vec!["arc"];
+    v.extend_from_slice(args);
+    cli::run(v)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+fn plan_and_fly(scenario: &str, units: u8) {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let plan = dir.path().join("plan.json");
+    let out = dir.path().join("sim.json");
+    let pic = dir.path().join("sim.svg");
+    let n = units.to_string();
+    arc(&[
+        "plan",
+        "--scenario",
+        scenario,
+        "--units",
+        &n,
+        "--out",
+        s(&plan),
+    ])
+    .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
+    arc(&[
+        "sim",
+        "--scenario",
+        scenario,
+        "--plan",
+        s(&plan),
+        "--out",
+        s(&out),
+        "--picture",
+        s(&pic),
+    ])
+    .unwrap_or_else(|e| panic!("{scenario} N={units}: arc sim failed: {e}"));
+    let text = std::fs::read_to_string(&out).expect("sim output");
+    let v: serde_json::Value = serde_json::from_str(&text).expect("sim output is JSON");
+    assert_eq!(v["format"], "arc-sim/1");
+    let r = &v["report"];
+    let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("report.{k}"));
+    eprintln!(
+        "{scenario} N={units}: flown {:.1} s, head max {:.4} m, link max {:.3} deg, clearance {:.3} m, {:.1}x real time",
+        f("simulated_time"),
+        f("head_max"),
+        f("link_max_deg"),
+        f("min_clearance"),
+        f("realtime_factor")
+    );
+    assert_eq!(r["reached_goal"], true);
+    assert_eq!(r["contact"], false);
+    assert_eq!(r["self_contact"], false);
+    assert_eq!(r["diverged"], false);
+    assert!(f("min_clearance") > 0.0);
+    assert!(
+        f("head_max") < DEFAULT_CLEARANCE,
+        "{scenario} N={units}: head strayed {} m",
+        f("head_max")
+    );
+    assert!(
+        f("link_max_deg") < 2.0,
+        "{scenario} N={units}: a link strayed {} deg",
+        f("link_max_deg")
+    );
+    assert_eq!(r["mpc_failures"], 0);
+    let svg = std::fs::read_to_string(&pic).expect("picture");
+    assert!(svg.starts_with("<svg") && svg.contains("flown chain"));
+}
+
+#[test]
+fn window_n4() {
+    plan_and_fly("window", 4);
+}
+
+#[test]
+fn window_n6() {
+    plan_and_fly("window", 6);
+}
+
+#[test]
+fn maze_n5() {
+    plan_and_fly("maze", 5);
+}
+
+#[test]
+fn silos_n4() {
+    plan_and_fly("silos", 4);
+}
+
+#[test]
+fn silos_n6() {
+    plan_and_fly("silos", 6);
+}
+
+#[test]
+fn bad_plans_are_input_errors() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, "{\"format\": \"nope\"}").unwrap();
+    let e = arc(&["sim", "--scenario", "window", "--plan", s(&bad)]).unwrap_err();
+    assert_eq!(e.code, 2, "{}", e.message);
+    let e = arc(&[
+        "sim",
+        "--scenario",
+        "window",
+        "--plan",
+        s(&dir.path().join("missing.json")),
+    ])
+    .unwrap_err();
+    assert_eq!(e.code, 2);
+    let e = arc(&["sim", "--scenario", "nowhere", "--plan", s(&bad)]).unwrap_err();
+    assert_eq!(e.code, 2);
+}
+
+#[test]
+fn a_plan_into_a_wall_fails_with_exit_1() {
+    // A straight translation of the window scenario's start chain into the wall.
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let sc = arc_host_sim::map::scenarios::build("window").unwrap();
+    let params = arc_core::ChainParams::new(4);
+    let shape = sc.start_shape(4).unwrap();
+    let start = sc.start;
+    let goal = [sc.goal[0], start[1], start[2]];
+    let plan = arc_host_sim::plan::Plan {
+        format: arc_host_sim::plan::FORMAT.into(),
+        chain: arc_host_sim::plan::ChainSection::from_params(&params),
+        map: arc_host_sim::plan::MapSection {
+            resolution: sc.grid.resolution(),
+            unknown_is_occupied: true,
+        },
+        waypoints: vec![
+            arc_host_sim::plan::Waypoint::new(start, &shape),
+            arc_host_sim::plan::Waypoint::new(goal, &shape),
+        ],
+        stats: Default::default(),
+    };
+    let path = dir.path().join("wall.json");
+    plan.write(&path).unwrap();
+    let e = arc(&["sim", "--scenario", "window", "--plan", s(&path)]).unwrap_err();
+    assert_eq!(e.code, 1, "{}", e.message);
+    assert!(e.message.contains("touched"), "{}", e.message);
+}
