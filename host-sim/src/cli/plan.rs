@@ -69,9 +69,15 @@ pub struct PlanArgs {
     /// Clearance margin added to every body's radius (m): plans keep this far from walls.
     #[arg(long, default_value_t = DEFAULT_CLEARANCE)]
     clearance: f64,
-    /// Head edges the planner may drop before it gives up.
+    /// Head edges the planner may drop per roadmap before it grows the roadmap.
     #[arg(long, default_value_t = 200)]
     max_replans: usize,
+    /// How strongly head paths keep away from obstacles (0: shortest, as in the paper).
+    #[arg(long, default_value_t = 2.0)]
+    clearance_weight: f64,
+    /// Times a failing query may double the head roadmap and try again.
+    #[arg(long, default_value_t = 3)]
+    max_growth: usize,
     /// Give up after this many seconds.
     #[arg(long)]
     time_limit: Option<f64>,
@@ -88,6 +94,12 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
     let bad = |flag: &str, v: String, want: &str| {
         Err(CliError::input(format!("{flag} {v}: must be {want}")))
     };
+    if a.max_growth > 8 {
+        return bad("--max-growth", a.max_growth.to_string(), "at most 8 (256 times the vertices)");
+    }
+    if !(a.clearance_weight.is_finite() && a.clearance_weight >= 0.0) {
+        return bad("--clearance-weight", a.clearance_weight.to_string(), "a number >= 0");
+    }
     if a.vertices == 0 {
         return bad("--vertices", a.vertices.to_string(), "at least 1");
     }
@@ -209,6 +221,8 @@ pub fn run(a: PlanArgs) -> CliResult {
         prefer: a.prefer,
         seed: a.seed,
         max_replans: a.max_replans,
+        max_growth: a.max_growth,
+        clearance_weight: a.clearance_weight,
         goal_tol: a.goal_tol,
     };
     let mut planner =

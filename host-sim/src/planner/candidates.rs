@@ -18,6 +18,8 @@ pub enum Source {
     Lsc(LscKind),
     /// A random shape, by index in the SRS.
     Srs(u16),
+    /// A random shape turned about the head so that it trails behind the edge.
+    SrsTurned(u16),
 }
 
 /// A shape with its origin.

@@ -68,8 +68,13 @@ pub struct Settings {
     pub prefer: Preference,
     /// Seed of the roadmap sampler.
     pub seed: u64,
-    /// Replans (dropped head edges) allowed before giving up.
+    /// Replans (dropped head edges) allowed per roadmap before growing it.
     pub max_replans: usize,
+    /// Times a failing query may double the roadmap and try again.
+    pub max_growth: usize,
+    /// How strongly head paths avoid passing close to obstacles (0: shortest paths,
+    /// as in the paper); see [`roadmap::Roadmap::build`].
+    pub clearance_weight: f64,
     /// Goal tolerance for the head (m).
     pub goal_tol: f64,
 }
@@ -85,6 +90,8 @@ impl Default for Settings {
             prefer: Preference::Least,
             seed: 1,
             max_replans: 200,
+            max_growth: 3,
+            clearance_weight: 2.0,
             goal_tol: 0.3,
         }
     }
@@ -131,8 +138,10 @@ pub struct Stats {
     pub srs_uses: usize,
     /// SRSConnect calls.
     pub srs_connects: usize,
-    /// Head edges dropped and routes asked again.
+    /// Head edges dropped and routes asked again (in the final roadmap).
     pub replans: usize,
+    /// Times the roadmap was doubled during the query.
+    pub roadmap_growths: usize,
     /// Full-chain collision checks (configurations, translations, shape changes).
     pub collision_checks: u64,
     /// Roadmap vertices and candidate edges.
@@ -225,6 +234,8 @@ impl Checker<'_> {
 pub struct Planner {
     ctx: CollisionContext,
     tables: ShapeTables,
+    /// Per SRS shape: the yaw from the head to the centroid of its units.
+    trail_yaw: Vec<f32>,
     settings: Settings,
     roadmap: Option<Roadmap>,
     roadmap_s: f64,
@@ -243,28 +254,25 @@ impl Planner {
                 chain: ctx.params().units,
             });
         }
-        Ok(Self {
-            ctx,
-            tables,
-            settings,
-            roadmap: None,
-            roadmap_s: 0.0,
-        })
+        let trail_yaw = tables.srs.iter().map(|s| trail_yaw(&tables.params, s)).collect();
+        Ok(Self { ctx, tables, trail_yaw, settings, roadmap: None, roadmap_s: 0.0 })
     }
 
     /// Builds the head roadmap (once; later calls do nothing).
     pub fn setup(&mut self) {
         if self.roadmap.is_none() {
             let t = Instant::now();
-            let mut rng = Pcg64::seed_from_u64(self.settings.seed);
-            self.roadmap = Some(Roadmap::build(
-                &self.ctx,
-                self.settings.vertices,
-                self.settings.r_t,
-                &mut rng,
-            ));
+            self.build_roadmap(self.settings.vertices);
             self.roadmap_s = t.elapsed().as_secs_f64();
         }
+    }
+
+    /// (Re)builds the roadmap with `vertices` vertices. The sampler restarts from the
+    /// seed, so a larger roadmap holds every vertex of a smaller one.
+    fn build_roadmap(&mut self, vertices: usize) {
+        let mut rng = Pcg64::seed_from_u64(self.settings.seed);
+        let weight = (self.settings.clearance_weight, self.ctx.params().reach() as f64 / 2.0);
+        self.roadmap = Some(Roadmap::build(&self.ctx, vertices, self.settings.r_t, weight, &mut rng));
     }
 
     /// Forgets the roadmap.
@@ -305,13 +313,27 @@ impl Planner {
             };
             return Err(PlanError::GoalInvalid(why));
         }
-        let mut roadmap = self.roadmap.take().expect("setup built the roadmap");
-        let result =
-            Construction::new(self, &mut roadmap, start, start_shape, goal, stop, began).run();
-        roadmap.clear_query();
-        let size = (roadmap.vertex_count(), roadmap.edge_count());
-        self.roadmap = Some(roadmap);
-        let (steps, mut stats) = result?;
+        // Like OMPL's PRM, grow the roadmap while the query fails and time remains.
+        let mut growths = 0;
+        let (steps, mut stats, size) = loop {
+            let mut roadmap = self.roadmap.take().expect("setup built the roadmap");
+            let result = Construction::new(self, &mut roadmap, start, start_shape, goal, stop, began).run();
+            roadmap.clear_query();
+            let size = (roadmap.vertex_count(), roadmap.edge_count());
+            self.roadmap = Some(roadmap);
+            match result {
+                Ok((steps, stats)) => break (steps, stats, size),
+                Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
+                    if growths < self.settings.max_growth
+                        && !stop.time_limit.is_some_and(|t| began.elapsed() > t) =>
+                {
+                    growths += 1;
+                    self.build_roadmap(self.settings.vertices << growths);
+                }
+                Err(e) => return Err(e),
+            }
+        };
+        stats.roadmap_growths = growths;
         let after = self.ctx.stats();
         stats.collision_checks = (after.configs + after.translations + after.shape_changes)
             - (checks_before.configs + checks_before.translations + checks_before.shape_changes);
@@ -321,6 +343,16 @@ impl Planner {
         Ok(Solution { steps, stats })
     }
 }
+
+/// Yaw of the direction from the head to the centroid of the units of `shape`.
+fn trail_yaw(params: &arc_core::ChainParams, shape: &Shape) -> f32 {
+    let p = arc_core::kinematics::offsets(params, shape);
+    let c = p.iter().take(shape.units()).fold(nalgebra::Vector3::zeros(), |a, q| a + q);
+    c.y.atan2(c.x)
+}
+
+/// Edges that may fail from one vertex before the chain backs up from it.
+const FAILS_BEFORE_BACKING_UP: usize = 4;
 
 /// One query's online construction (Alg. 4).
 struct Construction<'p> {
@@ -397,42 +429,53 @@ impl<'p> Construction<'p> {
     fn run(mut self) -> Result<(Vec<Step>, Stats), PlanError> {
         let mut path = self.route(self.start)?;
         let mut i = 0;
+        // Where the chain has been: vertex, its shape there, steps up to arriving.
+        let mut trail = vec![(self.start, self.current, self.steps.len())];
+        // Edges that failed from each vertex, in this query.
+        let mut fails = vec![0usize; self.roadmap.len()];
         while i + 1 < path.len() {
-            if self
-                .stop
-                .time_limit
-                .is_some_and(|t| self.began.elapsed() > t)
-            {
-                return Err(PlanError::TimeLimit {
-                    replans: self.stats.replans,
-                });
+            if self.stop.time_limit.is_some_and(|t| self.began.elapsed() > t) {
+                return Err(PlanError::TimeLimit { replans: self.stats.replans });
             }
             let (v, u) = (path[i], path[i + 1]);
-            match self.connect(v, u) {
-                Some(changes) => {
-                    self.accept(v, u, changes);
-                    i += 1;
-                }
-                None => {
-                    self.banned.insert((v.min(u), v.max(u)));
-                    self.stats.replans += 1;
-                    let (from, to) = (self.roadmap.point(v), self.roadmap.point(u));
-                    if self.stats.replans > self.planner.settings.max_replans {
-                        return Err(PlanError::NoShape {
-                            from,
-                            to,
-                            replans: self.stats.replans,
-                        });
-                    }
-                    path = self.route(v).map_err(|_| PlanError::NoShape {
-                        from,
-                        to,
-                        replans: self.stats.replans,
-                    })?;
-                    i = 0;
-                }
+            if let Some(changes) = self.connect(v, u) {
+                self.accept(v, u, changes);
+                trail.push((u, self.current, self.steps.len()));
+                i += 1;
+                continue;
             }
+            // (e) drop the edge and ask for another head path from here. Where no
+            // path leaves this vertex, or edges keep failing from it (the chain's
+            // shape here is the trouble, not the edge), back up along the trail:
+            // flying an edge backwards with the same shape is as admissible as forwards.
+            let (from, to) = (self.roadmap.point(v), self.roadmap.point(u));
+            fails[v] += 1;
+            let mut bad = (v, u);
+            path = loop {
+                self.banned.insert((bad.0.min(bad.1), bad.0.max(bad.1)));
+                self.stats.replans += 1;
+                if self.stats.replans > self.planner.settings.max_replans {
+                    return Err(PlanError::NoShape { from, to, replans: self.stats.replans });
+                }
+                let here = trail.last().map(|t| t.0).unwrap_or(self.start);
+                let stuck = fails[here] >= FAILS_BEFORE_BACKING_UP && trail.len() > 1;
+                let route = if stuck { Err(PlanError::Unreachable { tol: 0.0 }) } else { self.route(here) };
+                match route {
+                    Ok(p) => break p,
+                    Err(_) if trail.len() > 1 => {
+                        let (dead, _, _) = trail.pop().expect("trail has two entries");
+                        let (back, shape, len) = *trail.last().expect("trail has an entry");
+                        self.steps.truncate(len);
+                        self.current = shape;
+                        fails[back] += 1;
+                        bad = (back, dead);
+                    }
+                    Err(_) => return Err(PlanError::NoShape { from, to, replans: self.stats.replans }),
+                }
+            };
+            i = 0;
         }
+        self.count_steps();
         self.stats.collision_s = self.checker.time.as_secs_f64();
         Ok((self.steps, self.stats))
     }
@@ -441,29 +484,28 @@ impl<'p> Construction<'p> {
     fn accept(&mut self, v: VertexId, u: VertexId, changes: Vec<Candidate>) {
         let xi = self.roadmap.point(v);
         for c in changes {
-            match c.source {
-                Source::Rotation => self.stats.rotations += 1,
-                Source::Lsc(_) => self.stats.lsc_uses += 1,
-                Source::Srs(_) => self.stats.srs_uses += 1,
-                Source::Start => {}
-            }
-            self.stats.shape_changes += 1;
-            self.steps.push(Step {
-                xi,
-                shape: c.shape,
-                source: c.source,
-                shape_change: true,
-            });
+            self.steps.push(Step { xi, shape: c.shape, source: c.source, shape_change: true });
             self.current = c;
         }
-        self.stats.edges += 1;
         let cur = self.current;
-        self.steps.push(Step {
-            xi: self.roadmap.point(u),
-            shape: cur.shape,
-            source: cur.source,
-            shape_change: false,
-        });
+        self.steps.push(Step { xi: self.roadmap.point(u), shape: cur.shape, source: cur.source, shape_change: false });
+    }
+
+    /// Counts of the final plan's steps (after any backing up).
+    fn count_steps(&mut self) {
+        for s in &self.steps[1..] {
+            if !s.shape_change {
+                self.stats.edges += 1;
+                continue;
+            }
+            self.stats.shape_changes += 1;
+            match s.source {
+                Source::Rotation => self.stats.rotations += 1,
+                Source::Lsc(_) => self.stats.lsc_uses += 1,
+                Source::Srs(_) | Source::SrsTurned(_) => self.stats.srs_uses += 1,
+                Source::Start => {}
+            }
+        }
     }
 
     /// The shape changes at `v` that let the chain fly `v -> u`, or None.
@@ -509,17 +551,14 @@ impl<'p> Construction<'p> {
             return None;
         }
         self.stats.srs_connects += 1;
-        let mut pool: Vec<Candidate> = self
-            .planner
-            .tables
-            .srs
-            .iter()
-            .enumerate()
-            .map(|(k, &shape)| Candidate {
-                shape,
-                source: Source::Srs(k as u16),
-            })
-            .collect();
+        let srs = &self.planner.tables.srs;
+        let mut pool: Vec<Candidate> = Vec::with_capacity(2 * srs.len() + lib.len());
+        for (k, &shape) in srs.iter().enumerate() {
+            pool.push(Candidate { shape, source: Source::Srs(k as u16) });
+            // The same shape turned so that its body trails straight behind the edge.
+            let turn = arc_core::angle::diff(self.planner.trail_yaw[k], edge_yaw + std::f32::consts::PI);
+            pool.push(Candidate { shape: shape.rotated(turn), source: Source::SrsTurned(k as u16) });
+        }
         pool.extend(lib);
         srs_connect::connect(
             &mut self.checker,

@@ -19,6 +19,7 @@ pub fn source_label(s: &Source, shape_change: bool) -> String {
         (Source::Rotation, true) => "rotation".into(),
         (Source::Lsc(k), true) => format!("LSC:{}", k.name()),
         (Source::Srs(i), true) => format!("SRS:{i}"),
+        (Source::SrsTurned(i), true) => format!("SRS:{i}:turned"),
     }
 }
 
@@ -39,6 +40,7 @@ pub fn to_plan(
         ("srs_uses", st.srs_uses as u64),
         ("srs_connects", st.srs_connects as u64),
         ("replans", st.replans as u64),
+        ("roadmap_growths", st.roadmap_growths as u64),
         ("collision_checks", st.collision_checks),
         ("roadmap_vertices", st.roadmap_vertices as u64),
         ("roadmap_edges", st.roadmap_edges as u64),

@@ -41,6 +41,12 @@ struct Edge {
 #[derive(Debug)]
 pub struct Roadmap {
     points: Vec<[f64; 3]>,
+    /// Proven obstacle clearance at each vertex (m).
+    clearance: Vec<f64>,
+    /// Edge weight factor: see [`Roadmap::build`].
+    clearance_weight: f64,
+    /// Clearance at which the weight factor vanishes (m).
+    clearance_ref: f64,
     edges: Vec<Vec<Edge>>,
     tree: ImmutableKdTree<f64, 3>,
     r_t: f64,
@@ -63,7 +69,20 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 impl Roadmap {
     /// Samples `vertices` free head positions (at most `vertices * 200` tries) and
     /// joins each to every other within `r_t`.
-    pub fn build(ctx: &CollisionContext, vertices: usize, r_t: f64, rng: &mut Pcg64) -> Self {
+    ///
+    /// Edges weigh their length times `1 + w * max(0, 1 - c / c_ref)`, where `c` is
+    /// the smaller obstacle clearance of their ends, `w` = `clearance_weight` and
+    /// `c_ref` = `clearance_ref`: head paths keep to the middle of gaps and rooms,
+    /// where the chain behind the head has room. With `w = 0` paths are the
+    /// shortest, as in the paper. Weights are never below the length, so the
+    /// Euclidean A* heuristic stays admissible.
+    pub fn build(
+        ctx: &CollisionContext,
+        vertices: usize,
+        r_t: f64,
+        (clearance_weight, clearance_ref): (f64, f64),
+        rng: &mut Pcg64,
+    ) -> Self {
         let (lo, hi) = ctx.field().grid().bounds();
         let mut points = Vec::with_capacity(vertices);
         let mut tries = 0usize;
@@ -96,13 +115,33 @@ impl Roadmap {
             }
         }
         let sampled = points.len();
-        Self {
-            points,
-            edges,
-            tree,
-            r_t,
-            sampled,
+        let clearance = points.iter().map(|&p| ctx.clearance(p)).collect();
+        let mut map = Self { points, clearance, clearance_weight, clearance_ref, edges, tree, r_t, sampled };
+        map.weigh_edges(0);
+        map
+    }
+
+    /// Applies the clearance factor to the edges of vertices `from..`.
+    fn weigh_edges(&mut self, from: VertexId) {
+        let (w, r) = (self.clearance_weight, self.clearance_ref.max(1e-9));
+        for v in from..self.points.len() {
+            for k in 0..self.edges[v].len() {
+                let u = self.edges[v][k].to;
+                let c = self.clearance[v].min(self.clearance[u]);
+                let f = 1.0 + w * (1.0 - c / r).max(0.0);
+                let e = &mut self.edges[v][k];
+                e.length = dist(self.points[v], self.points[u]) * f;
+                // Keep both directions equal.
+                if let Some(back) = self.edges[u].iter_mut().find(|x| x.to == v) {
+                    back.length = dist(self.points[v], self.points[u]) * f;
+                }
+            }
         }
+    }
+
+    /// Number of vertices, query vertices included.
+    pub fn len(&self) -> usize {
+        self.points.len()
     }
 
     /// Number of sampled vertices.
@@ -130,6 +169,7 @@ impl Roadmap {
     pub fn add_query_vertex(&mut self, p: [f64; 3]) -> VertexId {
         let id = self.points.len();
         self.points.push(p);
+        self.clearance.push(f64::INFINITY);
         self.edges.push(Vec::new());
         let mut near = self
             .tree
@@ -172,6 +212,7 @@ impl Roadmap {
     /// known about its edges stay.
     pub fn clear_query(&mut self) {
         self.points.truncate(self.sampled);
+        self.clearance.truncate(self.sampled);
         self.edges.truncate(self.sampled);
         let n = self.sampled;
         for e in self.edges.iter_mut() {

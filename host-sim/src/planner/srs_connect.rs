@@ -8,7 +8,8 @@
 //!    random shapes are joined when `G_SRS` joins them (within `r_S`, and known
 //!    offline to change into each other without self-collision); the current shape
 //!    and the library shapes are joined to every valid shape within `d_c` in the
-//!    `C_T` metric. Neighbour lists are made when a vertex is first expanded, so
+//!    `C_T` metric; a random shape turned to trail behind the edge is joined to
+//!    its unturned self and to those. Neighbour lists are made when a vertex is first expanded, so
 //!    the parts of `G_Val` the search never reaches cost nothing;
 //! 4. OptAdmissibleTransition: Dijkstra by `C_T` from the current shape to the
 //!    nearest admissible one;
@@ -24,8 +25,38 @@ use arc_core::cost::transition_cost;
 use super::candidates::{Candidate, Source};
 use super::Checker;
 
+/// Lazy answers to "is shape `v` valid at `xi_i`" and "is it admissible along the
+/// edge": each asked at most once, and only for shapes the search reaches.
+struct Oracle<'c, 'p> {
+    checker: &'c mut Checker<'p>,
+    from: [f64; 3],
+    to: [f64; 3],
+    valid: Vec<Option<bool>>,
+    admissible: Vec<Option<bool>>,
+}
+
+impl Oracle<'_, '_> {
+    fn valid(&mut self, v: usize, nodes: &[Candidate]) -> bool {
+        if self.valid[v].is_none() {
+            self.valid[v] = Some(self.checker.placement(self.from, &nodes[v].shape));
+        }
+        self.valid[v] == Some(true)
+    }
+
+    fn admissible(&mut self, v: usize, nodes: &[Candidate]) -> bool {
+        if self.admissible[v].is_none() {
+            self.admissible[v] = Some(self.checker.translation(self.from, self.to, &nodes[v].shape));
+        }
+        self.admissible[v] == Some(true)
+    }
+}
+
 /// What SRSConnect found: the shapes to pass through at `xi_i` (the last one
 /// admissible along the edge), or nothing.
+///
+/// ValidShapes and AdmissibleShapes are evaluated lazily inside the search: a shape's
+/// placement is checked when the search first reaches it, its admissibility when
+/// it is the nearest open shape. The answer is the one the eager sets would give.
 pub fn connect(
     checker: &mut Checker<'_>,
     from: [f64; 3],
@@ -35,37 +66,25 @@ pub fn connect(
     srs_adjacency: &[Vec<u16>],
     d_c: f32,
 ) -> Option<Vec<Candidate>> {
-    // 1-2. Valid and admissible shapes; vertex 0 of G_Val is the current shape.
+    // Vertex 0 of G_Val is the current shape: valid here, not admissible (else
+    // the edge would not have come to SRSConnect).
     let mut nodes = vec![*current];
-    let mut admissible = vec![false];
-    for c in pool {
-        if checker.placement(from, &c.shape) {
-            nodes.push(*c);
-            admissible.push(false);
-        }
-    }
-    let mut any = false;
-    for (i, c) in nodes.iter().enumerate().skip(1) {
-        if checker.translation(from, to, &c.shape) {
-            admissible[i] = true;
-            any = true;
-        }
-    }
-    if !any {
-        return None;
-    }
-    // 3-5. Cheapest transition to an admissible shape, pruning failed edges.
+    nodes.extend_from_slice(pool);
+    let n = nodes.len();
+    let mut oracle = Oracle { checker, from, to, valid: vec![None; n], admissible: vec![None; n] };
+    oracle.valid[0] = Some(true);
+    oracle.admissible[0] = Some(false);
     let mut graph = Graph::new(&nodes, srs_adjacency, d_c);
     let mut pruned: BTreeSet<(usize, usize)> = BTreeSet::new();
     let mut checked: BTreeMap<(usize, usize), bool> = BTreeMap::new();
     loop {
-        let path = cheapest(&mut graph, &admissible, &pruned)?;
+        let path = cheapest(&mut graph, &mut oracle, &pruned)?;
         let mut ok = true;
         for w in path.windows(2) {
             let key = (w[0].min(w[1]), w[0].max(w[1]));
-            let free = *checked.entry(key).or_insert_with(|| {
-                checker.shape_change(from, &nodes[w[0]].shape, &nodes[w[1]].shape)
-            });
+            let free = *checked
+                .entry(key)
+                .or_insert_with(|| oracle.checker.shape_change(from, &nodes[w[0]].shape, &nodes[w[1]].shape));
             if !free {
                 pruned.insert(key);
                 ok = false;
@@ -81,8 +100,9 @@ pub fn connect(
 /// `G_Val` with neighbour lists made on first use.
 struct Graph<'a> {
     nodes: &'a [Candidate],
-    /// Node index of each valid SRS shape (by SRS index).
+    /// Node index of each valid SRS shape (by SRS index), and of its turned copy.
     srs_node: Vec<Option<usize>>,
+    turned_node: Vec<Option<usize>>,
     srs_adjacency: &'a [Vec<u16>],
     /// The current shape and the library shapes: joined by `d_c`.
     hubs: Vec<usize>,
@@ -93,16 +113,19 @@ struct Graph<'a> {
 impl<'a> Graph<'a> {
     fn new(nodes: &'a [Candidate], srs_adjacency: &'a [Vec<u16>], d_c: f32) -> Self {
         let mut srs_node = vec![None; srs_adjacency.len()];
+        let mut turned_node = vec![None; srs_adjacency.len()];
         let mut hubs = Vec::new();
         for (i, c) in nodes.iter().enumerate() {
             match c.source {
                 Source::Srs(k) if i > 0 => srs_node[k as usize] = Some(i),
+                Source::SrsTurned(k) if i > 0 => turned_node[k as usize] = Some(i),
                 _ => hubs.push(i),
             }
         }
         Self {
             nodes,
             srs_node,
+            turned_node,
             srs_adjacency,
             hubs,
             d_c,
@@ -110,8 +133,12 @@ impl<'a> Graph<'a> {
         }
     }
 
+    fn cost(&self, v: usize, u: usize) -> f32 {
+        transition_cost(&self.nodes[v].shape, &self.nodes[u].shape)
+    }
+
     fn within(&self, v: usize, u: usize) -> Option<(usize, f32)> {
-        let c = transition_cost(&self.nodes[v].shape, &self.nodes[u].shape);
+        let c = self.cost(v, u);
         (u != v && c <= self.d_c).then_some((u, c))
     }
 
@@ -130,6 +157,13 @@ impl<'a> Graph<'a> {
                             )
                         })
                         .collect();
+                    l.extend(self.turned_node[k as usize].map(|u| (u, self.cost(v, u))));
+                    l.extend(self.hubs.iter().filter_map(|&u| self.within(v, u)));
+                    l
+                }
+                Source::SrsTurned(k) if v > 0 => {
+                    let mut l: Vec<(usize, f32)> =
+                        self.srs_node[k as usize].map(|u| (u, self.cost(v, u))).into_iter().collect();
                     l.extend(self.hubs.iter().filter_map(|&u| self.within(v, u)));
                     l
                 }
@@ -145,11 +179,7 @@ impl<'a> Graph<'a> {
 
 /// Dijkstra over `G_Val` (minus `pruned` edges) from vertex 0 to the nearest
 /// admissible vertex.
-fn cheapest(
-    graph: &mut Graph<'_>,
-    admissible: &[bool],
-    pruned: &BTreeSet<(usize, usize)>,
-) -> Option<Vec<usize>> {
+fn cheapest(graph: &mut Graph<'_>, oracle: &mut Oracle<'_, '_>, pruned: &BTreeSet<(usize, usize)>) -> Option<Vec<usize>> {
     let n = graph.nodes.len();
     let mut dist = vec![f32::INFINITY; n];
     let mut parent = vec![usize::MAX; n];
@@ -162,7 +192,7 @@ fn cheapest(
             continue;
         }
         done[v] = true;
-        if admissible[v] && v != 0 {
+        if v != 0 && oracle.admissible(v, graph.nodes) {
             let mut path = vec![v];
             while path[path.len() - 1] != 0 {
                 path.push(parent[path[path.len() - 1]]);
@@ -170,8 +200,9 @@ fn cheapest(
             path.reverse();
             return Some(path);
         }
+        let nodes = graph.nodes;
         for &(u, c) in graph.neighbours(v) {
-            if done[u] || pruned.contains(&(v.min(u), v.max(u))) {
+            if done[u] || pruned.contains(&(v.min(u), v.max(u))) || !oracle.valid(u, nodes) {
                 continue;
             }
             if d + c < dist[u] {

@@ -1,0 +1,211 @@
+//! End to end: `arc plan` on every built-in scenario, checked by the exact validity
+//! test of ARC-MODEL.md (`arc verify` and `verify_plan`), never by the planner's own
+//! conservative shortcuts; failures and bad input give the right exit codes.
+
+use std::path::{Path, PathBuf};
+
+use arc_host_sim::cli;
+use arc_host_sim::collision::verify_plan;
+use arc_host_sim::map::grid::{Cell, Grid};
+use arc_host_sim::map::scenarios;
+use arc_host_sim::plan::Plan;
+
+fn arc(args: &[&str]) -> Result<(), cli::CliError> {
+    let mut v = vec!["arc"];
+    v.extend_from_slice(args);
+    cli::run(v)
+}
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().expect("temporary directory")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+/// Plans `scenario` with `units`, verifies it exactly, returns the plan.
+fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
+    let out = dir.join(format!("{scenario}-{units}.json"));
+    let n = units.to_string();
+    arc(&["plan", "--scenario", scenario, "--units", &n, "--out", s(&out)])
+        .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
+    arc(&["verify", "--scenario", scenario, "--plan", s(&out)])
+        .unwrap_or_else(|e| panic!("{scenario} N={units}: arc verify: {e}"));
+    let plan = Plan::read(&out).expect("plan file reads back");
+    let sc = scenarios::build(scenario).expect("built-in scenario");
+    let report = verify_plan(&sc.grid, &plan);
+    assert!(report.ok, "{scenario} N={units}: {:?}", report.violation);
+    assert!(report.min_clearance > 0.0);
+    // Starts at the scenario's start, in the start shape; ends within 0.3 m of the goal.
+    let first = plan.waypoints[0].xi();
+    assert!((0..3).all(|k| (first[k] - sc.start[k]).abs() <= 1e-6));
+    let start_shape = sc.start_shape(units).expect("start shape");
+    for (a, b) in plan.waypoints[0].eta().iter().zip(start_shape.as_slice()) {
+        assert!((a - *b as f64).abs() < 1e-6, "start shape differs");
+    }
+    let last = plan.waypoints[plan.waypoints.len() - 1].xi();
+    let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
+    assert!(d <= 0.3 + 1e-9, "{scenario} N={units}: ends {d} m from the goal");
+    let changes = plan.stats["shape_changes"].as_u64().expect("shape_changes in stats");
+    eprintln!(
+        "{scenario} N={units}: {} waypoints, {changes} shape changes, min clearance {:.3} m",
+        plan.waypoints.len(),
+        report.min_clearance
+    );
+    assert!(changes > 0, "the scenarios are built so that the chain must change shape");
+    plan
+}
+
+#[test]
+fn window_plans_verify() {
+    let dir = tmp();
+    for n in [4, 5, 6] {
+        plan_and_verify("window", n, dir.path());
+    }
+}
+
+#[test]
+fn maze_plans_verify() {
+    let dir = tmp();
+    for n in [4, 5, 6] {
+        plan_and_verify("maze", n, dir.path());
+    }
+}
+
+#[test]
+fn silos_plans_verify() {
+    let dir = tmp();
+    for n in [4, 5, 6] {
+        plan_and_verify("silos", n, dir.path());
+    }
+}
+
+#[test]
+fn corridor_plans_verify() {
+    let dir = tmp();
+    for n in [4, 5, 6] {
+        plan_and_verify("corridor", n, dir.path());
+    }
+}
+
+#[test]
+fn same_seed_same_plan_byte_for_byte() {
+    let dir = tmp();
+    let run = |name: &str, seed: &str| -> String {
+        let out = dir.path().join(name);
+        arc(&["plan", "--scenario", "window", "--units", "5", "--seed", seed, "--out", s(&out)]).expect("plan");
+        let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        // Wall-clock timings are the one part that differs between runs.
+        v["stats"].as_object_mut().unwrap().remove("timing");
+        serde_json::to_string_pretty(&v).unwrap()
+    };
+    assert_eq!(run("a.json", "7"), run("b.json", "7"));
+    assert_ne!(run("c.json", "7"), run("d.json", "8"), "another seed, another roadmap");
+}
+
+/// A map of two sealed rooms: free inside, walls around and between.
+fn sealed_rooms(dir: &Path) -> PathBuf {
+    let mut g = Grid::new(0.1, [0, 0, 0], [80, 40, 30], Cell::Free, true).unwrap();
+    let wall = |g: &mut Grid, lo: [f64; 3], hi: [f64; 3]| g.fill_box(lo, hi, Cell::Occupied);
+    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 4.0, 0.2]);
+    wall(&mut g, [0.0, 0.0, 2.8], [8.0, 4.0, 3.0]);
+    wall(&mut g, [0.0, 0.0, 0.0], [0.2, 4.0, 3.0]);
+    wall(&mut g, [7.8, 0.0, 0.0], [8.0, 4.0, 3.0]);
+    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 0.2, 3.0]);
+    wall(&mut g, [0.0, 3.8, 0.0], [8.0, 4.0, 3.0]);
+    wall(&mut g, [3.9, 0.0, 0.0], [4.1, 4.0, 3.0]);
+    let path = dir.join("sealed.bt");
+    g.to_octree().unwrap().write_bt(&path).unwrap();
+    path
+}
+
+#[test]
+fn unreachable_goal_exits_1_with_the_reason() {
+    let dir = tmp();
+    let map = sealed_rooms(dir.path());
+    let out = dir.path().join("p.json");
+    let e = arc(&[
+        "plan", "--map", s(&map), "--units", "4", "--start", "3,2,1.5", "--start-yaw-deg", "0",
+        "--goal", "6,2,1.5", "--vertices", "300", "--max-growth", "1", "--out", s(&out),
+    ])
+    .unwrap_err();
+    assert_eq!(e.code, 1, "{e}");
+    assert!(e.message.contains("not reachable"), "{e}");
+    assert!(!out.exists(), "no plan file is written when there is no plan");
+}
+
+#[test]
+fn start_in_collision_names_the_body() {
+    let dir = tmp();
+    let out = dir.path().join("p.json");
+    // Window scenario: the dividing wall stands at x = 4.0..4.2; unit 3 lands in it.
+    let e = arc(&[
+        "plan", "--scenario", "window", "--units", "4", "--start", "5.1,1,1.5", "--start-yaw-deg", "0",
+        "--out", s(&out),
+    ])
+    .unwrap_err();
+    assert_eq!(e.code, 1, "{e}");
+    assert!(e.message.contains("start is invalid") && e.message.contains("unit"), "{e}");
+}
+
+#[test]
+fn malformed_input_exits_2() {
+    let dir = tmp();
+    let out = dir.path().join("p.json");
+    let o = s(&out);
+    let garbage = dir.path().join("garbage.bt");
+    std::fs::write(&garbage, b"# Octomap OcTree binary file\nid OcTree\nsize 99\nres 0.1\ndata\n\x03").unwrap();
+    let cases: Vec<Vec<&str>> = vec![
+        vec!["plan", "--scenario", "window", "--out"],
+        vec!["plan", "--scenario", "window", "--start", "1,2", "--out", o],
+        vec!["plan", "--scenario", "window", "--units", "40", "--out", o],
+        vec!["plan", "--scenario", "nowhere", "--out", o],
+        vec!["plan", "--map", "/no/such/map.bt", "--units", "4", "--start", "1,1,1", "--goal", "2,2,2", "--out", o],
+        vec!["plan", "--map", s(&garbage), "--units", "4", "--start", "1,1,1", "--goal", "2,2,2", "--out", o],
+        vec!["plan", "--scenario", "window", "--vertices", "0", "--out", o],
+        vec!["plan", "--scenario", "window", "--start-shape", "XX", "--out", o],
+        vec!["plan", "--scenario", "window", "--tables", s(&garbage), "--out", o],
+        vec!["verify", "--scenario", "window", "--plan", s(&garbage)],
+        vec!["tables", "inspect", s(&garbage)],
+        vec!["frobnicate"],
+    ];
+    for c in cases {
+        let e = arc(&c).expect_err(&format!("{c:?} must fail"));
+        assert_eq!(e.code, 2, "{c:?}: {e}");
+        assert!(!e.message.is_empty(), "{c:?}: an error names the problem");
+    }
+}
+
+#[test]
+fn a_tampered_plan_fails_verification() {
+    let dir = tmp();
+    let plan = plan_and_verify("window", 4, dir.path());
+    // Push one waypoint's head into the dividing wall.
+    let mut bad = plan.clone();
+    let k = bad.waypoints.len() / 2;
+    bad.waypoints[k].zeta[0] = 4.1;
+    bad.waypoints[k].zeta[1] = 1.0;
+    let path = dir.path().join("bad.json");
+    bad.write(&path).unwrap();
+    let e = arc(&["verify", "--scenario", "window", "--plan", s(&path)]).unwrap_err();
+    assert_eq!(e.code, 1, "{e}");
+    assert!(e.message.contains("INVALID"), "{e}");
+}
+
+#[test]
+fn plans_from_a_table_file_match_generated_tables() {
+    let dir = tmp();
+    let table = dir.path().join("t5.arct");
+    arc(&["tables", "build", "--units", "5", "--srs", "500", "--seed", "1", "--out", s(&table)]).unwrap();
+    arc(&["tables", "inspect", s(&table)]).unwrap();
+    let (a, b) = (dir.path().join("a.json"), dir.path().join("b.json"));
+    arc(&["plan", "--scenario", "maze", "--units", "5", "--out", s(&a)]).unwrap();
+    arc(&["plan", "--scenario", "maze", "--units", "5", "--tables", s(&table), "--out", s(&b)]).unwrap();
+    let (pa, pb) = (Plan::read(&a).unwrap(), Plan::read(&b).unwrap());
+    assert_eq!(pa.waypoints, pb.waypoints, "the file holds the very shapes the generator makes");
+    // A table for another chain is refused.
+    let e = arc(&["plan", "--scenario", "maze", "--units", "6", "--tables", s(&table), "--out", s(&a)]).unwrap_err();
+    assert_eq!(e.code, 2);
+    assert!(e.message.contains("another chain"), "{e}");
+}
