@@ -169,13 +169,14 @@ fn time_limit_caps_build_and_query() {
         ctx,
         PrmSettings {
             vertices: 1_000_000,
+            k: Some(2),
             ..Default::default()
         },
     )
     .unwrap();
     let shape = sc.start_shape(5).unwrap();
     let stop = Termination {
-        time_limit: Some(Duration::from_millis(200)),
+        time_limit: Some(Duration::from_millis(100)),
     };
     let t = std::time::Instant::now();
     let r = prm.solve(sc.start, shape, sc.goal, stop);

@@ -1,1 +1,991 @@
-//! Benchmark runs (placeholder while it is written).
+//! Benchmark runs: the paper's evaluation (Tables 1-3) and scaling studies, as
+//! independent seeded runs spread over all cores.
+//!
+//! A run ([`RunSpec`]) is one planner on one query: the ARCplanner in one of its modes
+//! ([`Method::Arc`]) or the full-state PRM baseline ([`Method::FullPrm`],
+//! [`crate::baseline`]), on a built-in scenario, for one chain size, budget and seed.
+//! Every run builds its own collision context (its own counters), its own shape tables
+//! (SRS seeded with the run's seed) and its own roadmap (seeded with the run's seed),
+//! so a run's outcome depends on its spec alone: [`run_all`] may spread runs over any
+//! number of threads and returns the same results in the same order, timings aside
+//! (and unless a run is cut by its time limit, which depends on the machine's speed).
+//! Successful plans are checked with the exact verifier
+//! ([`crate::collision::verify_plan`]).
+//!
+//! Times are wall-clock per run. With several runs in parallel on a loaded machine they
+//! include some contention; both planners of a study run in the same batch, so their
+//! ratio is fair.
+
+pub mod paper;
+pub mod plot;
+pub mod scale;
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::io::IsTerminal;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use arc_core::lsc::library;
+use arc_core::{ChainParams, Shape};
+use rayon::prelude::*;
+
+use crate::baseline::{self, FullStatePrm, PrmError, PrmSettings};
+use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
+use crate::map::distance::DistanceField;
+use crate::map::scenarios::{self, Scenario};
+use crate::planner::{motion, Mode, PlanError, Planner, Settings, Termination};
+use crate::tables::{ShapeTables, TableSettings};
+
+/// Which planner a run uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Method {
+    /// The ARCplanner with these shape sources.
+    Arc(ArcMode),
+    /// The full-state lazy PRM.
+    FullPrm,
+}
+
+/// The ARCplanner's shape sources (the paper's ablation), orderable for grouping.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ArcMode {
+    /// Library shapes only ("LSC").
+    Lsc,
+    /// Random shapes only ("SRS").
+    Srs,
+    /// Both ("Both", the full ARCplanner).
+    Both,
+}
+
+impl ArcMode {
+    /// The planner's mode.
+    pub fn mode(self) -> Mode {
+        match self {
+            ArcMode::Lsc => Mode::Lsc,
+            ArcMode::Srs => Mode::Srs,
+            ArcMode::Both => Mode::Both,
+        }
+    }
+}
+
+impl Method {
+    /// Short label: `ARC-lsc`, `ARC-srs`, `ARC-both`, `PRM`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Method::Arc(ArcMode::Lsc) => "ARC-lsc",
+            Method::Arc(ArcMode::Srs) => "ARC-srs",
+            Method::Arc(ArcMode::Both) => "ARC-both",
+            Method::FullPrm => "PRM",
+        }
+    }
+}
+
+/// Start and goal of a query.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Query {
+    /// Head start position (m).
+    pub start: [f64; 3],
+    /// Start shape.
+    pub shape: Shape,
+    /// Head goal (m).
+    pub goal: [f64; 3],
+}
+
+/// One benchmark run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunSpec {
+    /// Which study it belongs to (`table1`, `scale-units`, ...).
+    pub study: String,
+    /// Built-in scenario name.
+    pub scenario: String,
+    /// Chain size N.
+    pub units: u8,
+    /// Planner.
+    pub method: Method,
+    /// Roadmap vertices: `M_VT` for the ARCplanner, `M_F` for the PRM.
+    pub vertices: usize,
+    /// Random shapes `N_SRS` (ARCplanner; 0 for LSC only).
+    pub srs: usize,
+    /// Seed of the roadmap (and of the SRS).
+    pub seed: u64,
+    /// Time limit of the query, and of the PRM's roadmap build (s).
+    pub time_limit: Option<f64>,
+    /// Start and goal; `None`: the scenario's own (LI at its start yaw).
+    pub query: Option<Query>,
+}
+
+/// What a run gave.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunResult {
+    /// The run.
+    pub spec: RunSpec,
+    /// Whether a plan was found.
+    pub success: bool,
+    /// `solved`, `time_limit`, `no_shape`, `unreachable`, `no_path`, `start_invalid`,
+    /// `goal_invalid`, `error`.
+    pub outcome: String,
+    /// The planner's message when it failed.
+    pub message: String,
+    /// Shape tables build (offline, not part of `t_G`) (s).
+    pub tables_s: f64,
+    /// Roadmap build `t_G` (s).
+    pub roadmap_s: f64,
+    /// Query `t_P` (s).
+    pub planning_s: f64,
+    /// CPU time of the roadmap build on its thread (s; Linux, `None` elsewhere).
+    pub roadmap_cpu_s: Option<f64>,
+    /// CPU time of the query on its thread (s; Linux, `None` elsewhere).
+    pub planning_cpu_s: Option<f64>,
+    /// Of the query, full-chain collision checks (s; successful runs).
+    pub collision_s: Option<f64>,
+    /// Of the query, the rest: shape search, head routing, lazy search (s; successful runs).
+    pub search_s: Option<f64>,
+    /// Shape changes of the plan.
+    pub shape_changes: Option<usize>,
+    /// Edges of the plan (head edges, or PRM roadmap edges).
+    pub edges: Option<usize>,
+    /// Head edges dropped and rerouted (ARCplanner).
+    pub replans: Option<usize>,
+    /// SRSConnect calls (ARCplanner).
+    pub srs_connects: Option<usize>,
+    /// Lazy A* searches (PRM).
+    pub iterations: Option<usize>,
+    /// Full-chain collision checks in the query.
+    pub collision_checks: Option<u64>,
+    /// Roadmap vertices actually built.
+    pub roadmap_vertices: usize,
+    /// Whether the PRM's roadmap build was cut by the time limit.
+    pub build_capped: bool,
+    /// Plan waypoints.
+    pub waypoints: Option<usize>,
+    /// Exact verification of the plan (`None` without a plan).
+    pub verified: Option<bool>,
+}
+
+impl RunResult {
+    fn failed(spec: &RunSpec, outcome: &str, message: String) -> Self {
+        Self {
+            spec: spec.clone(),
+            success: false,
+            outcome: outcome.into(),
+            message,
+            tables_s: 0.0,
+            roadmap_s: 0.0,
+            planning_s: 0.0,
+            roadmap_cpu_s: None,
+            planning_cpu_s: None,
+            collision_s: None,
+            search_s: None,
+            shape_changes: None,
+            edges: None,
+            replans: None,
+            srs_connects: None,
+            iterations: None,
+            collision_checks: None,
+            roadmap_vertices: 0,
+            build_capped: false,
+            waypoints: None,
+            verified: None,
+        }
+    }
+
+    /// Everything but the timings: equal for equal specs on any thread count (unless
+    /// the time limit cut a run).
+    pub fn fingerprint(&self) -> String {
+        format!(
+            "{:?}|{}|{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}|{}|{:?}|{:?}",
+            self.spec,
+            self.success,
+            self.outcome,
+            self.shape_changes,
+            self.edges,
+            self.replans,
+            self.srs_connects,
+            self.iterations,
+            self.collision_checks,
+            self.roadmap_vertices,
+            self.build_capped,
+            self.waypoints,
+            self.verified
+        )
+    }
+
+    /// Roadmap build plus query (s).
+    pub fn total_s(&self) -> f64 {
+        self.roadmap_s + self.planning_s
+    }
+
+    /// CPU time of roadmap build plus query (s), when measured.
+    pub fn total_cpu_s(&self) -> Option<f64> {
+        Some(self.roadmap_cpu_s? + self.planning_cpu_s?)
+    }
+}
+
+/// CPU time this thread has run so far (s), from `/proc/thread-self/schedstat` (Linux;
+/// `None` where that is unavailable). Unlike wall-clock time it leaves out the time a
+/// run waits for a core on a loaded machine.
+pub fn thread_cpu_s() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: u64 = s.split_whitespace().next()?.parse().ok()?;
+    Some(ns as f64 * 1e-9)
+}
+
+/// Wall-clock and CPU time of `f`.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
+    let c0 = thread_cpu_s();
+    let t = Instant::now();
+    let r = f();
+    let wall = t.elapsed().as_secs_f64();
+    let cpu = c0.and_then(|a| thread_cpu_s().map(|b| (b - a).max(0.0)));
+    (r, wall, cpu)
+}
+
+/// A scenario's map, ready for runs (shared read-only between threads).
+pub struct Env {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// Its distance field.
+    pub field: Arc<DistanceField>,
+}
+
+/// Prefix of the bench-only variant of `window` with a wider opening.
+pub const WIDE_WINDOW: &str = "window-wide:";
+
+/// A built-in scenario ([`scenarios::build`]), or the bench-only variant
+/// `window-wide:W`: `window` with its opening widened to `W` x `W` metres (`0.8..=2.4`,
+/// same centre), where a full-state PRM has a chance (see [`paper`]).
+pub fn build_scenario(name: &str) -> Result<Scenario, String> {
+    let Some(w) = name.strip_prefix(WIDE_WINDOW) else {
+        return scenarios::build(name);
+    };
+    let w: f64 = w
+        .parse()
+        .map_err(|_| format!("{name}: the opening {w:?} is not a number"))?;
+    if !(0.8..=2.4).contains(&w) {
+        return Err(format!("{name}: the opening must be 0.8 to 2.4 m"));
+    }
+    let mut sc = scenarios::window();
+    let (h, e) = (0.5 * w, 1e-6);
+    sc.grid.fill_box(
+        [4.0 + e, 3.0 - h + e, 1.5 - h + e],
+        [4.2 - e, 3.0 + h - e, 1.5 + h - e],
+        crate::map::grid::Cell::Free,
+    );
+    sc.name = name.to_string();
+    sc.description = format!(
+        "window with its opening widened from 0.8 m x 0.8 m to {w} m x {w} m (bench-only variant)"
+    );
+    Ok(sc)
+}
+
+/// Scenarios by name, each built once.
+pub struct Envs(BTreeMap<String, Env>);
+
+impl Envs {
+    /// Builds every scenario the specs name.
+    pub fn for_specs(specs: &[RunSpec]) -> Result<Self, String> {
+        let mut m = BTreeMap::new();
+        for s in specs {
+            if !m.contains_key(&s.scenario) {
+                let scenario = build_scenario(&s.scenario)?;
+                let field = Arc::new(DistanceField::new(scenario.grid.clone()));
+                m.insert(s.scenario.clone(), Env { scenario, field });
+            }
+        }
+        Ok(Self(m))
+    }
+
+    /// The environment of `name`, if built.
+    pub fn get(&self, name: &str) -> Option<&Env> {
+        self.0.get(name)
+    }
+}
+
+/// A collision context of its own (fresh counters) for a run.
+pub fn context(env: &Env, units: u8) -> Result<CollisionContext, String> {
+    let params = ChainParams::new(units)
+        .validate()
+        .map_err(|e| format!("N = {units}: {e}"))?;
+    CollisionContext::new(env.field.clone(), params, DEFAULT_CLEARANCE)
+}
+
+/// The scenario's own query for `units`: its start, LI at its start yaw, its goal.
+pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, String> {
+    Ok(Query {
+        start: sc.start,
+        shape: sc.start_shape(units)?,
+        goal: sc.goal,
+    })
+}
+
+/// A query for a chain that may not fit at the scenario's start as a straight line
+/// (long chains): the first of, in this order, the scenario's start with LI at its start
+/// yaw; the start with each library shape (LSC order: LI, SE, SM, SV, CA, PN) at the
+/// start yaw plus `j * 45` degrees, `j = 0..8`; the same at the lattice points (0.1 m,
+/// at the start's height) within 1.5 m of the start, nearest first; whose configuration
+/// is valid. The goal is the scenario's.
+pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, String> {
+    let params = *ctx.params();
+    let lib = library(&params);
+    let mut positions = vec![sc.start];
+    let mut ring = Vec::new();
+    for i in -15i32..=15 {
+        for j in -15i32..=15 {
+            let d = (i * i + j * j) as f64;
+            if d > 0.0 && d <= 225.0 {
+                ring.push((d, i, j));
+            }
+        }
+    }
+    ring.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    positions.extend(ring.iter().map(|&(_, i, j)| {
+        [
+            sc.start[0] + 0.1 * i as f64,
+            sc.start[1] + 0.1 * j as f64,
+            sc.start[2],
+        ]
+    }));
+    let yaw0 = sc.start_yaw as f32;
+    for p in positions {
+        for e in lib.entries.iter() {
+            for j in 0..8 {
+                let yaw = yaw0 + j as f32 * std::f32::consts::FRAC_PI_4;
+                let shape = e
+                    .shape
+                    .rotated(arc_core::angle::diff(e.shape.head_yaw(), yaw));
+                if ctx.check_config(p, &shape).is_ok() {
+                    return Ok(Query {
+                        start: p,
+                        shape,
+                        goal: sc.goal,
+                    });
+                }
+            }
+        }
+    }
+    Err(format!(
+        "no library shape of N = {} fits within 1.5 m of {}'s start",
+        params.units, sc.name
+    ))
+}
+
+fn plan_error_outcome(e: &PlanError) -> &'static str {
+    match e {
+        PlanError::TimeLimit { .. } => "time_limit",
+        PlanError::NoShape { .. } => "no_shape",
+        PlanError::Unreachable { .. } => "unreachable",
+        PlanError::StartInvalid(_) => "start_invalid",
+        PlanError::GoalInvalid(_) => "goal_invalid",
+        PlanError::TablesMismatch { .. } => "error",
+    }
+}
+
+fn prm_error_outcome(e: &PrmError) -> &'static str {
+    match e {
+        PrmError::TimeLimit { .. } => "time_limit",
+        PrmError::NoPath { .. } => "no_path",
+        PrmError::StartInvalid(_) => "start_invalid",
+        PrmError::GoalInvalid(_) => "goal_invalid",
+        PrmError::BadSettings(_) => "error",
+    }
+}
+
+/// Runs one spec.
+pub fn run_one(envs: &Envs, spec: &RunSpec) -> RunResult {
+    let Some(env) = envs.get(&spec.scenario) else {
+        return RunResult::failed(
+            spec,
+            "error",
+            format!("scenario {} not built", spec.scenario),
+        );
+    };
+    let ctx = match context(env, spec.units) {
+        Ok(c) => c,
+        Err(e) => return RunResult::failed(spec, "error", e),
+    };
+    let query = match spec.query {
+        Some(q) => q,
+        None => match default_query(&env.scenario, spec.units) {
+            Ok(q) => q,
+            Err(e) => return RunResult::failed(spec, "error", e),
+        },
+    };
+    let stop = Termination {
+        time_limit: spec.time_limit.map(Duration::from_secs_f64),
+    };
+    match spec.method {
+        Method::Arc(mode) => run_arc(env, ctx, spec, mode, query, stop),
+        Method::FullPrm => run_prm(env, ctx, spec, query, stop),
+    }
+}
+
+fn run_arc(
+    env: &Env,
+    ctx: CollisionContext,
+    spec: &RunSpec,
+    mode: ArcMode,
+    q: Query,
+    stop: Termination,
+) -> RunResult {
+    let params = *ctx.params();
+    let t = Instant::now();
+    let tables = ShapeTables::build(
+        params,
+        &TableSettings {
+            srs: spec.srs,
+            seed: spec.seed,
+            ..Default::default()
+        },
+        &AtomicUsize::new(0),
+    );
+    let tables_s = t.elapsed().as_secs_f64();
+    let tables = match tables {
+        Ok(t) => t,
+        Err(e) => return RunResult::failed(spec, "error", e.to_string()),
+    };
+    let settings = Settings {
+        vertices: spec.vertices,
+        mode: mode.mode(),
+        seed: spec.seed,
+        ..Default::default()
+    };
+    let mut planner = match Planner::new(ctx, tables, settings) {
+        Ok(p) => p,
+        Err(e) => return RunResult::failed(spec, "error", e.to_string()),
+    };
+    let ((), roadmap_s, roadmap_cpu_s) = timed(|| planner.setup());
+    let (res, planning_s, planning_cpu_s) = timed(|| planner.solve(q.start, q.shape, q.goal, stop));
+    let mut r = RunResult::failed(spec, "solved", String::new());
+    r.tables_s = tables_s;
+    r.roadmap_s = roadmap_s;
+    r.planning_s = planning_s;
+    r.roadmap_cpu_s = roadmap_cpu_s;
+    r.planning_cpu_s = planning_cpu_s;
+    r.roadmap_vertices = spec.vertices;
+    match res {
+        Err(e) => {
+            r.outcome = plan_error_outcome(&e).into();
+            r.message = e.to_string();
+        }
+        Ok(sol) => {
+            let s = &sol.stats;
+            r.success = true;
+            r.roadmap_vertices = s.roadmap_vertices;
+            r.collision_s = Some(s.collision_s);
+            r.search_s = Some((s.planning_s - s.collision_s).max(0.0));
+            r.shape_changes = Some(s.shape_changes);
+            r.edges = Some(s.edges);
+            r.replans = Some(s.replans);
+            r.srs_connects = Some(s.srs_connects);
+            r.collision_checks = Some(s.collision_checks);
+            let g = &env.scenario.grid;
+            let plan = motion::to_plan(&sol, &params, g.resolution(), g.unknown_is_occupied());
+            r.waypoints = Some(plan.waypoints.len());
+            r.verified = Some(verify_plan(g, &plan).ok);
+        }
+    }
+    r
+}
+
+fn run_prm(
+    env: &Env,
+    ctx: CollisionContext,
+    spec: &RunSpec,
+    q: Query,
+    stop: Termination,
+) -> RunResult {
+    let params = *ctx.params();
+    let settings = PrmSettings {
+        vertices: spec.vertices,
+        seed: spec.seed,
+        ..Default::default()
+    };
+    let mut prm = match FullStatePrm::new(ctx, settings) {
+        Ok(p) => p,
+        Err(e) => return RunResult::failed(spec, "error", e.to_string()),
+    };
+    let ((), roadmap_s, roadmap_cpu_s) = timed(|| prm.setup(q.goal, stop.time_limit));
+    let (res, planning_s, planning_cpu_s) = timed(|| prm.solve(q.start, q.shape, q.goal, stop));
+    let rs = prm.roadmap_stats();
+    let mut r = RunResult::failed(spec, "solved", String::new());
+    r.roadmap_s = roadmap_s;
+    r.planning_s = planning_s;
+    r.roadmap_cpu_s = roadmap_cpu_s;
+    r.planning_cpu_s = planning_cpu_s;
+    r.roadmap_vertices = rs.vertices;
+    r.build_capped = rs.build_capped;
+    match res {
+        Err(e) => {
+            r.outcome = prm_error_outcome(&e).into();
+            r.message = e.to_string();
+            if let PrmError::NoPath { iterations, .. } | PrmError::TimeLimit { iterations } = e {
+                r.iterations = Some(iterations);
+            }
+        }
+        Ok(sol) => {
+            let s = &sol.stats;
+            r.success = true;
+            r.collision_s = Some(s.collision_s);
+            r.search_s = Some((s.planning_s - s.collision_s).max(0.0));
+            r.shape_changes = Some(s.shape_changes);
+            r.edges = Some(s.path_edges);
+            r.iterations = Some(s.iterations);
+            r.collision_checks = Some(s.collision_checks);
+            let g = &env.scenario.grid;
+            let plan = baseline::to_plan(&sol, &params, g.resolution(), g.unknown_is_occupied());
+            r.waypoints = Some(plan.waypoints.len());
+            r.verified = Some(verify_plan(g, &plan).ok);
+        }
+    }
+    r
+}
+
+/// Runs every spec, in parallel over `threads` threads (`None`: rayon's default, which
+/// follows `RAYON_NUM_THREADS`), showing a progress bar on a terminal (and a line every
+/// tenth of the runs otherwise, when `log` is set). Results come back in spec order.
+pub fn run_all(
+    envs: &Envs,
+    specs: &[RunSpec],
+    threads: Option<usize>,
+    what: &str,
+    log: bool,
+) -> Result<Vec<RunResult>, String> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| format!("thread pool: {e}"))?;
+    let total = specs.len();
+    let bar = if log && std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(total as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg} [{bar:40}] {pos}/{len} runs ({elapsed}, eta {eta})",
+            )
+            .map_err(|e| e.to_string())?
+            .progress_chars("=> "),
+        );
+        b.set_message(what.to_string());
+        Some(b)
+    } else {
+        None
+    };
+    let done = AtomicUsize::new(0);
+    let began = Instant::now();
+    let results = pool.install(|| {
+        specs
+            .par_iter()
+            .map(|s| {
+                let r = run_one(envs, s);
+                let k = done.fetch_add(1, Ordering::Relaxed) + 1;
+                if let Some(b) = &bar {
+                    b.inc(1);
+                } else if log
+                    && (k * 10 / total.max(1) != (k - 1) * 10 / total.max(1) || k == total)
+                {
+                    eprintln!(
+                        "{what}: {k}/{total} runs done ({:.0} s)",
+                        began.elapsed().as_secs_f64()
+                    );
+                }
+                r
+            })
+            .collect()
+    });
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    Ok(results)
+}
+
+/// Order statistics of a sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Spread {
+    /// Number of values.
+    pub n: usize,
+    /// Median.
+    pub median: f64,
+    /// First quartile.
+    pub q1: f64,
+    /// Third quartile.
+    pub q3: f64,
+    /// Smallest.
+    pub min: f64,
+    /// Largest.
+    pub max: f64,
+}
+
+/// Quantile `q` (0..=1) of sorted values, linear between order statistics.
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let h = (sorted.len() - 1) as f64 * q;
+    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
+    sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
+}
+
+impl Spread {
+    /// The spread of `values` (NaN fields when empty).
+    pub fn of(values: impl IntoIterator<Item = f64>) -> Self {
+        let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();
+        v.sort_by(f64::total_cmp);
+        Self {
+            n: v.len(),
+            median: quantile(&v, 0.5),
+            q1: quantile(&v, 0.25),
+            q3: quantile(&v, 0.75),
+            min: v.first().copied().unwrap_or(f64::NAN),
+            max: v.last().copied().unwrap_or(f64::NAN),
+        }
+    }
+}
+
+/// The aggregate of the runs of one group (same study, scenario, N, planner, budgets).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Summary {
+    /// Study.
+    pub study: String,
+    /// Scenario.
+    pub scenario: String,
+    /// N.
+    pub units: u8,
+    /// Planner.
+    pub method: Method,
+    /// Roadmap vertices asked.
+    pub vertices: usize,
+    /// `N_SRS`.
+    pub srs: usize,
+    /// Time limit (s).
+    pub time_limit: Option<f64>,
+    /// Runs.
+    pub runs: usize,
+    /// Successful runs.
+    pub successes: usize,
+    /// Successful runs whose plan passed exact verification.
+    pub verified: usize,
+    /// Runs stopped by the time limit.
+    pub time_limited: usize,
+    /// Roadmap build, all runs (s).
+    pub roadmap: Spread,
+    /// Query, successful runs (s).
+    pub planning: Spread,
+    /// Query, all runs (s).
+    pub planning_all: Spread,
+    /// Build plus query, all runs (s).
+    pub total_all: Spread,
+    /// Build plus query, successful runs (s).
+    pub total_ok: Spread,
+    /// CPU time of the roadmap build, all runs (s).
+    pub roadmap_cpu: Spread,
+    /// CPU time of the query, successful runs (s).
+    pub planning_cpu: Spread,
+    /// CPU time of build plus query, all runs (s).
+    pub total_cpu_all: Spread,
+    /// Collision checks in the query, successful runs (s).
+    pub collision: Spread,
+    /// The rest of the query, successful runs (s).
+    pub search: Spread,
+    /// Shape changes, successful runs.
+    pub shape_changes: Spread,
+    /// Replans, successful runs.
+    pub replans: Spread,
+    /// Tables build, all runs (s).
+    pub tables: Spread,
+}
+
+impl Summary {
+    /// Success rate (0..=1).
+    pub fn success_rate(&self) -> f64 {
+        if self.runs == 0 {
+            0.0
+        } else {
+            self.successes as f64 / self.runs as f64
+        }
+    }
+}
+
+/// What runs of one group share: study, scenario, N, planner, vertices, `N_SRS`.
+type GroupKey = (String, String, u8, Method, usize, usize);
+
+/// Groups results by (study, scenario, N, planner, budgets), in first-seen order.
+pub fn summarize(results: &[RunResult]) -> Vec<Summary> {
+    let mut order: Vec<GroupKey> = Vec::new();
+    let mut groups: BTreeMap<GroupKey, Vec<&RunResult>> = BTreeMap::new();
+    for r in results {
+        let s = &r.spec;
+        let key = (
+            s.study.clone(),
+            s.scenario.clone(),
+            s.units,
+            s.method,
+            s.vertices,
+            s.srs,
+        );
+        if !groups.contains_key(&key) {
+            order.push(key.clone());
+        }
+        groups.entry(key).or_default().push(r);
+    }
+    order
+        .into_iter()
+        .map(|key| {
+            let rs = &groups[&key];
+            let ok: Vec<&&RunResult> = rs.iter().filter(|r| r.success).collect();
+            Summary {
+                study: key.0.clone(),
+                scenario: key.1.clone(),
+                units: key.2,
+                method: key.3,
+                vertices: key.4,
+                srs: key.5,
+                time_limit: rs[0].spec.time_limit,
+                runs: rs.len(),
+                successes: ok.len(),
+                verified: ok.iter().filter(|r| r.verified == Some(true)).count(),
+                time_limited: rs.iter().filter(|r| r.outcome == "time_limit").count(),
+                roadmap: Spread::of(rs.iter().map(|r| r.roadmap_s)),
+                planning: Spread::of(ok.iter().map(|r| r.planning_s)),
+                planning_all: Spread::of(rs.iter().map(|r| r.planning_s)),
+                total_all: Spread::of(rs.iter().map(|r| r.total_s())),
+                total_ok: Spread::of(ok.iter().map(|r| r.total_s())),
+                roadmap_cpu: Spread::of(rs.iter().filter_map(|r| r.roadmap_cpu_s)),
+                planning_cpu: Spread::of(ok.iter().filter_map(|r| r.planning_cpu_s)),
+                total_cpu_all: Spread::of(rs.iter().filter_map(|r| r.total_cpu_s())),
+                collision: Spread::of(ok.iter().filter_map(|r| r.collision_s)),
+                search: Spread::of(ok.iter().filter_map(|r| r.search_s)),
+                shape_changes: Spread::of(
+                    ok.iter().filter_map(|r| r.shape_changes.map(|x| x as f64)),
+                ),
+                replans: Spread::of(ok.iter().filter_map(|r| r.replans.map(|x| x as f64))),
+                tables: Spread::of(rs.iter().map(|r| r.tables_s)),
+            }
+        })
+        .collect()
+}
+
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+fn opt<T: ToString>(v: Option<T>) -> String {
+    v.map(|x| x.to_string()).unwrap_or_default()
+}
+
+/// One line per run.
+pub fn runs_csv(results: &[RunResult]) -> String {
+    let mut s = String::from(
+        "study,scenario,units,method,vertices,srs,seed,time_limit_s,start_x,start_y,start_z,success,outcome,\
+         tables_s,roadmap_s,planning_s,roadmap_cpu_s,planning_cpu_s,collision_s,search_s,shape_changes,edges,replans,srs_connects,\
+         iterations,collision_checks,roadmap_vertices,build_capped,waypoints,verified,message\n",
+    );
+    for r in results {
+        let p = &r.spec;
+        let start = p.query.map(|q| q.start);
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            csv_field(&p.study),
+            csv_field(&p.scenario),
+            p.units,
+            p.method.label(),
+            p.vertices,
+            p.srs,
+            p.seed,
+            opt(p.time_limit),
+            opt(start.map(|s| s[0])),
+            opt(start.map(|s| s[1])),
+            opt(start.map(|s| s[2])),
+            r.success,
+            r.outcome,
+            r.tables_s,
+            r.roadmap_s,
+            r.planning_s,
+            opt(r.roadmap_cpu_s.map(|x| format!("{x:.6}"))),
+            opt(r.planning_cpu_s.map(|x| format!("{x:.6}"))),
+            opt(r.collision_s.map(|x| format!("{x:.6}"))),
+            opt(r.search_s.map(|x| format!("{x:.6}"))),
+            opt(r.shape_changes),
+            opt(r.edges),
+            opt(r.replans),
+            opt(r.srs_connects),
+            opt(r.iterations),
+            opt(r.collision_checks),
+            r.roadmap_vertices,
+            r.build_capped,
+            opt(r.waypoints),
+            opt(r.verified),
+            csv_field(&r.message)
+        );
+    }
+    s
+}
+
+fn spread_cols(s: &Spread) -> String {
+    format!(
+        "{:.6},{:.6},{:.6},{:.6},{:.6}",
+        s.median, s.q1, s.q3, s.min, s.max
+    )
+}
+
+/// One line per group.
+pub fn summary_csv(sums: &[Summary]) -> String {
+    let mut s = String::from("study,scenario,units,method,vertices,srs,time_limit_s,runs,successes,success_rate,verified,time_limited");
+    for name in [
+        "roadmap_s",
+        "planning_s",
+        "planning_all_s",
+        "total_all_s",
+        "roadmap_cpu_s",
+        "planning_cpu_s",
+        "total_cpu_all_s",
+        "collision_s",
+        "search_s",
+        "shape_changes",
+    ] {
+        for q in ["median", "q1", "q3", "min", "max"] {
+            let _ = write!(s, ",{name}_{q}");
+        }
+    }
+    s.push('\n');
+    for g in sums {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{},{},{}",
+            csv_field(&g.study),
+            csv_field(&g.scenario),
+            g.units,
+            g.method.label(),
+            g.vertices,
+            g.srs,
+            opt(g.time_limit),
+            g.runs,
+            g.successes,
+            g.success_rate(),
+            g.verified,
+            g.time_limited,
+            spread_cols(&g.roadmap),
+            spread_cols(&g.planning),
+            spread_cols(&g.planning_all),
+            spread_cols(&g.total_all),
+            spread_cols(&g.roadmap_cpu),
+            spread_cols(&g.planning_cpu),
+            spread_cols(&g.total_cpu_all),
+            spread_cols(&g.collision),
+            spread_cols(&g.search),
+            spread_cols(&g.shape_changes)
+        );
+    }
+    s
+}
+
+/// `median [q1-q3]` in milliseconds, or `-` without values.
+pub fn ms(s: &Spread) -> String {
+    if s.n == 0 {
+        "-".into()
+    } else {
+        format!("{} [{}-{}]", fmt_ms(s.median), fmt_ms(s.q1), fmt_ms(s.q3))
+    }
+}
+
+/// A duration in milliseconds with 3 significant digits.
+pub fn fmt_ms(sec: f64) -> String {
+    let m = sec * 1e3;
+    if m >= 100.0 {
+        format!("{m:.0}")
+    } else if m >= 10.0 {
+        format!("{m:.1}")
+    } else {
+        format!("{m:.2}")
+    }
+}
+
+/// `median [min-max]` of a count, or `-`.
+pub fn count(s: &Spread) -> String {
+    if s.n == 0 {
+        "-".into()
+    } else {
+        format!("{} [{}-{}]", s.median, s.min, s.max)
+    }
+}
+
+/// Writes `name` under `dir` atomically (creating `dir`).
+pub fn write_out(
+    dir: &std::path::Path,
+    name: &str,
+    bytes: &[u8],
+) -> Result<std::path::PathBuf, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let p = dir.join(name);
+    crate::fsutil::write_atomic(&p, bytes).map_err(|e| format!("{}: {e}", p.display()))?;
+    Ok(p)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles() {
+        let s = Spread::of([4.0, 1.0, 3.0, 2.0, f64::NAN]);
+        assert_eq!(s.n, 4);
+        assert_eq!(s.median, 2.5);
+        assert_eq!(s.min, 1.0);
+        assert_eq!(s.max, 4.0);
+        assert_eq!(s.q1, 1.75);
+        let e = Spread::of([]);
+        assert_eq!(e.n, 0);
+        assert!(e.median.is_nan());
+        assert_eq!(ms(&e), "-");
+    }
+
+    #[test]
+    fn csv_quotes() {
+        assert_eq!(csv_field("a,b"), "\"a,b\"");
+        assert_eq!(csv_field("say \"x\""), "\"say \"\"x\"\"\"");
+        assert_eq!(csv_field("plain"), "plain");
+    }
+
+    #[test]
+    fn long_chains_get_a_start_that_fits() {
+        let sc = scenarios::build("window").unwrap();
+        let field = Arc::new(DistanceField::new(sc.grid.clone()));
+        let env = Env {
+            scenario: sc,
+            field,
+        };
+        for n in [3u8, 12, 16] {
+            let ctx = context(&env, n).unwrap();
+            let q = fitting_query(&env.scenario, &ctx).unwrap();
+            assert!(ctx.check_config(q.start, &q.shape).is_ok());
+        }
+        // A short chain keeps the scenario's own start.
+        let ctx = context(&env, 4).unwrap();
+        let q = fitting_query(&env.scenario, &ctx).unwrap();
+        assert_eq!(q, default_query(&env.scenario, 4).unwrap());
+    }
+
+    #[test]
+    fn unknown_scenario_is_an_error() {
+        let spec = RunSpec {
+            study: "t".into(),
+            scenario: "nowhere".into(),
+            units: 4,
+            method: Method::FullPrm,
+            vertices: 10,
+            srs: 0,
+            seed: 1,
+            time_limit: None,
+            query: None,
+        };
+        assert!(Envs::for_specs(std::slice::from_ref(&spec)).is_err());
+        let envs = Envs(BTreeMap::new());
+        let r = run_one(&envs, &spec);
+        assert!(!r.success);
+        assert_eq!(r.outcome, "error");
+    }
+}

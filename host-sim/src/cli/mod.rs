@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod bench;
 pub mod common;
 mod map;
 mod plan;
@@ -74,6 +75,9 @@ enum Command {
     /// Maps: export built-in scenarios as OctoMap files, inspect and draw maps.
     #[command(subcommand)]
     Map(map::MapCommand),
+    /// Benchmarks: the paper's Tables 1-3, scaling studies, full-state PRM plans.
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
     /// Fly a plan: chain dynamics, head MPC, link SO(3) controllers, unit attitude loops.
     Sim(sim::SimArgs),
 }
@@ -109,6 +113,7 @@ where
         Command::Plan(a) => plan::run(*a),
         Command::Verify(a) => verify::run(a),
         Command::Map(c) => map::run(c),
+        Command::Bench(c) => bench::run(c),
         Command::Sim(a) => sim::run(a),
     }
 }

@@ -1,0 +1,135 @@
+//! Criterion benches of the planner's parts: the head roadmap build on `window`, one
+//! ARCplanner query on `window` with N = 5, batches of translation and shape-change
+//! checks, and the full-state PRM's roadmap build for comparison.
+//!
+//! `cargo bench -p arc-host-sim --bench planner`
+
+use std::hint::black_box;
+use std::sync::atomic::AtomicUsize;
+use std::sync::Arc;
+use std::time::Duration;
+
+use arc_core::{ChainParams, Shape};
+use arc_host_sim::baseline::{FullStatePrm, PrmSettings};
+use arc_host_sim::collision::{CollisionContext, DEFAULT_CLEARANCE};
+use arc_host_sim::map::distance::DistanceField;
+use arc_host_sim::map::scenarios::{self, Scenario};
+use arc_host_sim::planner::{Planner, Settings, Termination};
+use arc_host_sim::tables::{ShapeTables, TableSettings};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use rand::{Rng, SeedableRng};
+
+fn window(units: u8) -> (Scenario, CollisionContext, ShapeTables) {
+    let sc = scenarios::build("window").expect("built-in scenario");
+    let field = Arc::new(DistanceField::new(sc.grid.clone()));
+    let params = ChainParams::new(units);
+    let ctx = CollisionContext::new(field, params, DEFAULT_CLEARANCE).expect("valid chain");
+    let tables = ShapeTables::build(params, &TableSettings::default(), &AtomicUsize::new(0))
+        .expect("tables");
+    (sc, ctx, tables)
+}
+
+fn planner(ctx: &CollisionContext, tables: &ShapeTables) -> Planner {
+    Planner::new(ctx.clone(), tables.clone(), Settings::default()).expect("same chain")
+}
+
+fn roadmap_and_query(c: &mut Criterion) {
+    let (sc, ctx, tables) = window(5);
+    let mut g = c.benchmark_group("planner");
+    g.sample_size(10).measurement_time(Duration::from_secs(5));
+    g.bench_function("roadmap_build/window_1500", |b| {
+        b.iter_batched(
+            || planner(&ctx, &tables),
+            |mut p| {
+                p.setup();
+                p
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    let shape = sc.start_shape(5).expect("N = 5");
+    g.bench_function("solve/window_n5", |b| {
+        b.iter_batched(
+            || {
+                let mut p = planner(&ctx, &tables);
+                p.setup();
+                p
+            },
+            |mut p| {
+                let r = p.solve(sc.start, shape, sc.goal, Termination::default());
+                black_box(r.is_ok())
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.bench_function("prm_roadmap_build/window_n5_1500", |b| {
+        b.iter_batched(
+            || FullStatePrm::new(ctx.clone(), PrmSettings::default()).expect("settings"),
+            |mut p| {
+                p.setup(sc.goal, None);
+                p
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.finish();
+}
+
+/// 200 valid placements of SRS shapes in `window`, each with a translation target
+/// 0.5 m away and another SRS shape to change to.
+fn cases(ctx: &CollisionContext, tables: &ShapeTables) -> Vec<([f64; 3], [f64; 3], Shape, Shape)> {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
+    let (lo, hi) = ctx.field().grid().bounds();
+    let mut v = Vec::new();
+    while v.len() < 200 {
+        let p = [
+            rng.gen_range(lo[0]..hi[0]),
+            rng.gen_range(lo[1]..hi[1]),
+            rng.gen_range(lo[2]..hi[2]),
+        ];
+        let s = tables.srs[rng.gen_range(0..tables.srs.len())];
+        if ctx.check_placement(p, &s).is_err() {
+            continue;
+        }
+        let a: f64 = rng.gen_range(0.0..std::f64::consts::TAU);
+        let q = [p[0] + 0.5 * a.cos(), p[1] + 0.5 * a.sin(), p[2]];
+        let t = tables.srs[rng.gen_range(0..tables.srs.len())];
+        v.push((p, q, s, t));
+    }
+    v
+}
+
+fn checks(c: &mut Criterion) {
+    let (_, ctx, tables) = window(5);
+    let cases = cases(&ctx, &tables);
+    let mut g = c.benchmark_group("checks");
+    g.sample_size(20).measurement_time(Duration::from_secs(3));
+    g.bench_function("translation_x200/window_n5", |b| {
+        b.iter(|| {
+            cases
+                .iter()
+                .filter(|(p, q, s, _)| ctx.check_translation(*p, *q, s).is_ok())
+                .count()
+        })
+    });
+    g.bench_function("shape_change_x200/window_n5", |b| {
+        b.iter(|| {
+            cases
+                .iter()
+                .filter(|(p, _, s, t)| ctx.check_shape_change(*p, s, t).is_ok())
+                .count()
+        })
+    });
+    g.bench_function("placement_x200/window_n5", |b| {
+        b.iter(|| {
+            cases
+                .iter()
+                .filter(|(p, _, s, _)| ctx.check_placement(*p, s).is_ok())
+                .count()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, roadmap_and_query, checks);
+criterion_main!(benches);

@@ -1,0 +1,331 @@
+//! `arc bench scale`: the ARCplanner's planning time and success against the number of
+//! units N (scenario `window`) and against the map's size (`corridor:L`).
+//!
+//! Starts: a chain longer than about 11 links does not fit at `window`'s start as a
+//! straight line (the first room is 5.6 m wide), so every N gets its start from
+//! [`super::fitting_query`]: the scenario's start and LI when it fits, else the first
+//! library shape and heading (then the nearest head position within 1.5 m) that does.
+//! The chosen start is listed in the report. The goal is always the scenario's.
+//!
+//! Map size: `corridor:L` keeps its cross-section and door spacing and grows in length,
+//! so the head roadmap keeps its density when `M_VT` grows with `L`
+//! ([`ScaleOptions::corridor_vertices_per_m`]); a fixed `M_VT` is also possible.
+
+use std::fmt::Write as _;
+
+use arc_core::lsc::library;
+use plotters::style::RGBColor;
+
+use super::plot::{self, Chart, Curve};
+use super::{count, fitting_query, ms, ArcMode, Envs, Method, Query, RunSpec, Summary};
+
+/// What to run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScaleOptions {
+    /// Seeds per configuration.
+    pub seeds: u64,
+    /// Chain sizes for `window`.
+    pub units: Vec<u8>,
+    /// Head roadmap vertices for `window`.
+    pub vertices: usize,
+    /// Corridor lengths (m).
+    pub lengths: Vec<f64>,
+    /// Chain size in the corridors.
+    pub corridor_units: u8,
+    /// Head roadmap vertices per metre of corridor (`None`: `vertices` for every length).
+    pub corridor_vertices_per_m: Option<f64>,
+    /// Random shapes `N_SRS`.
+    pub srs: usize,
+    /// Time limit per run (s).
+    pub time_limit: Option<f64>,
+}
+
+impl ScaleOptions {
+    /// The full study: N = 3..16, corridors 10..100 m every 10 m, 20 seeds,
+    /// `M_VT = 1500` in `window` and 100 vertices per metre of corridor (2000 in the
+    /// default 20 m corridor), `N_SRS = 500`, 60 s per run.
+    pub fn full() -> Self {
+        Self {
+            seeds: 20,
+            units: (3..=16).collect(),
+            vertices: 1500,
+            lengths: (1..=10).map(|k| 10.0 * k as f64).collect(),
+            corridor_units: 5,
+            corridor_vertices_per_m: Some(100.0),
+            srs: 500,
+            time_limit: Some(60.0),
+        }
+    }
+
+    /// A smoke run: two sizes, two corridors, one seed, small budgets.
+    pub fn quick() -> Self {
+        Self {
+            seeds: 1,
+            units: vec![3, 4],
+            vertices: 300,
+            lengths: vec![10.0, 20.0],
+            corridor_units: 4,
+            corridor_vertices_per_m: Some(30.0),
+            srs: 100,
+            time_limit: Some(2.0),
+        }
+    }
+
+    fn corridor_vertices(&self, l: f64) -> usize {
+        match self.corridor_vertices_per_m {
+            Some(d) => (d * l).round().max(1.0) as usize,
+            None => self.vertices,
+        }
+    }
+}
+
+/// The scenario name of a corridor of `l` metres.
+pub fn corridor_name(l: f64) -> String {
+    format!("corridor:{l}")
+}
+
+/// The start chosen for one N: N, the query, the library shape's name.
+pub type StartChoice = (u8, Query, String);
+
+/// Every run of the study (N first, then the corridors), and the start chosen per N.
+pub fn specs(o: &ScaleOptions) -> Result<(Vec<RunSpec>, Vec<StartChoice>), String> {
+    let window: Vec<RunSpec> = vec![RunSpec {
+        study: "scale-units".into(),
+        scenario: "window".into(),
+        units: 3,
+        method: Method::Arc(ArcMode::Both),
+        vertices: o.vertices,
+        srs: o.srs,
+        seed: 1,
+        time_limit: o.time_limit,
+        query: None,
+    }];
+    let envs = Envs::for_specs(&window)?;
+    let env = envs.get("window").ok_or("window not built")?;
+    let mut v = Vec::new();
+    let mut starts = Vec::new();
+    for &n in &o.units {
+        let ctx = super::context(env, n)?;
+        let q = fitting_query(&env.scenario, &ctx)?;
+        let lib = library(ctx.params());
+        let name = lib
+            .entries
+            .iter()
+            .find(|e| {
+                let d = arc_core::angle::diff(e.shape.head_yaw(), q.shape.head_yaw());
+                e.shape.rotated(d).max_angle_diff(&q.shape) < 1e-5
+            })
+            .map_or("?", |e| e.kind.name());
+        starts.push((n, q, name.to_string()));
+        for seed in 1..=o.seeds {
+            v.push(RunSpec {
+                study: "scale-units".into(),
+                scenario: "window".into(),
+                units: n,
+                method: Method::Arc(ArcMode::Both),
+                vertices: o.vertices,
+                srs: o.srs,
+                seed,
+                time_limit: o.time_limit,
+                query: Some(q),
+            });
+        }
+    }
+    for &l in &o.lengths {
+        for seed in 1..=o.seeds {
+            v.push(RunSpec {
+                study: "scale-map".into(),
+                scenario: corridor_name(l),
+                units: o.corridor_units,
+                method: Method::Arc(ArcMode::Both),
+                vertices: o.corridor_vertices(l),
+                srs: o.srs,
+                seed,
+                time_limit: o.time_limit,
+                query: None,
+            });
+        }
+    }
+    Ok((v, starts))
+}
+
+fn corridor_length(s: &Summary) -> f64 {
+    s.scenario
+        .strip_prefix("corridor:")
+        .and_then(|l| l.parse().ok())
+        .unwrap_or(f64::NAN)
+}
+
+/// The markdown report.
+pub fn markdown(
+    sums: &[Summary],
+    o: &ScaleOptions,
+    starts: &[StartChoice],
+    meta: &str,
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# ARC benchmark: scaling\n\n{meta}\n");
+    let _ = writeln!(
+        s,
+        "The full ARCplanner (LSC and SRS), N_SRS = {}, {} seeds per row, time limit {} s per run. \
+         Times in ms, median [first-third quartile]; `t_P` over successful runs.\n",
+        o.srs,
+        o.seeds,
+        o.time_limit.map_or("none".into(), |t| t.to_string())
+    );
+    let _ = writeln!(
+        s,
+        "## Against the number of units (`window`, M_VT = {})\n\n\
+         Start: the scenario's (2.0, 4.5, 1.5) with LI at 90 deg where that fits; otherwise the first \
+         library shape, heading (90 deg + k 45 deg) and head position (0.1 m lattice, nearest first) \
+         that is valid. Goal: (6.6, 3.0, 1.5), tolerance 0.3 m.\n",
+        o.vertices
+    );
+    let _ = writeln!(
+        s,
+        "| N | start (m) | start shape, yaw (deg) | success | verified | t_G (ms) | t_P (ms) | t_P CPU (ms) | shape changes | replans | time-limited |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
+    for g in sums.iter().filter(|g| g.study == "scale-units") {
+        let st = starts.iter().find(|x| x.0 == g.units);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {}/{} | {}/{} | {} | {} | {} | {} | {} | {} |",
+            g.units,
+            st.map_or("-".into(), |x| format!(
+                "({:.1}, {:.1}, {:.1})",
+                x.1.start[0], x.1.start[1], x.1.start[2]
+            )),
+            st.map_or("-".into(), |x| format!(
+                "{}, {:.0}",
+                x.2,
+                (x.1.shape.head_yaw() as f64).to_degrees()
+            )),
+            g.successes,
+            g.runs,
+            g.verified,
+            g.successes,
+            ms(&g.roadmap),
+            ms(&g.planning),
+            ms(&g.planning_cpu),
+            count(&g.shape_changes),
+            count(&g.replans),
+            g.time_limited
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\n## Against the map's size (`corridor:L`, N = {}, M_VT = {})\n",
+        o.corridor_units,
+        match o.corridor_vertices_per_m {
+            Some(d) => format!("{d} per metre of corridor"),
+            None => o.vertices.to_string(),
+        }
+    );
+    let _ = writeln!(
+        s,
+        "| L (m) | M_VT | success | verified | t_G (ms) | t_P (ms) | t_P CPU (ms) | shape changes | replans | time-limited |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+    for g in sums.iter().filter(|g| g.study == "scale-map") {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {}/{} | {}/{} | {} | {} | {} | {} | {} | {} |",
+            corridor_length(g),
+            g.vertices,
+            g.successes,
+            g.runs,
+            g.verified,
+            g.successes,
+            ms(&g.roadmap),
+            ms(&g.planning),
+            ms(&g.planning_cpu),
+            count(&g.shape_changes),
+            count(&g.replans),
+            g.time_limited
+        );
+    }
+    s
+}
+
+const BLUE: RGBColor = RGBColor(31, 119, 180);
+const ORANGE: RGBColor = RGBColor(255, 127, 14);
+const GREEN: RGBColor = RGBColor(44, 160, 44);
+
+/// The figure: time and success against N (left) and against corridor length (right).
+pub fn figure(sums: &[Summary], corridor_units: u8) -> Result<String, String> {
+    let by_n: Vec<&Summary> = sums.iter().filter(|g| g.study == "scale-units").collect();
+    let by_l: Vec<&Summary> = sums.iter().filter(|g| g.study == "scale-map").collect();
+    let n = |g: &Summary| g.units as f64;
+    let times = |v: &[&Summary]| {
+        v.iter()
+            .flat_map(|g| [g.planning.q3, g.roadmap.q3, g.planning.q1, g.roadmap.q1])
+            .filter(|x| x.is_finite() && *x > 0.0)
+            .map(|x| x * 1e3)
+            .fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)))
+    };
+    let range = |r: (f64, f64)| {
+        if r.0.is_finite() && r.1 > 0.0 {
+            (r.0 / 2.0, r.1 * 2.0)
+        } else {
+            (0.1, 1000.0)
+        }
+    };
+    let time_curves = |v: &[&Summary], x: &dyn Fn(&Summary) -> f64| {
+        vec![
+            Curve {
+                label: "t_P, query (successful runs)".into(),
+                colour: BLUE,
+                points: plot::planning_ms(v, x),
+            },
+            Curve {
+                label: "t_G, head roadmap".into(),
+                colour: ORANGE,
+                points: plot::roadmap_ms(v, x),
+            },
+        ]
+    };
+    let charts = vec![
+        Chart {
+            title: "window: time against N (median, IQR)".into(),
+            x_label: "units N".into(),
+            y_label: "ms".into(),
+            log_y: true,
+            y_range: range(times(&by_n)),
+            curves: time_curves(&by_n, &n),
+        },
+        Chart {
+            title: format!("corridor:L: time against length (N = {corridor_units})"),
+            x_label: "corridor length L (m)".into(),
+            y_label: "ms".into(),
+            log_y: true,
+            y_range: range(times(&by_l)),
+            curves: time_curves(&by_l, &corridor_length),
+        },
+        Chart {
+            title: "window: success against N".into(),
+            x_label: "units N".into(),
+            y_label: "success (%)".into(),
+            log_y: false,
+            y_range: (0.0, 105.0),
+            curves: vec![Curve {
+                label: "success".into(),
+                colour: GREEN,
+                points: plot::success_pct(&by_n, n),
+            }],
+        },
+        Chart {
+            title: "corridor:L: success against length".into(),
+            x_label: "corridor length L (m)".into(),
+            y_label: "success (%)".into(),
+            log_y: false,
+            y_range: (0.0, 105.0),
+            curves: vec![Curve {
+                label: "success".into(),
+                colour: GREEN,
+                points: plot::success_pct(&by_l, corridor_length),
+            }],
+        },
+    ];
+    plot::svg(&charts, 2, 2, (1200, 800))
+}

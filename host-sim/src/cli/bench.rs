@@ -1,0 +1,462 @@
+//! `arc bench`: the paper's evaluation, the scaling study, and single full-state PRM plans.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use clap::{Args, Subcommand};
+
+use super::common::{parse_point, ChainArgs, MapArgs};
+use super::{CliError, CliResult};
+use crate::baseline::{self, FullStatePrm, PrmError, PrmSettings};
+use crate::bench::{self, paper, scale};
+use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
+use crate::planner::Termination;
+
+/// `arc bench ...`
+#[derive(Subcommand, Debug)]
+pub enum BenchCommand {
+    /// The paper's Tables 1-3 (window, maze; LSC / SRS / both; full-state PRM), paper
+    /// numbers beside ours; markdown on stdout, CSV and markdown in --out-dir.
+    Paper(PaperArgs),
+    /// Planning time and success against N (window, N = 3..16) and map size
+    /// (corridor:10..100), with a plot (SVG and PNG).
+    Scale(ScaleArgs),
+    /// One plan by the full-state lazy PRM baseline (arc-plan/1, verified exactly).
+    Prm(Box<PrmArgs>),
+}
+
+/// Options shared by the studies.
+#[derive(Args, Debug)]
+pub struct StudyArgs {
+    /// Smoke run: few seeds, small budgets, short time limits (seconds in all).
+    #[arg(long)]
+    quick: bool,
+    /// Seeds per configuration (default: 20, or the quick run's).
+    #[arg(long)]
+    seeds: Option<u64>,
+    /// Time limit per run in seconds; 0 for none (default: 60, or 2 with --quick).
+    #[arg(long)]
+    time_limit: Option<f64>,
+    /// Where CSV, markdown and plots go.
+    #[arg(long, default_value = "bench-out")]
+    out_dir: PathBuf,
+    /// Worker threads (default: RAYON_NUM_THREADS, else every core).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Head roadmap vertices M_VT (default 1500, quick 300).
+    #[arg(long)]
+    vertices: Option<usize>,
+    /// Random shapes N_SRS (default 500, quick 100).
+    #[arg(long)]
+    srs: Option<usize>,
+}
+
+/// `arc bench paper`
+#[derive(Args, Debug)]
+pub struct PaperArgs {
+    #[command(flatten)]
+    study: StudyArgs,
+    /// Vertex budgets M_F of the full-state PRM, comma-separated (default 1500,15000).
+    #[arg(long, value_delimiter = ',')]
+    prm_vertices: Option<Vec<usize>>,
+    /// Chain sizes of Table 3, comma-separated (default 5).
+    #[arg(long, value_delimiter = ',')]
+    prm_units: Option<Vec<u8>>,
+    /// Tables to run, comma-separated (default 1,2,3).
+    #[arg(long, value_delimiter = ',')]
+    tables: Option<Vec<u8>>,
+    /// Opening (m) of the widened-window variant of Table 3, where the full-state PRM
+    /// can pass; 0 to skip it (default 1.6).
+    #[arg(long)]
+    wide_window: Option<f64>,
+}
+
+/// `arc bench scale`
+#[derive(Args, Debug)]
+pub struct ScaleArgs {
+    #[command(flatten)]
+    study: StudyArgs,
+    /// Chain sizes in window, comma-separated (default 3..16).
+    #[arg(long, value_delimiter = ',')]
+    units: Option<Vec<u8>>,
+    /// Corridor lengths in metres, comma-separated (default 10,20,...,100).
+    #[arg(long, value_delimiter = ',')]
+    lengths: Option<Vec<f64>>,
+    /// Head roadmap vertices per metre of corridor; 0 for --vertices at every length
+    /// (default 100).
+    #[arg(long)]
+    corridor_density: Option<f64>,
+}
+
+/// `arc bench prm`
+#[derive(Args, Debug)]
+pub struct PrmArgs {
+    #[command(flatten)]
+    map: MapArgs,
+    #[command(flatten)]
+    chain: ChainArgs,
+    /// Head start position x,y,z (m); a scenario has its own.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    start: Option<[f64; 3]>,
+    /// Start yaw (degrees); a scenario has its own.
+    #[arg(long, allow_hyphen_values = true)]
+    start_yaw_deg: Option<f64>,
+    /// Start shape: a library name (LI, SE, SM, SV, CA, PN) turned to the start yaw.
+    #[arg(long, default_value = "LI")]
+    start_shape: String,
+    /// Head goal position x,y,z (m); a scenario has its own.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    goal: Option<[f64; 3]>,
+    /// Goal tolerance for the head (m).
+    #[arg(long, default_value_t = 0.3)]
+    goal_tol: f64,
+    /// Vertex budget M_F.
+    #[arg(long, default_value_t = 1500)]
+    vertices: usize,
+    /// Neighbours per vertex (default: the PRM* rule).
+    #[arg(long)]
+    k: Option<usize>,
+    /// Configurations sampled in the goal ball (default: 1% of M_F, at least 10).
+    #[arg(long)]
+    goal_samples: Option<usize>,
+    /// Seed of the sampler.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Clearance margin added to every body's radius (m).
+    #[arg(long, default_value_t = DEFAULT_CLEARANCE)]
+    clearance: f64,
+    /// Give up after this many seconds (roadmap build and query each).
+    #[arg(long)]
+    time_limit: Option<f64>,
+    /// Output plan (JSON, arc-plan/1).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn check_study(a: &StudyArgs) -> Result<(), CliError> {
+    if a.seeds == Some(0) {
+        return Err(CliError::input("--seeds 0: must be at least 1"));
+    }
+    if let Some(t) = a.time_limit {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(CliError::input(format!(
+                "--time-limit {t}: must be a number of seconds >= 0"
+            )));
+        }
+    }
+    if a.threads == Some(0) {
+        return Err(CliError::input("--threads 0: must be at least 1"));
+    }
+    if a.vertices == Some(0) {
+        return Err(CliError::input("--vertices 0: must be at least 1"));
+    }
+    if a.srs.is_some_and(|s| s > u16::MAX as usize) {
+        return Err(CliError::input("--srs: must be at most 65535"));
+    }
+    Ok(())
+}
+
+fn time_limit(a: &StudyArgs, default: Option<f64>) -> Option<f64> {
+    match a.time_limit {
+        Some(0.0) => None,
+        Some(t) => Some(t),
+        None => default,
+    }
+}
+
+fn meta(a: &StudyArgs, runs: usize) -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = a
+        .threads
+        .or_else(|| {
+            std::env::var("RAYON_NUM_THREADS")
+                .ok()
+                .and_then(|v| v.parse().ok())
+        })
+        .unwrap_or(cores);
+    format!(
+        "`arc bench` {} ({} runs; {} worker threads on {} cores, {cpu}; {} build).",
+        if a.quick { "--quick" } else { "full" },
+        runs,
+        threads,
+        cores,
+        if cfg!(debug_assertions) {
+            "debug"
+        } else {
+            "release"
+        }
+    )
+}
+
+fn write(dir: &std::path::Path, name: &str, text: &[u8]) -> Result<PathBuf, CliError> {
+    bench::write_out(dir, name, text).map_err(CliError::input)
+}
+
+fn run_paper(a: PaperArgs) -> CliResult {
+    check_study(&a.study)?;
+    let base = if a.study.quick {
+        paper::PaperOptions::quick()
+    } else {
+        paper::PaperOptions::full()
+    };
+    let o = paper::PaperOptions {
+        seeds: a.study.seeds.unwrap_or(base.seeds),
+        vertices: a.study.vertices.unwrap_or(base.vertices),
+        srs: a.study.srs.unwrap_or(base.srs),
+        prm_vertices: a.prm_vertices.clone().unwrap_or(base.prm_vertices),
+        prm_units: a.prm_units.clone().unwrap_or(base.prm_units),
+        time_limit: time_limit(&a.study, base.time_limit),
+        tables: a.tables.clone().unwrap_or(base.tables),
+        wide_window: match a.wide_window {
+            Some(0.0) => None,
+            Some(w) => Some(w),
+            None => base.wide_window,
+        },
+    };
+    if let Some(w) = o.wide_window {
+        if !(0.8..=2.4).contains(&w) {
+            return Err(CliError::input(format!(
+                "--wide-window {w}: must be 0.8 to 2.4 m (or 0 to skip)"
+            )));
+        }
+    }
+    if let Some(t) = o.tables.iter().find(|t| !(1..=3).contains(*t)) {
+        return Err(CliError::input(format!(
+            "--tables {t}: tables are 1, 2 and 3"
+        )));
+    }
+    if o.prm_vertices.contains(&0) {
+        return Err(CliError::input(
+            "--prm-vertices: every budget must be at least 1",
+        ));
+    }
+    if let Some(n) = o.prm_units.iter().find(|n| !(2..=16).contains(*n)) {
+        return Err(CliError::input(format!(
+            "--prm-units {n}: must be within 2..=16"
+        )));
+    }
+    let specs = paper::specs(&o);
+    let envs = bench::Envs::for_specs(&specs).map_err(CliError::input)?;
+    let t = Instant::now();
+    let results = bench::run_all(&envs, &specs, a.study.threads, "arc bench paper", true)
+        .map_err(CliError::input)?;
+    let sums = bench::summarize(&results);
+    let md = paper::markdown(
+        &sums,
+        &o,
+        &format!(
+            "{} Wall time of the whole study: {:.0} s.",
+            meta(&a.study, specs.len()),
+            t.elapsed().as_secs_f64()
+        ),
+    );
+    let dir = &a.study.out_dir;
+    let files = [
+        write(dir, "paper_runs.csv", bench::runs_csv(&results).as_bytes())?,
+        write(
+            dir,
+            "paper_summary.csv",
+            bench::summary_csv(&sums).as_bytes(),
+        )?,
+        write(dir, "paper.md", md.as_bytes())?,
+    ];
+    println!("{md}");
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
+fn run_scale(a: ScaleArgs) -> CliResult {
+    check_study(&a.study)?;
+    let base = if a.study.quick {
+        scale::ScaleOptions::quick()
+    } else {
+        scale::ScaleOptions::full()
+    };
+    let o = scale::ScaleOptions {
+        seeds: a.study.seeds.unwrap_or(base.seeds),
+        units: a.units.clone().unwrap_or(base.units),
+        vertices: a.study.vertices.unwrap_or(base.vertices),
+        lengths: a.lengths.clone().unwrap_or(base.lengths),
+        corridor_units: base.corridor_units,
+        corridor_vertices_per_m: match a.corridor_density {
+            Some(0.0) => None,
+            Some(d) => Some(d),
+            None => base.corridor_vertices_per_m,
+        },
+        srs: a.study.srs.unwrap_or(base.srs),
+        time_limit: time_limit(&a.study, base.time_limit),
+    };
+    if let Some(n) = o.units.iter().find(|n| !(2..=16).contains(*n)) {
+        return Err(CliError::input(format!(
+            "--units {n}: must be within 2..=16"
+        )));
+    }
+    if let Some(d) = o.corridor_vertices_per_m {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(CliError::input(format!(
+                "--corridor-density {d}: must be a positive number (or 0 for --vertices)"
+            )));
+        }
+    }
+    let (specs, starts) = scale::specs(&o).map_err(CliError::input)?;
+    let envs = bench::Envs::for_specs(&specs).map_err(CliError::input)?;
+    let t = Instant::now();
+    let results = bench::run_all(&envs, &specs, a.study.threads, "arc bench scale", true)
+        .map_err(CliError::input)?;
+    let sums = bench::summarize(&results);
+    let md = scale::markdown(
+        &sums,
+        &o,
+        &starts,
+        &format!(
+            "{} Wall time of the whole study: {:.0} s.",
+            meta(&a.study, specs.len()),
+            t.elapsed().as_secs_f64()
+        ),
+    );
+    let svg = scale::figure(&sums, o.corridor_units).map_err(CliError::failed)?;
+    let png = crate::picture::rasterise(&svg).map_err(CliError::failed)?;
+    let dir = &a.study.out_dir;
+    let files = [
+        write(dir, "scale_runs.csv", bench::runs_csv(&results).as_bytes())?,
+        write(
+            dir,
+            "scale_summary.csv",
+            bench::summary_csv(&sums).as_bytes(),
+        )?,
+        write(dir, "scale.md", md.as_bytes())?,
+        write(dir, "scale.svg", svg.as_bytes())?,
+        write(dir, "scale.png", &png)?,
+    ];
+    println!("{md}");
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
+fn run_prm(a: PrmArgs) -> CliResult {
+    if let Some(t) = a.time_limit {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(CliError::input(format!(
+                "--time-limit {t}: must be a positive number of seconds"
+            )));
+        }
+    }
+    if !(a.clearance.is_finite() && a.clearance >= 0.0) {
+        return Err(CliError::input(format!(
+            "--clearance {}: must be a number >= 0",
+            a.clearance
+        )));
+    }
+    let loaded = a.map.load()?;
+    let sc = loaded.scenario.as_ref();
+    let units = a
+        .chain
+        .units
+        .or(sc.map(|s| s.default_units))
+        .ok_or_else(|| CliError::input("--units is required with --map"))?;
+    let params = a.chain.params(units)?;
+    let start = a
+        .start
+        .or(sc.map(|s| s.start))
+        .ok_or_else(|| CliError::input("--start is required with --map"))?;
+    let goal = a
+        .goal
+        .or(sc.map(|s| s.goal))
+        .ok_or_else(|| CliError::input("--goal is required with --map"))?;
+    let yaw = a
+        .start_yaw_deg
+        .map(f64::to_radians)
+        .or(sc.map(|s| s.start_yaw))
+        .unwrap_or(0.0);
+    let shape = super::plan::start_shape(&params, &a.start_shape, yaw as f32)?;
+    let grid = loaded.grid.clone();
+    let (field, _) = loaded.into_field();
+    let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;
+    let settings = PrmSettings {
+        vertices: a.vertices,
+        k: a.k,
+        goal_samples: a.goal_samples,
+        seed: a.seed,
+        goal_tol: a.goal_tol,
+    };
+    let mut prm = FullStatePrm::new(ctx, settings).map_err(|e| CliError::input(e.to_string()))?;
+    let stop = Termination {
+        time_limit: a.time_limit.map(Duration::from_secs_f64),
+    };
+    let sol = prm.solve(start, shape, goal, stop).map_err(|e| match e {
+        PrmError::BadSettings(_) | PrmError::StartInvalid(_) | PrmError::GoalInvalid(_) => {
+            CliError::input(e.to_string())
+        }
+        _ => {
+            let r = prm.roadmap_stats();
+            CliError::failed(format!(
+                "no plan: {e} (roadmap {} vertices, {} edges, built in {:.1} ms{})",
+                r.vertices,
+                r.graph_edges,
+                r.roadmap_s * 1e3,
+                if r.build_capped {
+                    ", cut by the time limit"
+                } else {
+                    ""
+                }
+            ))
+        }
+    })?;
+    let plan = baseline::to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
+    let report = verify_plan(&grid, &plan);
+    plan.write(&a.out)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    let s = &sol.stats;
+    println!(
+        "{}: full-state PRM solved {} with N = {}: {} waypoints, {} roadmap edges, {} shape changes",
+        a.out.display(),
+        a.map.name(),
+        params.units,
+        plan.waypoints.len(),
+        s.path_edges,
+        s.shape_changes
+    );
+    println!(
+        "  roadmap {:.1} ms ({} vertices, k = {}, {} edges), planning {:.1} ms ({} lazy searches, {} edges checked, {} blocked; {:.1} ms in checks)",
+        s.roadmap_s * 1e3,
+        s.vertices,
+        s.k,
+        s.graph_edges,
+        s.planning_s * 1e3,
+        s.iterations,
+        s.edges_checked,
+        s.edges_blocked,
+        s.collision_s * 1e3
+    );
+    if report.ok {
+        println!("  exact verification: ok");
+        Ok(())
+    } else {
+        Err(CliError::failed(format!(
+            "the plan fails exact verification: {:?}",
+            report.violation
+        )))
+    }
+}
+
+/// Runs `arc bench ...`.
+pub fn run(c: BenchCommand) -> CliResult {
+    match c {
+        BenchCommand::Paper(a) => run_paper(a),
+        BenchCommand::Scale(a) => run_scale(a),
+        BenchCommand::Prm(a) => run_prm(*a),
+    }
+}
