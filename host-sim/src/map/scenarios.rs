@@ -261,10 +261,12 @@ pub fn corridor(length: f64) -> Result<Scenario, String> {
     let yc = 0.5 * sy;
     let amp = 0.45;
     let z = 1.2;
-    // Doors: 0.2 m walls across the corridor at x0 = 3.5 + 2 j, each with an opening
+    // Doors: 0.2 m walls across the corridor at x0 = FIRST + 2 j, each with an opening
     // 0.8 m wide and 1.8 m high (z 0.2 .. 2.0) centred at yc + amp (j even) or yc - amp.
+    // The start leaves room behind the head for a straight chain of 6 units.
+    const FIRST: f64 = 4.5;
     let mut doors = Vec::new();
-    let mut x0 = 3.5;
+    let mut x0 = FIRST;
     while x0 <= sx - 3.5 + 1e-9 {
         doors.push(x0);
         x0 += 2.0;
@@ -275,15 +277,16 @@ pub fn corridor(length: f64) -> Result<Scenario, String> {
         open(&mut g, [x0, y - 0.4, WALL], [x0 + 0.2, y + 0.4, 2.0]);
     }
     // Route: straight from the start, then a sine through every door's centre
-    // (y = yc + amp sin(pi (x - 2.6) / 2), extreme at each door), then straight on.
-    let start = [2.5, yc, z];
-    let last = doors.last().copied().unwrap_or(2.6) + 0.1;
+    // (y = yc + amp sin(pi (x - s0) / 2), extreme at each door), then straight on.
+    let s0 = FIRST - 0.9;
+    let start = [s0 - 0.1, yc, z];
+    let last = doors.last().copied().unwrap_or(s0) + 0.1;
     let end_s = last + 1.0;
     let goal = [sx - 1.0, yc, z];
-    let mut route = vec![start, [2.6, yc, z]];
-    let mut x = 2.7;
+    let mut route = vec![start, [s0, yc, z]];
+    let mut x = s0 + 0.1;
     while x < end_s - 1e-9 {
-        route.push([x, yc + amp * (PI * (x - 2.6) / 2.0).sin(), z]);
+        route.push([x, yc + amp * (PI * (x - s0) / 2.0).sin(), z]);
         x += 0.1;
     }
     route.push([end_s, yc, z]);
