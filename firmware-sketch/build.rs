@@ -115,7 +115,7 @@ mod tables {
             .validate()
             .unwrap_or_else(|e| panic!("ARC_UNITS={units}: {e}"));
         let lib = library(&params);
-        let settings = SrsSettings::new(n_srs, seed);
+        let settings = SrsSettings::new(params.units, n_srs, seed);
         let mut sampler = Sampler::new(params, settings.seed, settings.max_tries_per_shape);
         let shapes: Vec<Shape> = (0..n_srs)
             .map(|_| {

@@ -439,7 +439,7 @@ fn corrupted_table_puts_the_unit_in_safe_mode() {
 fn host_table(units: u8, count: usize, name: &str) -> PathBuf {
     let p = ChainParams::new(units);
     let lib = library(&p);
-    let srs = Srs::<128, 8>::generate(p, &SrsSettings::new(count, 7)).expect("srs");
+    let srs = Srs::<128, 8>::generate(p, &SrsSettings::new(p.units, count, 7)).expect("srs");
     let mut buf = vec![0u8; 64 * 1024];
     let len = encode_into(&mut buf, &p, &lib.entries, &srs.shapes, &srs.adjacency).expect("encode");
     let dir = workspace_root().join("target/firmware/qemu-tests");

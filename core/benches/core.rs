@@ -18,14 +18,14 @@ fn srs_sampling(c: &mut Criterion) {
     let mut g = c.benchmark_group("srs");
     g.sample_size(20);
     g.bench_function("sample_and_roadmap_n6_500", |b| {
-        b.iter(|| Srs500::generate(black_box(p), &SrsSettings::new(500, 1)).unwrap())
+        b.iter(|| Srs500::generate(black_box(p), &SrsSettings::new(6, 500, 1)).unwrap())
     });
     g.finish();
 }
 
 fn table_decode(c: &mut Criterion) {
     let p = ChainParams::new(6);
-    let srs = Srs500::generate(p, &SrsSettings::new(500, 1)).unwrap();
+    let srs = Srs500::generate(p, &SrsSettings::new(6, 500, 1)).unwrap();
     let lib = library(&p);
     let mut buf = vec![0u8; 64 * 1024];
     let len = encode_into(&mut buf, &p, &lib.entries, &srs.shapes, &srs.adjacency).unwrap();

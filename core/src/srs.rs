@@ -40,15 +40,22 @@ pub struct SrsSettings {
 }
 
 impl SrsSettings {
-    /// Defaults: 500 shapes, seed 1, `r_S = 3.0`, 100 000 tries per shape.
-    pub const fn new(count: usize, seed: u64) -> Self {
-        Self {
-            count,
-            seed,
-            r_s: 3.0,
-            max_tries_per_shape: 100_000,
-        }
+    /// `count` shapes for a chain of `units` units: `r_S` = [`default_r_s`], 100 000
+    /// tries per shape.
+    pub fn new(units: u8, count: usize, seed: u64) -> Self {
+        Self { count, seed, r_s: default_r_s(units, count), max_tries_per_shape: 100_000 }
     }
+}
+
+/// Default roadmap radius `r_S` (in `C_T`) for `count` shapes of a chain of `units`.
+///
+/// Between two random shapes `C_T` grows like N (its weights sum to N^2), and the
+/// nearest of `count` samples in the 2N-1 dimensions of a shape sits at about
+/// `count^(-1/(2N-1))` of that spread: `1.8 N count^(-1/(2N-1))` gives a roadmap of
+/// useful degree for every N (3.0 for N = 4 and 500 shapes).
+pub fn default_r_s(units: u8, count: usize) -> f32 {
+    let dims = (2 * units as u32).saturating_sub(1).max(1) as f32;
+    1.8 * units as f32 * libm::powf(count.max(2) as f32, -1.0 / dims)
 }
 
 /// Why an SRS could not be built.
@@ -228,9 +235,9 @@ mod tests {
     #[test]
     fn same_seed_same_shapes() {
         let p = ChainParams::new(6);
-        let a = Srs::<60, 8>::generate(p, &SrsSettings::new(60, 7)).unwrap();
-        let b = Srs::<60, 8>::generate(p, &SrsSettings::new(60, 7)).unwrap();
-        let c = Srs::<60, 8>::generate(p, &SrsSettings::new(60, 8)).unwrap();
+        let a = Srs::<60, 8>::generate(p, &SrsSettings::new(6, 60, 7)).unwrap();
+        let b = Srs::<60, 8>::generate(p, &SrsSettings::new(6, 60, 7)).unwrap();
+        let c = Srs::<60, 8>::generate(p, &SrsSettings::new(6, 60, 8)).unwrap();
         assert_eq!(a.shapes, b.shapes);
         assert_eq!(a.adjacency, b.adjacency);
         assert_ne!(a.shapes, c.shapes);
@@ -241,7 +248,7 @@ mod tests {
     fn capacity_is_checked() {
         let p = ChainParams::new(4);
         assert_eq!(
-            Srs::<10, 4>::generate(p, &SrsSettings::new(11, 1)).unwrap_err(),
+            Srs::<10, 4>::generate(p, &SrsSettings::new(4, 11, 1)).unwrap_err(),
             SrsError::Capacity
         );
     }
@@ -255,7 +262,7 @@ mod tests {
         };
         let s = SrsSettings {
             max_tries_per_shape: 50,
-            ..SrsSettings::new(3, 1)
+            ..SrsSettings::new(4, 3, 1)
         };
         assert_eq!(
             Srs::<3, 2>::generate(p, &s).unwrap_err(),
@@ -266,7 +273,7 @@ mod tests {
     #[test]
     fn sixteen_units_sample() {
         let p = ChainParams::new(16);
-        let srs = Srs::<20, 6>::generate(p, &SrsSettings::new(20, 3)).unwrap();
+        let srs = Srs::<20, 6>::generate(p, &SrsSettings::new(16, 20, 3)).unwrap();
         assert!(srs.shapes.iter().all(|s| check_shape(&p, s).is_ok()));
     }
 
@@ -278,7 +285,7 @@ mod tests {
         #[test]
         fn shapes_and_edges_are_valid(n in 3u8..9, seed in 0u64..1000) {
             let p = ChainParams::new(n);
-            let srs = Srs::<40, 6>::generate(p, &SrsSettings::new(40, seed)).unwrap();
+            let srs = Srs::<40, 6>::generate(p, &SrsSettings::new(n, 40, seed)).unwrap();
             for s in &srs.shapes {
                 prop_assert!(check_shape(&p, s).is_ok());
             }

@@ -490,7 +490,7 @@ mod tests {
     fn table(n: u8, count: usize, buf: &mut [u8]) -> usize {
         let p = ChainParams::new(n);
         let lib = library(&p);
-        let srs = Srs::<64, 8>::generate(p, &SrsSettings::new(count, 5)).unwrap();
+        let srs = Srs::<64, 8>::generate(p, &SrsSettings::new(n, count, 5)).unwrap();
         encode_into(buf, &p, &lib.entries, &srs.shapes, &srs.adjacency).unwrap()
     }
 
@@ -505,7 +505,7 @@ mod tests {
         for (i, e) in lib.entries.iter().enumerate() {
             assert_eq!(v.lsc(i).unwrap(), *e);
         }
-        let srs = Srs::<64, 8>::generate(p, &SrsSettings::new(40, 5)).unwrap();
+        let srs = Srs::<64, 8>::generate(p, &SrsSettings::new(6, 40, 5)).unwrap();
         let back: Srs<64, 8> = v.to_srs().unwrap();
         assert_eq!(back.shapes, srs.shapes);
         assert_eq!(back.adjacency, srs.adjacency);

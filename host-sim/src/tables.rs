@@ -21,8 +21,8 @@ pub struct TableSettings {
     pub srs: usize,
     /// Seed of the SRS sampler.
     pub seed: u64,
-    /// Roadmap radius `r_S` (in the `C_T` metric).
-    pub r_s: f32,
+    /// Roadmap radius `r_S` (in the `C_T` metric); `None`: `arc_core::srs::default_r_s`.
+    pub r_s: Option<f32>,
 }
 
 impl Default for TableSettings {
@@ -30,7 +30,7 @@ impl Default for TableSettings {
         Self {
             srs: 500,
             seed: 1,
-            r_s: SrsSettings::new(0, 0).r_s,
+            r_s: None,
         }
     }
 }
@@ -86,7 +86,7 @@ impl ShapeTables {
             return Err(TablesError::Srs(SrsError::Capacity));
         }
         let lib = library(&params);
-        let defaults = SrsSettings::new(settings.srs, settings.seed);
+        let defaults = SrsSettings::new(params.units, settings.srs, settings.seed);
         let mut sampler = Sampler::new(params, settings.seed, defaults.max_tries_per_shape);
         let mut srs = Vec::with_capacity(settings.srs);
         for i in 0..settings.srs {
@@ -94,7 +94,7 @@ impl ShapeTables {
             progress.store(i + 1, Ordering::Relaxed);
         }
         let mut adj = vec![Neighbours::<DEGREE>::new(); srs.len()];
-        build_roadmap(&params, &srs, settings.r_s, &mut adj);
+        build_roadmap(&params, &srs, settings.r_s.unwrap_or(defaults.r_s), &mut adj);
         Ok(Self {
             params,
             lsc: lib.entries.to_vec(),
@@ -224,7 +224,7 @@ mod tests {
             &AtomicUsize::new(0),
         )
         .unwrap();
-        let core = arc_core::srs::Srs::<30, DEGREE>::generate(p, &SrsSettings::new(30, 9)).unwrap();
+        let core = arc_core::srs::Srs::<30, DEGREE>::generate(p, &SrsSettings::new(4, 30, 9)).unwrap();
         assert_eq!(t.srs, core.shapes.to_vec());
         let adj: Vec<Vec<u16>> = core.adjacency.iter().map(|a| a.to_vec()).collect();
         assert_eq!(t.adjacency, adj);

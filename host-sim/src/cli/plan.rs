@@ -54,9 +54,9 @@ pub struct PlanArgs {
     /// Headings tried per shape (n_psi).
     #[arg(long, default_value_t = 8)]
     n_psi: usize,
-    /// G_Val connection radius d_c (C_T metric).
-    #[arg(long, default_value_t = 4.0)]
-    d_c: f32,
+    /// G_Val connection radius d_c (C_T metric) [default: r_S for N and N_SRS].
+    #[arg(long)]
+    d_c: Option<f32>,
     /// Random shapes N_SRS (when the tables are generated).
     #[arg(long, default_value_t = 500)]
     srs: usize,
@@ -109,8 +109,8 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
     if a.n_psi == 0 || a.n_psi > 360 {
         return bad("--n-psi", a.n_psi.to_string(), "between 1 and 360");
     }
-    if !(a.d_c.is_finite() && a.d_c > 0.0) {
-        return bad("--d-c", a.d_c.to_string(), "a positive number");
+    if a.d_c.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
+        return bad("--d-c", format!("{:?}", a.d_c), "a positive number");
     }
     if !(a.goal_tol.is_finite() && a.goal_tol >= 0.0) {
         return bad("--goal-tol", a.goal_tol.to_string(), "a number >= 0");

@@ -37,9 +37,9 @@ pub struct BuildArgs {
     /// Seed of the SRS sampler.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Roadmap radius r_S (C_T metric).
-    #[arg(long, default_value_t = TableSettings::default().r_s)]
-    r_s: f32,
+    /// Roadmap radius r_S (C_T metric) [default: 1.8 N N_SRS^(-1/(2N-1))].
+    #[arg(long)]
+    r_s: Option<f32>,
     /// Output file.
     #[arg(long)]
     out: PathBuf,
@@ -76,9 +76,9 @@ fn build(a: BuildArgs) -> CliResult {
             u16::MAX
         )));
     }
-    if !(a.r_s.is_finite() && a.r_s > 0.0) {
+    if a.r_s.is_some_and(|r| !(r.is_finite() && r > 0.0)) {
         return Err(CliError::input(format!(
-            "--r-s {} must be a positive number",
+            "--r-s {:?} must be a positive number",
             a.r_s
         )));
     }

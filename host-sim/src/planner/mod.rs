@@ -60,8 +60,9 @@ pub struct Settings {
     pub r_t: f64,
     /// Discrete headings per library shape and rotations of the current shape.
     pub n_psi: usize,
-    /// `G_Val` connection radius `d_c` (`C_T` metric).
-    pub d_c: f32,
+    /// `G_Val` connection radius `d_c` (`C_T` metric); `None`: the roadmap radius
+    /// `arc_core::srs::default_r_s` for the chain and the SRS size.
+    pub d_c: Option<f32>,
     /// Shape sources.
     pub mode: Mode,
     /// Shape preference.
@@ -85,7 +86,7 @@ impl Default for Settings {
             vertices: 1500,
             r_t: 1.5,
             n_psi: 8,
-            d_c: 4.0,
+            d_c: None,
             mode: Mode::Both,
             prefer: Preference::Least,
             seed: 1,
@@ -552,14 +553,14 @@ impl<'p> Construction<'p> {
         }
         self.stats.srs_connects += 1;
         let srs = &self.planner.tables.srs;
-        let mut pool: Vec<Candidate> = Vec::with_capacity(2 * srs.len() + lib.len());
+        let mut pool: Vec<Candidate> = Vec::with_capacity(2 * srs.len());
         for (k, &shape) in srs.iter().enumerate() {
             pool.push(Candidate { shape, source: Source::Srs(k as u16) });
             // The same shape turned so that its body trails straight behind the edge.
             let turn = arc_core::angle::diff(self.planner.trail_yaw[k], edge_yaw + std::f32::consts::PI);
             pool.push(Candidate { shape: shape.rotated(turn), source: Source::SrsTurned(k as u16) });
         }
-        pool.extend(lib);
+        // G_Val holds the random shapes only, as in the paper: the library was tried in (c).
         srs_connect::connect(
             &mut self.checker,
             a,
@@ -567,7 +568,7 @@ impl<'p> Construction<'p> {
             &cur,
             &pool,
             &self.planner.tables.adjacency,
-            s.d_c,
+            s.d_c.unwrap_or_else(|| arc_core::srs::default_r_s(self.planner.tables.params.units, srs.len())),
         )
     }
 

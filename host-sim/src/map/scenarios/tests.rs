@@ -149,7 +149,7 @@ fn the_straight_chain_cannot_get_through() {
         (window(), 4.0, 4.2),
         (maze(), 2.7, 2.9),
         (silos(), 6.95, 7.05),
-        (corridor(10.0).unwrap(), 5.5, 5.7),
+        (corridor(10.0).unwrap(), 6.5, 6.7),
     ];
     for (s, x0, x1) in cases {
         let p = ChainParams::new(s.default_units);
