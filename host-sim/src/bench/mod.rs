@@ -222,13 +222,24 @@ impl RunResult {
     }
 }
 
-/// CPU time this thread has run so far (s), from `/proc/thread-self/schedstat` (Linux;
-/// `None` where that is unavailable). Unlike wall-clock time it leaves out the time a
+/// CPU time this thread has run so far (s), from `clock_gettime(CLOCK_THREAD_CPUTIME_ID)`
+/// (Unix; `None` elsewhere or on error). Unlike wall-clock time it leaves out the time a
 /// run waits for a core on a loaded machine.
+#[cfg(unix)]
 pub fn thread_cpu_s() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: u64 = s.split_whitespace().next()?.parse().ok()?;
-    Some(ns as f64 * 1e-9)
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the call only writes into it.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    (rc == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+}
+
+/// CPU time this thread has run so far: unavailable off Unix.
+#[cfg(not(unix))]
+pub fn thread_cpu_s() -> Option<f64> {
+    None
 }
 
 /// Wall-clock and CPU time of `f`.
@@ -941,6 +952,23 @@ mod tests {
         assert_eq!(e.n, 0);
         assert!(e.median.is_nan());
         assert_eq!(ms(&e), "-");
+    }
+
+    #[test]
+    fn thread_cpu_time_is_fine_grained() {
+        let Some(a) = thread_cpu_s() else {
+            return;
+        };
+        let mut x = 0u64;
+        let t = Instant::now();
+        while t.elapsed() < Duration::from_millis(20) {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+        }
+        std::hint::black_box(x);
+        let b = thread_cpu_s().unwrap();
+        assert!(b - a > 1e-3, "20 ms of busy work took {} s of CPU", b - a);
+        let c = thread_cpu_s().unwrap();
+        assert!(c - b < 1e-3, "two reads in a row: {} s apart", c - b);
     }
 
     #[test]

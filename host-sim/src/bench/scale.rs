@@ -157,12 +157,7 @@ fn corridor_length(s: &Summary) -> f64 {
 }
 
 /// The markdown report.
-pub fn markdown(
-    sums: &[Summary],
-    o: &ScaleOptions,
-    starts: &[StartChoice],
-    meta: &str,
-) -> String {
+pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta: &str) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# ARC benchmark: scaling\n\n{meta}\n");
     let _ = writeln!(

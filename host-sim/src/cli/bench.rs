@@ -65,10 +65,10 @@ pub struct PaperArgs {
     /// Tables to run, comma-separated (default 1,2,3).
     #[arg(long, value_delimiter = ',')]
     tables: Option<Vec<u8>>,
-    /// Opening (m) of the widened-window variant of Table 3, where the full-state PRM
-    /// can pass; 0 to skip it (default 1.6).
-    #[arg(long)]
-    wide_window: Option<f64>,
+    /// Openings (m) of the widened-window variants of Table 3, where the full-state PRM
+    /// can pass, comma-separated; 0 for none (default 1.0,1.2,1.4,1.6).
+    #[arg(long, value_delimiter = ',')]
+    wide_window: Option<Vec<f64>>,
 }
 
 /// `arc bench scale`
@@ -216,16 +216,16 @@ fn run_paper(a: PaperArgs) -> CliResult {
         prm_units: a.prm_units.clone().unwrap_or(base.prm_units),
         time_limit: time_limit(&a.study, base.time_limit),
         tables: a.tables.clone().unwrap_or(base.tables),
-        wide_window: match a.wide_window {
-            Some(0.0) => None,
-            Some(w) => Some(w),
-            None => base.wide_window,
+        wide_windows: match &a.wide_window {
+            Some(v) if v.as_slice() == [0.0] => Vec::new(),
+            Some(v) => v.clone(),
+            None => base.wide_windows,
         },
     };
-    if let Some(w) = o.wide_window {
+    for &w in &o.wide_windows {
         if !(0.8..=2.4).contains(&w) {
             return Err(CliError::input(format!(
-                "--wide-window {w}: must be 0.8 to 2.4 m (or 0 to skip)"
+                "--wide-window {w}: every opening must be 0.8 to 2.4 m (or 0 alone for none)"
             )));
         }
     }
