@@ -70,6 +70,28 @@ mod tests {
         assert!(close(q[2], [-c30, -0.5, 0.25]));
     }
 
+    proptest::proptest! {
+        /// Rotating a shape about the head moves no unit relative to another, and
+        /// turns every unit about the head by exactly the rotation.
+        #[test]
+        fn rotation_preserves_distances_between_units(
+            eta in proptest::collection::vec(-3.0f32..3.0, 11),
+            d in -7.0f32..7.0,
+        ) {
+            let p = ChainParams::new(6);
+            let s = Shape::from_slice(6, &eta).unwrap();
+            let (a, b) = (offsets(&p, &s), offsets(&p, &s.rotated(d)));
+            for i in 0..6 {
+                for j in 0..6 {
+                    proptest::prop_assert!(((a[i] - a[j]).norm() - (b[i] - b[j]).norm()).abs() < 1e-4);
+                }
+                let (c, sn) = (libm::cosf(d), libm::sinf(d));
+                let turned = Vector3::new(c * a[i].x - sn * a[i].y, sn * a[i].x + c * a[i].y, a[i].z);
+                proptest::prop_assert!((turned - b[i]).norm() < 1e-4);
+            }
+        }
+    }
+
     #[test]
     fn links_keep_their_length() {
         let p = ChainParams::new(16);

@@ -115,15 +115,6 @@ impl Shape {
         s
     }
 
-    /// Every angle wrapped to `(-pi, pi]`.
-    pub fn wrapped(&self) -> Self {
-        let mut s = *self;
-        for a in s.eta.iter_mut() {
-            *a = angle::wrap(*a);
-        }
-        s
-    }
-
     /// The point at fraction `t` of the straight motion from `self` to `to`, each angle
     /// moving along its shortest signed difference (ARC-MODEL.md shape-change edge).
     pub fn lerp(&self, to: &Shape, t: f32) -> Shape {

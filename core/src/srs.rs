@@ -43,7 +43,12 @@ impl SrsSettings {
     /// `count` shapes for a chain of `units` units: `r_S` = [`default_r_s`], 100 000
     /// tries per shape.
     pub fn new(units: u8, count: usize, seed: u64) -> Self {
-        Self { count, seed, r_s: default_r_s(units, count), max_tries_per_shape: 100_000 }
+        Self {
+            count,
+            seed,
+            r_s: default_r_s(units, count),
+            max_tries_per_shape: 100_000,
+        }
     }
 }
 

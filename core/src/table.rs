@@ -532,9 +532,9 @@ mod tests {
     }
 
     #[test]
-    fn every_truncation_and_every_byte_flip_is_rejected() {
+    fn every_truncation_and_every_byte_corruption_is_rejected() {
         let mut buf = [0u8; 8192];
-        let len = table(4, 12, &mut buf);
+        let len = table(3, 4, &mut buf);
         let blob = &buf[..len];
         for cut in 0..len {
             assert!(
@@ -544,7 +544,7 @@ mod tests {
         }
         let mut copy = [0u8; 8192];
         for i in 0..len {
-            for flip in [0x01u8, 0x80, 0xff] {
+            for flip in 1..=255u8 {
                 copy[..len].copy_from_slice(blob);
                 copy[i] ^= flip;
                 assert!(

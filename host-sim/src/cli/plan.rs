@@ -51,6 +51,9 @@ pub struct PlanArgs {
     /// Head roadmap radius r_T (m).
     #[arg(long, default_value_t = 1.5)]
     r_t: f64,
+    /// Most neighbours per head roadmap vertex (the nearest within r_T).
+    #[arg(long, default_value_t = 30)]
+    max_neighbours: usize,
     /// Headings tried per shape (n_psi).
     #[arg(long, default_value_t = 8)]
     n_psi: usize,
@@ -95,10 +98,25 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
         Err(CliError::input(format!("{flag} {v}: must be {want}")))
     };
     if a.max_growth > 8 {
-        return bad("--max-growth", a.max_growth.to_string(), "at most 8 (256 times the vertices)");
+        return bad(
+            "--max-growth",
+            a.max_growth.to_string(),
+            "at most 8 (256 times the vertices)",
+        );
     }
     if !(a.clearance_weight.is_finite() && a.clearance_weight >= 0.0) {
-        return bad("--clearance-weight", a.clearance_weight.to_string(), "a number >= 0");
+        return bad(
+            "--clearance-weight",
+            a.clearance_weight.to_string(),
+            "a number >= 0",
+        );
+    }
+    if a.max_neighbours == 0 {
+        return bad(
+            "--max-neighbours",
+            a.max_neighbours.to_string(),
+            "at least 1",
+        );
     }
     if a.vertices == 0 {
         return bad("--vertices", a.vertices.to_string(), "at least 1");
@@ -215,6 +233,7 @@ pub fn run(a: PlanArgs) -> CliResult {
     let settings = Settings {
         vertices: a.vertices,
         r_t: a.r_t,
+        max_neighbours: a.max_neighbours,
         n_psi: a.n_psi,
         d_c: a.d_c,
         mode: a.mode,

@@ -58,6 +58,8 @@ pub struct Settings {
     pub vertices: usize,
     /// Head roadmap connection radius `r_T` (m).
     pub r_t: f64,
+    /// Most neighbours a vertex takes (the nearest within `r_T`).
+    pub max_neighbours: usize,
     /// Discrete headings per library shape and rotations of the current shape.
     pub n_psi: usize,
     /// `G_Val` connection radius `d_c` (`C_T` metric); `None`: the roadmap radius
@@ -85,6 +87,7 @@ impl Default for Settings {
         Self {
             vertices: 1500,
             r_t: 1.5,
+            max_neighbours: 30,
             n_psi: 8,
             d_c: None,
             mode: Mode::Both,
@@ -255,8 +258,19 @@ impl Planner {
                 chain: ctx.params().units,
             });
         }
-        let trail_yaw = tables.srs.iter().map(|s| trail_yaw(&tables.params, s)).collect();
-        Ok(Self { ctx, tables, trail_yaw, settings, roadmap: None, roadmap_s: 0.0 })
+        let trail_yaw = tables
+            .srs
+            .iter()
+            .map(|s| trail_yaw(&tables.params, s))
+            .collect();
+        Ok(Self {
+            ctx,
+            tables,
+            trail_yaw,
+            settings,
+            roadmap: None,
+            roadmap_s: 0.0,
+        })
     }
 
     /// Builds the head roadmap (once; later calls do nothing).
@@ -269,11 +283,18 @@ impl Planner {
     }
 
     /// (Re)builds the roadmap with `vertices` vertices. The sampler restarts from the
-    /// seed, so a larger roadmap holds every vertex of a smaller one.
+    /// seed, so a larger roadmap holds every vertex of a smaller one. The radius
+    /// shrinks as `(M_VT / vertices)^(1/3)`, so the number of neighbours stays the same.
     fn build_roadmap(&mut self, vertices: usize) {
         let mut rng = Pcg64::seed_from_u64(self.settings.seed);
-        let weight = (self.settings.clearance_weight, self.ctx.params().reach() as f64 / 2.0);
-        self.roadmap = Some(Roadmap::build(&self.ctx, vertices, self.settings.r_t, weight, &mut rng));
+        let weight = (
+            self.settings.clearance_weight,
+            self.ctx.params().reach() as f64 / 2.0,
+        );
+        let r_t =
+            self.settings.r_t * (self.settings.vertices as f64 / vertices.max(1) as f64).cbrt();
+        let near = (r_t, self.settings.max_neighbours);
+        self.roadmap = Some(Roadmap::build(&self.ctx, vertices, near, weight, &mut rng));
     }
 
     /// Forgets the roadmap.
@@ -318,7 +339,8 @@ impl Planner {
         let mut growths = 0;
         let (steps, mut stats, size) = loop {
             let mut roadmap = self.roadmap.take().expect("setup built the roadmap");
-            let result = Construction::new(self, &mut roadmap, start, start_shape, goal, stop, began).run();
+            let result =
+                Construction::new(self, &mut roadmap, start, start_shape, goal, stop, began).run();
             roadmap.clear_query();
             let size = (roadmap.vertex_count(), roadmap.edge_count());
             self.roadmap = Some(roadmap);
@@ -348,7 +370,10 @@ impl Planner {
 /// Yaw of the direction from the head to the centroid of the units of `shape`.
 fn trail_yaw(params: &arc_core::ChainParams, shape: &Shape) -> f32 {
     let p = arc_core::kinematics::offsets(params, shape);
-    let c = p.iter().take(shape.units()).fold(nalgebra::Vector3::zeros(), |a, q| a + q);
+    let c = p
+        .iter()
+        .take(shape.units())
+        .fold(nalgebra::Vector3::zeros(), |a, q| a + q);
     c.y.atan2(c.x)
 }
 
@@ -435,8 +460,14 @@ impl<'p> Construction<'p> {
         // Edges that failed from each vertex, in this query.
         let mut fails = vec![0usize; self.roadmap.len()];
         while i + 1 < path.len() {
-            if self.stop.time_limit.is_some_and(|t| self.began.elapsed() > t) {
-                return Err(PlanError::TimeLimit { replans: self.stats.replans });
+            if self
+                .stop
+                .time_limit
+                .is_some_and(|t| self.began.elapsed() > t)
+            {
+                return Err(PlanError::TimeLimit {
+                    replans: self.stats.replans,
+                });
             }
             let (v, u) = (path[i], path[i + 1]);
             if let Some(changes) = self.connect(v, u) {
@@ -456,11 +487,19 @@ impl<'p> Construction<'p> {
                 self.banned.insert((bad.0.min(bad.1), bad.0.max(bad.1)));
                 self.stats.replans += 1;
                 if self.stats.replans > self.planner.settings.max_replans {
-                    return Err(PlanError::NoShape { from, to, replans: self.stats.replans });
+                    return Err(PlanError::NoShape {
+                        from,
+                        to,
+                        replans: self.stats.replans,
+                    });
                 }
                 let here = trail.last().map(|t| t.0).unwrap_or(self.start);
                 let stuck = fails[here] >= FAILS_BEFORE_BACKING_UP && trail.len() > 1;
-                let route = if stuck { Err(PlanError::Unreachable { tol: 0.0 }) } else { self.route(here) };
+                let route = if stuck {
+                    Err(PlanError::Unreachable { tol: 0.0 })
+                } else {
+                    self.route(here)
+                };
                 match route {
                     Ok(p) => break p,
                     Err(_) if trail.len() > 1 => {
@@ -471,7 +510,13 @@ impl<'p> Construction<'p> {
                         fails[back] += 1;
                         bad = (back, dead);
                     }
-                    Err(_) => return Err(PlanError::NoShape { from, to, replans: self.stats.replans }),
+                    Err(_) => {
+                        return Err(PlanError::NoShape {
+                            from,
+                            to,
+                            replans: self.stats.replans,
+                        })
+                    }
                 }
             };
             i = 0;
@@ -485,11 +530,21 @@ impl<'p> Construction<'p> {
     fn accept(&mut self, v: VertexId, u: VertexId, changes: Vec<Candidate>) {
         let xi = self.roadmap.point(v);
         for c in changes {
-            self.steps.push(Step { xi, shape: c.shape, source: c.source, shape_change: true });
+            self.steps.push(Step {
+                xi,
+                shape: c.shape,
+                source: c.source,
+                shape_change: true,
+            });
             self.current = c;
         }
         let cur = self.current;
-        self.steps.push(Step { xi: self.roadmap.point(u), shape: cur.shape, source: cur.source, shape_change: false });
+        self.steps.push(Step {
+            xi: self.roadmap.point(u),
+            shape: cur.shape,
+            source: cur.source,
+            shape_change: false,
+        });
     }
 
     /// Counts of the final plan's steps (after any backing up).
@@ -555,10 +610,17 @@ impl<'p> Construction<'p> {
         let srs = &self.planner.tables.srs;
         let mut pool: Vec<Candidate> = Vec::with_capacity(2 * srs.len());
         for (k, &shape) in srs.iter().enumerate() {
-            pool.push(Candidate { shape, source: Source::Srs(k as u16) });
+            pool.push(Candidate {
+                shape,
+                source: Source::Srs(k as u16),
+            });
             // The same shape turned so that its body trails straight behind the edge.
-            let turn = arc_core::angle::diff(self.planner.trail_yaw[k], edge_yaw + std::f32::consts::PI);
-            pool.push(Candidate { shape: shape.rotated(turn), source: Source::SrsTurned(k as u16) });
+            let turn =
+                arc_core::angle::diff(self.planner.trail_yaw[k], edge_yaw + std::f32::consts::PI);
+            pool.push(Candidate {
+                shape: shape.rotated(turn),
+                source: Source::SrsTurned(k as u16),
+            });
         }
         // G_Val holds the random shapes only, as in the paper: the library was tried in (c).
         srs_connect::connect(
@@ -568,7 +630,9 @@ impl<'p> Construction<'p> {
             &cur,
             &pool,
             &self.planner.tables.adjacency,
-            s.d_c.unwrap_or_else(|| arc_core::srs::default_r_s(self.planner.tables.params.units, srs.len())),
+            s.d_c.unwrap_or_else(|| {
+                arc_core::srs::default_r_s(self.planner.tables.params.units, srs.len())
+            }),
         )
     }
 

@@ -68,7 +68,7 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 impl Roadmap {
     /// Samples `vertices` free head positions (at most `vertices * 200` tries) and
-    /// joins each to every other within `r_t`.
+    /// joins each to its `k` nearest within `r_t` (edges are kept both ways).
     ///
     /// Edges weigh their length times `1 + w * max(0, 1 - c / c_ref)`, where `c` is
     /// the smaller obstacle clearance of their ends, `w` = `clearance_weight` and
@@ -79,7 +79,7 @@ impl Roadmap {
     pub fn build(
         ctx: &CollisionContext,
         vertices: usize,
-        r_t: f64,
+        (r_t, k): (f64, usize),
         (clearance_weight, clearance_ref): (f64, f64),
         rng: &mut Pcg64,
     ) -> Self {
@@ -98,25 +98,45 @@ impl Roadmap {
             }
         }
         let tree = ImmutableKdTree::new_from_slice(&points);
-        let mut edges: Vec<Vec<Edge>> = vec![Vec::new(); points.len()];
+        // The k nearest within r_T (k + 1: the query finds the vertex itself), then
+        // made symmetric, in vertex order for determinism.
+        let mut adjacent: Vec<Vec<usize>> = vec![Vec::new(); points.len()];
+        let k1 = std::num::NonZero::new(k.saturating_add(1)).expect("k + 1 > 0");
         for (i, p) in points.iter().enumerate() {
-            let mut near = tree.within_unsorted::<SquaredEuclidean>(p, r_t * r_t);
-            // Sorted for determinism (the tree returns neighbours in no set order).
-            near.sort_by_key(|n| n.item);
-            for n in near {
+            for n in tree.nearest_n_within::<SquaredEuclidean>(p, r_t * r_t, k1, true) {
                 let j = n.item as usize;
                 if j != i {
-                    edges[i].push(Edge {
-                        to: j,
-                        length: n.distance.sqrt(),
-                        state: Cell::new(EdgeState::Unchecked),
-                    });
+                    adjacent[i].push(j);
+                    adjacent[j].push(i);
                 }
             }
         }
+        let edges: Vec<Vec<Edge>> = adjacent
+            .into_iter()
+            .enumerate()
+            .map(|(i, mut near)| {
+                near.sort_unstable();
+                near.dedup();
+                let edge = |j: usize| Edge {
+                    to: j,
+                    length: dist(points[i], points[j]),
+                    state: Cell::new(EdgeState::Unchecked),
+                };
+                near.into_iter().map(edge).collect()
+            })
+            .collect();
         let sampled = points.len();
         let clearance = points.iter().map(|&p| ctx.clearance(p)).collect();
-        let mut map = Self { points, clearance, clearance_weight, clearance_ref, edges, tree, r_t, sampled };
+        let mut map = Self {
+            points,
+            clearance,
+            clearance_weight,
+            clearance_ref,
+            edges,
+            tree,
+            r_t,
+            sampled,
+        };
         map.weigh_edges(0);
         map
     }
@@ -230,11 +250,6 @@ impl Roadmap {
                 e.state.set(s);
             }
         }
-    }
-
-    /// Marks an edge as unusable (for the head, or for the whole chain in this query).
-    pub fn block(&self, a: VertexId, b: VertexId) {
-        self.set_state(a, b, EdgeState::Blocked);
     }
 
     /// The shortest head path from `from` to any vertex of `goals`, every edge on it

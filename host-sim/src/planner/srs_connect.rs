@@ -14,11 +14,13 @@
 //! 4. OptAdmissibleTransition: Dijkstra by `C_T` from the current shape to the
 //!    nearest admissible one;
 //! 5. CollisionFreeE: every shape change on that path is checked at `xi_i`
-//!    (limits, self-collision, map); a failing edge is pruned from `G_Val` and the
-//!    search repeats until a path holds or none is left.
+//!    (limits, self-collision, map), and failing edges are pruned from `G_Val`
+//!    until a path holds or none is left. Steps 4 and 5 are one lazy search: a
+//!    change is checked when the search pops the shape it leads to, so no edge is
+//!    checked twice and no search is repeated.
 
 use std::cmp::Ordering;
-use std::collections::{BTreeMap, BTreeSet, BinaryHeap};
+use std::collections::BinaryHeap;
 
 use arc_core::cost::transition_cost;
 
@@ -45,7 +47,11 @@ impl Oracle<'_, '_> {
 
     fn admissible(&mut self, v: usize, nodes: &[Candidate]) -> bool {
         if self.admissible[v].is_none() {
-            self.admissible[v] = Some(self.checker.translation(self.from, self.to, &nodes[v].shape));
+            self.admissible[v] = Some(self.checker.translation(
+                self.from,
+                self.to,
+                &nodes[v].shape,
+            ));
         }
         self.admissible[v] == Some(true)
     }
@@ -71,30 +77,18 @@ pub fn connect(
     let mut nodes = vec![*current];
     nodes.extend_from_slice(pool);
     let n = nodes.len();
-    let mut oracle = Oracle { checker, from, to, valid: vec![None; n], admissible: vec![None; n] };
+    let mut oracle = Oracle {
+        checker,
+        from,
+        to,
+        valid: vec![None; n],
+        admissible: vec![None; n],
+    };
     oracle.valid[0] = Some(true);
     oracle.admissible[0] = Some(false);
     let mut graph = Graph::new(&nodes, srs_adjacency, d_c);
-    let mut pruned: BTreeSet<(usize, usize)> = BTreeSet::new();
-    let mut checked: BTreeMap<(usize, usize), bool> = BTreeMap::new();
-    loop {
-        let path = cheapest(&mut graph, &mut oracle, &pruned)?;
-        let mut ok = true;
-        for w in path.windows(2) {
-            let key = (w[0].min(w[1]), w[0].max(w[1]));
-            let free = *checked
-                .entry(key)
-                .or_insert_with(|| oracle.checker.shape_change(from, &nodes[w[0]].shape, &nodes[w[1]].shape));
-            if !free {
-                pruned.insert(key);
-                ok = false;
-                break;
-            }
-        }
-        if ok {
-            return Some(path[1..].iter().map(|&i| nodes[i]).collect());
-        }
-    }
+    let path = cheapest(&mut graph, &mut oracle)?;
+    Some(path[1..].iter().map(|&i| nodes[i]).collect())
 }
 
 /// `G_Val` with neighbour lists made on first use.
@@ -162,8 +156,10 @@ impl<'a> Graph<'a> {
                     l
                 }
                 Source::SrsTurned(k) if v > 0 => {
-                    let mut l: Vec<(usize, f32)> =
-                        self.srs_node[k as usize].map(|u| (u, self.cost(v, u))).into_iter().collect();
+                    let mut l: Vec<(usize, f32)> = self.srs_node[k as usize]
+                        .map(|u| (u, self.cost(v, u)))
+                        .into_iter()
+                        .collect();
                     l.extend(self.hubs.iter().filter_map(|&u| self.within(v, u)));
                     l
                 }
@@ -177,55 +173,73 @@ impl<'a> Graph<'a> {
     }
 }
 
-/// Dijkstra over `G_Val` (minus `pruned` edges) from vertex 0 to the nearest
-/// admissible vertex.
-fn cheapest(graph: &mut Graph<'_>, oracle: &mut Oracle<'_, '_>, pruned: &BTreeSet<(usize, usize)>) -> Option<Vec<usize>> {
+/// Lazy Dijkstra over `G_Val` from vertex 0 to the nearest admissible vertex.
+///
+/// OptAdmissibleTransition, CollisionFreeE and the pruning of Alg. 3 in one search:
+/// a shape enters the open list with the shape change that reaches it unchecked;
+/// the change is checked (at `xi_i`: limits, self-collision, map) when that entry
+/// is popped, and a failed one is dropped, which prunes that edge. So each edge is
+/// checked at most once and the path returned is checked throughout.
+fn cheapest(graph: &mut Graph<'_>, oracle: &mut Oracle<'_, '_>) -> Option<Vec<usize>> {
     let n = graph.nodes.len();
-    let mut dist = vec![f32::INFINITY; n];
+    let nodes = graph.nodes;
     let mut parent = vec![usize::MAX; n];
     let mut done = vec![false; n];
     let mut open = BinaryHeap::new();
-    dist[0] = 0.0;
-    open.push(Entry { d: 0.0, v: 0 });
-    while let Some(Entry { d, v }) = open.pop() {
+    open.push(Entry {
+        d: 0.0,
+        v: 0,
+        via: usize::MAX,
+    });
+    while let Some(Entry { d, v, via }) = open.pop() {
         if done[v] {
             continue;
         }
+        if via != usize::MAX
+            && !oracle
+                .checker
+                .shape_change(oracle.from, &nodes[via].shape, &nodes[v].shape)
+        {
+            continue;
+        }
         done[v] = true;
-        if v != 0 && oracle.admissible(v, graph.nodes) {
+        parent[v] = via;
+        if v != 0 && oracle.admissible(v, nodes) {
             let mut path = vec![v];
-            while path[path.len() - 1] != 0 {
+            while parent[path[path.len() - 1]] != usize::MAX {
                 path.push(parent[path[path.len() - 1]]);
             }
             path.reverse();
             return Some(path);
         }
-        let nodes = graph.nodes;
         for &(u, c) in graph.neighbours(v) {
-            if done[u] || pruned.contains(&(v.min(u), v.max(u))) || !oracle.valid(u, nodes) {
-                continue;
-            }
-            if d + c < dist[u] {
-                dist[u] = d + c;
-                parent[u] = v;
-                open.push(Entry { d: d + c, v: u });
+            if !done[u] && oracle.valid(u, nodes) {
+                open.push(Entry {
+                    d: d + c,
+                    v: u,
+                    via: v,
+                });
             }
         }
     }
     None
 }
 
+/// Open-list entry: shape `v` reached from `via` at cost `d`.
 #[derive(PartialEq)]
 struct Entry {
     d: f32,
     v: usize,
+    via: usize,
 }
 
 impl Eq for Entry {}
 
 impl Ord for Entry {
     fn cmp(&self, o: &Self) -> Ordering {
-        o.d.total_cmp(&self.d).then_with(|| o.v.cmp(&self.v))
+        o.d.total_cmp(&self.d)
+            .then_with(|| o.v.cmp(&self.v))
+            .then_with(|| o.via.cmp(&self.via))
     }
 }
 
