@@ -348,7 +348,7 @@ impl Planner {
                 Ok((steps, stats)) => break (steps, stats, size),
                 Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
                     if growths < self.settings.max_growth
-                        && !stop.time_limit.is_some_and(|t| began.elapsed() > t) =>
+                        && stop.time_limit.is_none_or(|t| began.elapsed() <= t) =>
                 {
                     growths += 1;
                     self.build_roadmap(self.settings.vertices << growths);
@@ -458,7 +458,7 @@ impl<'p> Construction<'p> {
         // Where the chain has been: vertex, its shape there, steps up to arriving.
         let mut trail = vec![(self.start, self.current, self.steps.len())];
         // Edges that failed from each vertex, in this query.
-        let mut fails = vec![0usize; self.roadmap.len()];
+        let mut fails = vec![0usize; self.roadmap.total_vertices()];
         while i + 1 < path.len() {
             if self
                 .stop

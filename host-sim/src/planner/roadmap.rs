@@ -160,7 +160,7 @@ impl Roadmap {
     }
 
     /// Number of vertices, query vertices included.
-    pub fn len(&self) -> usize {
+    pub fn total_vertices(&self) -> usize {
         self.points.len()
     }
 
