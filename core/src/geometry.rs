@@ -4,6 +4,11 @@ use nalgebra::Vector3;
 
 /// Distance from point `p` to the segment `a b`.
 pub fn point_segment_distance(p: &Vector3<f32>, a: &Vector3<f32>, b: &Vector3<f32>) -> f32 {
+    libm::sqrtf(point_segment_distance_squared(p, a, b))
+}
+
+/// Squared distance from point `p` to the segment `a b` (no square root).
+pub fn point_segment_distance_squared(p: &Vector3<f32>, a: &Vector3<f32>, b: &Vector3<f32>) -> f32 {
     let ab = b - a;
     let len2 = ab.norm_squared();
     let t = if len2 > 0.0 {
@@ -11,7 +16,7 @@ pub fn point_segment_distance(p: &Vector3<f32>, a: &Vector3<f32>, b: &Vector3<f3
     } else {
         0.0
     };
-    (a + ab * t - p).norm()
+    (a + ab * t - p).norm_squared()
 }
 
 /// Smallest distance between segments `p1 q1` and `p2 q2` (closest points by

@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 
-use crate::params::{ChainParams, MAX_UNITS};
+use crate::params::{ChainParams, MAX_LINKS, MAX_UNITS};
 use crate::shape::{Config, Shape};
 
 /// Unit centres of a chain, head first; only the first N entries are meaningful.
@@ -17,11 +17,29 @@ pub fn link_direction(pitch: f32, yaw: f32) -> Vector3<f32> {
     Vector3::new(cp * ct, sp * ct, -st)
 }
 
+/// Every link's direction (see [`link_direction`]); only the first N-1 are meaningful.
+pub fn directions(shape: &Shape) -> [Vector3<f32>; MAX_LINKS] {
+    let mut d = [Vector3::zeros(); MAX_LINKS];
+    for (k, v) in d.iter_mut().enumerate().take(shape.links()) {
+        *v = link_direction(shape.pitch(k), shape.yaw(k));
+    }
+    d
+}
+
 /// Unit centres relative to the head (`offsets[0]` is zero).
 pub fn offsets(params: &ChainParams, shape: &Shape) -> Points {
+    offsets_from(params, &directions(shape), shape.links())
+}
+
+/// Unit centres relative to the head from the first `links` link directions.
+pub fn offsets_from(
+    params: &ChainParams,
+    dirs: &[Vector3<f32>; MAX_LINKS],
+    links: usize,
+) -> Points {
     let mut p = [Vector3::zeros(); MAX_UNITS];
-    for k in 0..shape.links() {
-        p[k + 1] = p[k] - params.link_length * link_direction(shape.pitch(k), shape.yaw(k));
+    for k in 0..links {
+        p[k + 1] = p[k] - params.link_length * dirs[k];
     }
     p
 }

@@ -7,8 +7,12 @@
 //! the links ending at it, consecutive links, and consecutive units. Touching counts
 //! as a collision.
 
-use crate::geometry::{point_segment_distance, segment_segment_distance};
-use crate::kinematics::{link_direction, offsets, Points};
+use crate::geometry::{
+    point_segment_distance, point_segment_distance_squared, segment_segment_distance,
+};
+use nalgebra::Vector3;
+
+use crate::kinematics::{directions, link_direction, offsets, offsets_from, Points};
 use crate::params::{ChainParams, MAX_LINKS};
 use crate::shape::Shape;
 
@@ -68,13 +72,23 @@ pub fn bend(shape: &Shape, k: usize) -> f32 {
 
 /// Joint limits only: pitch of every link, bend between consecutive links.
 pub fn check_limits(params: &ChainParams, shape: &Shape) -> Result<(), Violation> {
+    limits_with(params, shape, &directions(shape))
+}
+
+/// [`check_limits`] with the link directions already computed.
+fn limits_with(
+    params: &ChainParams,
+    shape: &Shape,
+    dirs: &[Vector3<f32>; MAX_LINKS],
+) -> Result<(), Violation> {
     for k in 0..shape.links() {
         if shape.pitch(k).abs() > params.theta_max {
             return Err(Violation::Pitch(k as u8));
         }
     }
     for k in 0..shape.links().saturating_sub(1) {
-        if bend(shape, k) > params.beta_max {
+        // The same value as `bend`, from the directions at hand.
+        if libm::acosf(dirs[k].dot(&dirs[k + 1]).clamp(-1.0, 1.0)) > params.beta_max {
             return Err(Violation::Bend(k as u8));
         }
     }
@@ -83,17 +97,51 @@ pub fn check_limits(params: &ChainParams, shape: &Shape) -> Result<(), Violation
 
 /// Exact validity of one shape: limits, then self-collision.
 pub fn check_shape(params: &ChainParams, shape: &Shape) -> Result<(), Violation> {
-    check_limits(params, shape)?;
-    let p = offsets(params, shape);
-    let mut first = Ok(());
-    visit_pairs(params, shape.units(), &p, |a, b, gap| {
-        if gap <= 0.0 {
-            first = Err(Violation::SelfCollision(a, b));
-            return false;
+    let dirs = directions(shape);
+    limits_with(params, shape, &dirs)?;
+    let p = offsets_from(params, &dirs, shape.links());
+    self_collision(params, shape.units(), &p)
+}
+
+/// The first pair of bodies (sharing no joint) that touch: the same test as
+/// [`visit_pairs`] with `gap <= 0`, on squared distances where it can.
+fn self_collision(params: &ChainParams, units: usize, p: &Points) -> Result<(), Violation> {
+    let (ru, rl, l) = (params.unit_radius, params.link_radius, params.link_length);
+    let (uu, ul) = ((2.0 * ru) * (2.0 * ru), (ru + rl) * (ru + rl));
+    for i in 0..units {
+        for j in i + 2..units {
+            if (p[i] - p[j]).norm_squared() <= uu {
+                return Err(Violation::SelfCollision(
+                    Body::Unit(i as u8),
+                    Body::Unit(j as u8),
+                ));
+            }
         }
-        true
-    });
-    first
+        for m in (0..units - 1).filter(|&m| i != m && i != m + 1) {
+            if point_segment_distance_squared(&p[i], &p[m], &p[m + 1]) <= ul {
+                return Err(Violation::SelfCollision(
+                    Body::Unit(i as u8),
+                    Body::Link(m as u8),
+                ));
+            }
+        }
+    }
+    // Links whose midpoints are farther apart than l + 2 r_l cannot touch.
+    let far = (l + 2.0 * rl) * (l + 2.0 * rl);
+    for a in 0..units - 1 {
+        for b in a + 2..units - 1 {
+            let (ma, mb) = ((p[a] + p[a + 1]) * 0.5, (p[b] + p[b + 1]) * 0.5);
+            if (ma - mb).norm_squared() <= far
+                && segment_segment_distance(&p[a], &p[a + 1], &p[b], &p[b + 1]) <= 2.0 * rl
+            {
+                return Err(Violation::SelfCollision(
+                    Body::Link(a as u8),
+                    Body::Link(b as u8),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Calls `f(a, b, gap)` for every pair of bodies that share no joint, where `gap` is
@@ -232,6 +280,21 @@ fn safe_step(
 mod tests {
     use super::*;
     use crate::angle::deg;
+
+    proptest::proptest! {
+        /// The squared-distance test of `check_shape` finds a collision exactly
+        /// when `visit_pairs` reports a gap <= 0 (away from rounding ties).
+        #[test]
+        fn fast_self_collision_agrees_with_the_gaps(eta in proptest::collection::vec(-3.0f32..3.0, 11)) {
+            let p = ChainParams { beta_max: core::f32::consts::PI, ..ChainParams::new(6) };
+            let s = Shape::from_slice(6, &eta).unwrap();
+            let pts = offsets(&p, &s);
+            let mut min_gap = f32::INFINITY;
+            visit_pairs(&p, 6, &pts, |_, _, g| { min_gap = min_gap.min(g); true });
+            proptest::prop_assume!(min_gap.abs() > 1e-4);
+            proptest::prop_assert_eq!(self_collision(&p, 6, &pts).is_err(), min_gap <= 0.0);
+        }
+    }
 
     #[test]
     fn line_is_valid_for_every_n() {
