@@ -5,7 +5,14 @@ use arc_tests::cargo;
 
 fn build_core(features: &[&str]) {
     let mut c = cargo("cross");
-    c.args(["build", "--release", "-p", "arc-core", "--target", "thumbv7em-none-eabihf"]);
+    c.args([
+        "build",
+        "--release",
+        "-p",
+        "arc-core",
+        "--target",
+        "thumbv7em-none-eabihf",
+    ]);
     if !features.is_empty() {
         c.args(["--features", &features.join(",")]);
     }

@@ -28,8 +28,16 @@ fn s(p: &Path) -> &str {
 fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
     let out = dir.join(format!("{scenario}-{units}.json"));
     let n = units.to_string();
-    arc(&["plan", "--scenario", scenario, "--units", &n, "--out", s(&out)])
-        .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
+    arc(&[
+        "plan",
+        "--scenario",
+        scenario,
+        "--units",
+        &n,
+        "--out",
+        s(&out),
+    ])
+    .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
     arc(&["verify", "--scenario", scenario, "--plan", s(&out)])
         .unwrap_or_else(|e| panic!("{scenario} N={units}: arc verify: {e}"));
     let plan = Plan::read(&out).expect("plan file reads back");
@@ -46,14 +54,22 @@ fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
     }
     let last = plan.waypoints[plan.waypoints.len() - 1].xi();
     let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
-    assert!(d <= 0.3 + 1e-9, "{scenario} N={units}: ends {d} m from the goal");
-    let changes = plan.stats["shape_changes"].as_u64().expect("shape_changes in stats");
+    assert!(
+        d <= 0.3 + 1e-9,
+        "{scenario} N={units}: ends {d} m from the goal"
+    );
+    let changes = plan.stats["shape_changes"]
+        .as_u64()
+        .expect("shape_changes in stats");
     eprintln!(
         "{scenario} N={units}: {} waypoints, {changes} shape changes, min clearance {:.3} m",
         plan.waypoints.len(),
         report.min_clearance
     );
-    assert!(changes > 0, "the scenarios are built so that the chain must change shape");
+    assert!(
+        changes > 0,
+        "the scenarios are built so that the chain must change shape"
+    );
     plan
 }
 
@@ -94,14 +110,30 @@ fn same_seed_same_plan_byte_for_byte() {
     let dir = tmp();
     let run = |name: &str, seed: &str| -> String {
         let out = dir.path().join(name);
-        arc(&["plan", "--scenario", "window", "--units", "5", "--seed", seed, "--out", s(&out)]).expect("plan");
-        let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        arc(&[
+            "plan",
+            "--scenario",
+            "window",
+            "--units",
+            "5",
+            "--seed",
+            seed,
+            "--out",
+            s(&out),
+        ])
+        .expect("plan");
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
         // Wall-clock timings are the one part that differs between runs.
         v["stats"].as_object_mut().unwrap().remove("timing");
         serde_json::to_string_pretty(&v).unwrap()
     };
     assert_eq!(run("a.json", "7"), run("b.json", "7"));
-    assert_ne!(run("c.json", "7"), run("d.json", "8"), "another seed, another roadmap");
+    assert_ne!(
+        run("c.json", "7"),
+        run("d.json", "8"),
+        "another seed, another roadmap"
+    );
 }
 
 /// A map of two sealed rooms: free inside, walls around and between.
@@ -126,13 +158,31 @@ fn unreachable_goal_exits_1_with_the_reason() {
     let map = sealed_rooms(dir.path());
     let out = dir.path().join("p.json");
     let e = arc(&[
-        "plan", "--map", s(&map), "--units", "4", "--start", "3,2,1.5", "--start-yaw-deg", "0",
-        "--goal", "6,2,1.5", "--vertices", "300", "--max-growth", "1", "--out", s(&out),
+        "plan",
+        "--map",
+        s(&map),
+        "--units",
+        "4",
+        "--start",
+        "3,2,1.5",
+        "--start-yaw-deg",
+        "0",
+        "--goal",
+        "6,2,1.5",
+        "--vertices",
+        "300",
+        "--max-growth",
+        "1",
+        "--out",
+        s(&out),
     ])
     .unwrap_err();
     assert_eq!(e.code, 1, "{e}");
     assert!(e.message.contains("not reachable"), "{e}");
-    assert!(!out.exists(), "no plan file is written when there is no plan");
+    assert!(
+        !out.exists(),
+        "no plan file is written when there is no plan"
+    );
 }
 
 #[test]
@@ -141,12 +191,24 @@ fn start_in_collision_names_the_body() {
     let out = dir.path().join("p.json");
     // Window scenario: the dividing wall stands at x = 4.0..4.2; unit 3 lands in it.
     let e = arc(&[
-        "plan", "--scenario", "window", "--units", "4", "--start", "5.1,1,1.5", "--start-yaw-deg", "0",
-        "--out", s(&out),
+        "plan",
+        "--scenario",
+        "window",
+        "--units",
+        "4",
+        "--start",
+        "5.1,1,1.5",
+        "--start-yaw-deg",
+        "0",
+        "--out",
+        s(&out),
     ])
     .unwrap_err();
     assert_eq!(e.code, 1, "{e}");
-    assert!(e.message.contains("start is invalid") && e.message.contains("unit"), "{e}");
+    assert!(
+        e.message.contains("start is invalid") && e.message.contains("unit"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -155,17 +217,69 @@ fn malformed_input_exits_2() {
     let out = dir.path().join("p.json");
     let o = s(&out);
     let garbage = dir.path().join("garbage.bt");
-    std::fs::write(&garbage, b"# Octomap OcTree binary file\nid OcTree\nsize 99\nres 0.1\ndata\n\x03").unwrap();
+    std::fs::write(
+        &garbage,
+        b"# Octomap OcTree binary file\nid OcTree\nsize 99\nres 0.1\ndata\n\x03",
+    )
+    .unwrap();
     let cases: Vec<Vec<&str>> = vec![
         vec!["plan", "--scenario", "window", "--out"],
         vec!["plan", "--scenario", "window", "--start", "1,2", "--out", o],
         vec!["plan", "--scenario", "window", "--units", "40", "--out", o],
         vec!["plan", "--scenario", "nowhere", "--out", o],
-        vec!["plan", "--map", "/no/such/map.bt", "--units", "4", "--start", "1,1,1", "--goal", "2,2,2", "--out", o],
-        vec!["plan", "--map", s(&garbage), "--units", "4", "--start", "1,1,1", "--goal", "2,2,2", "--out", o],
-        vec!["plan", "--scenario", "window", "--vertices", "0", "--out", o],
-        vec!["plan", "--scenario", "window", "--start-shape", "XX", "--out", o],
-        vec!["plan", "--scenario", "window", "--tables", s(&garbage), "--out", o],
+        vec![
+            "plan",
+            "--map",
+            "/no/such/map.bt",
+            "--units",
+            "4",
+            "--start",
+            "1,1,1",
+            "--goal",
+            "2,2,2",
+            "--out",
+            o,
+        ],
+        vec![
+            "plan",
+            "--map",
+            s(&garbage),
+            "--units",
+            "4",
+            "--start",
+            "1,1,1",
+            "--goal",
+            "2,2,2",
+            "--out",
+            o,
+        ],
+        vec![
+            "plan",
+            "--scenario",
+            "window",
+            "--vertices",
+            "0",
+            "--out",
+            o,
+        ],
+        vec![
+            "plan",
+            "--scenario",
+            "window",
+            "--start-shape",
+            "XX",
+            "--out",
+            o,
+        ],
+        vec![
+            "plan",
+            "--scenario",
+            "window",
+            "--tables",
+            s(&garbage),
+            "--out",
+            o,
+        ],
         vec!["verify", "--scenario", "window", "--plan", s(&garbage)],
         vec!["tables", "inspect", s(&garbage)],
         vec!["frobnicate"],
@@ -197,15 +311,52 @@ fn a_tampered_plan_fails_verification() {
 fn plans_from_a_table_file_match_generated_tables() {
     let dir = tmp();
     let table = dir.path().join("t5.arct");
-    arc(&["tables", "build", "--units", "5", "--srs", "500", "--seed", "1", "--out", s(&table)]).unwrap();
+    arc(&[
+        "tables",
+        "build",
+        "--units",
+        "5",
+        "--srs",
+        "500",
+        "--seed",
+        "1",
+        "--out",
+        s(&table),
+    ])
+    .unwrap();
     arc(&["tables", "inspect", s(&table)]).unwrap();
     let (a, b) = (dir.path().join("a.json"), dir.path().join("b.json"));
     arc(&["plan", "--scenario", "maze", "--units", "5", "--out", s(&a)]).unwrap();
-    arc(&["plan", "--scenario", "maze", "--units", "5", "--tables", s(&table), "--out", s(&b)]).unwrap();
+    arc(&[
+        "plan",
+        "--scenario",
+        "maze",
+        "--units",
+        "5",
+        "--tables",
+        s(&table),
+        "--out",
+        s(&b),
+    ])
+    .unwrap();
     let (pa, pb) = (Plan::read(&a).unwrap(), Plan::read(&b).unwrap());
-    assert_eq!(pa.waypoints, pb.waypoints, "the file holds the very shapes the generator makes");
+    assert_eq!(
+        pa.waypoints, pb.waypoints,
+        "the file holds the very shapes the generator makes"
+    );
     // A table for another chain is refused.
-    let e = arc(&["plan", "--scenario", "maze", "--units", "6", "--tables", s(&table), "--out", s(&a)]).unwrap_err();
+    let e = arc(&[
+        "plan",
+        "--scenario",
+        "maze",
+        "--units",
+        "6",
+        "--tables",
+        s(&table),
+        "--out",
+        s(&a),
+    ])
+    .unwrap_err();
     assert_eq!(e.code, 2);
     assert!(e.message.contains("another chain"), "{e}");
 }

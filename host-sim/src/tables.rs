@@ -94,7 +94,12 @@ impl ShapeTables {
             progress.store(i + 1, Ordering::Relaxed);
         }
         let mut adj = vec![Neighbours::<DEGREE>::new(); srs.len()];
-        build_roadmap(&params, &srs, settings.r_s.unwrap_or(defaults.r_s), &mut adj);
+        build_roadmap(
+            &params,
+            &srs,
+            settings.r_s.unwrap_or(defaults.r_s),
+            &mut adj,
+        );
         Ok(Self {
             params,
             lsc: lib.entries.to_vec(),
@@ -224,7 +229,8 @@ mod tests {
             &AtomicUsize::new(0),
         )
         .unwrap();
-        let core = arc_core::srs::Srs::<30, DEGREE>::generate(p, &SrsSettings::new(4, 30, 9)).unwrap();
+        let core =
+            arc_core::srs::Srs::<30, DEGREE>::generate(p, &SrsSettings::new(4, 30, 9)).unwrap();
         assert_eq!(t.srs, core.shapes.to_vec());
         let adj: Vec<Vec<u16>> = core.adjacency.iter().map(|a| a.to_vec()).collect();
         assert_eq!(t.adjacency, adj);

@@ -2,5 +2,5 @@
 pub mod distance;
 pub mod grid;
 pub mod octomap;
-pub mod scenarios;
 pub mod picture;
+pub mod scenarios;
