@@ -381,7 +381,7 @@ fn run_prm(a: PrmArgs) -> CliResult {
         .map(f64::to_radians)
         .or(sc.map(|s| s.start_yaw))
         .unwrap_or(0.0);
-    let shape = super::plan::start_shape(&params, &a.start_shape, yaw as f32)?;
+    let shape = super::common::start_shape(&params, &a.start_shape, yaw as f32)?;
     let grid = loaded.grid.clone();
     let (field, _) = loaded.into_field();
     let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;

@@ -3,6 +3,8 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use arc_core::lsc::{library, LscKind};
+use arc_core::{ChainParams, Shape};
 use clap::Args;
 
 use super::CliError;
@@ -118,6 +120,84 @@ impl LoadedMap {
     pub fn into_field(self) -> (Arc<DistanceField>, Option<Scenario>) {
         (Arc::new(DistanceField::new(self.grid)), self.scenario)
     }
+}
+
+/// Where a query starts and ends; a scenario supplies what is not given.
+#[derive(Args, Debug, Clone)]
+pub struct QueryArgs {
+    /// Head start position x,y,z (m); a scenario has its own.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    pub start: Option<[f64; 3]>,
+    /// Start yaw (degrees); a scenario has its own.
+    #[arg(long, allow_hyphen_values = true)]
+    pub start_yaw_deg: Option<f64>,
+    /// Start shape: a library name (LI, SE, SM, SV, CA, PN) turned to the start yaw.
+    #[arg(long, default_value = "LI")]
+    pub start_shape: String,
+    /// Head goal position x,y,z (m); a scenario has its own.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    pub goal: Option<[f64; 3]>,
+}
+
+/// A resolved query: the chain, the start configuration and the goal.
+pub struct Query {
+    /// The chain (validated).
+    pub params: ChainParams,
+    /// Head start position (m).
+    pub start: [f64; 3],
+    /// Start shape.
+    pub shape: Shape,
+    /// Head goal position (m).
+    pub goal: [f64; 3],
+}
+
+impl QueryArgs {
+    /// The query, with the scenario's chain size, start, yaw and goal where not given.
+    pub fn resolve(&self, chain: &ChainArgs, sc: Option<&Scenario>) -> Result<Query, CliError> {
+        let units = chain
+            .units
+            .or(sc.map(|s| s.default_units))
+            .ok_or_else(|| CliError::input("--units is required with --map"))?;
+        let params = chain.params(units)?;
+        let start = self
+            .start
+            .or(sc.map(|s| s.start))
+            .ok_or_else(|| CliError::input("--start is required with --map"))?;
+        let goal = self
+            .goal
+            .or(sc.map(|s| s.goal))
+            .ok_or_else(|| CliError::input("--goal is required with --map"))?;
+        let yaw = self
+            .start_yaw_deg
+            .map(f64::to_radians)
+            .or(sc.map(|s| s.start_yaw))
+            .unwrap_or(0.0);
+        let shape = start_shape(&params, &self.start_shape, yaw as f32)?;
+        Ok(Query {
+            params,
+            start,
+            shape,
+            goal,
+        })
+    }
+}
+
+/// The start shape: a library shape turned so the head looks along `yaw`.
+pub fn start_shape(params: &ChainParams, name: &str, yaw: f32) -> Result<Shape, CliError> {
+    let kind = LscKind::from_name(name).ok_or_else(|| {
+        CliError::input(format!(
+            "--start-shape {name}: not one of LI SE SM SV CA PN"
+        ))
+    })?;
+    let lib = library(params);
+    let e = lib.get(kind).ok_or_else(|| {
+        CliError::input(format!(
+            "--start-shape {name}: not in the library for N = {}",
+            params.units
+        ))
+    })?;
+    Ok(e.shape
+        .rotated(arc_core::angle::diff(e.shape.head_yaw(), yaw)))
 }
 
 /// Parses `x,y,z`.

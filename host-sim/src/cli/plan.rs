@@ -4,11 +4,10 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicUsize;
 use std::time::Duration;
 
-use arc_core::lsc::{library, LscKind};
-use arc_core::{ChainParams, Shape};
+use arc_core::ChainParams;
 use clap::Args;
 
-use super::common::{parse_point, ChainArgs, MapArgs};
+use super::common::{ChainArgs, MapArgs, Query, QueryArgs};
 use super::{CliError, CliResult};
 use crate::collision::{CollisionContext, DEFAULT_CLEARANCE};
 use crate::planner::{motion, Mode, Planner, Preference, Settings, Termination};
@@ -21,18 +20,8 @@ pub struct PlanArgs {
     map: MapArgs,
     #[command(flatten)]
     chain: ChainArgs,
-    /// Head start position x,y,z (m); a scenario has its own.
-    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
-    start: Option<[f64; 3]>,
-    /// Start yaw (degrees); a scenario has its own.
-    #[arg(long, allow_hyphen_values = true)]
-    start_yaw_deg: Option<f64>,
-    /// Start shape: a library name (LI, SE, SM, SV, CA, PN) turned to the start yaw.
-    #[arg(long, default_value = "LI")]
-    start_shape: String,
-    /// Head goal position x,y,z (m); a scenario has its own.
-    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
-    goal: Option<[f64; 3]>,
+    #[command(flatten)]
+    query: QueryArgs,
     /// Goal tolerance for the head (m).
     #[arg(long, default_value_t = 0.3)]
     goal_tol: f64,
@@ -149,24 +138,6 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The start shape: a library shape turned so the head looks along `yaw`.
-pub fn start_shape(params: &ChainParams, name: &str, yaw: f32) -> Result<Shape, CliError> {
-    let kind = LscKind::from_name(name).ok_or_else(|| {
-        CliError::input(format!(
-            "--start-shape {name}: not one of LI SE SM SV CA PN"
-        ))
-    })?;
-    let lib = library(params);
-    let e = lib.get(kind).ok_or_else(|| {
-        CliError::input(format!(
-            "--start-shape {name}: not in the library for N = {}",
-            params.units
-        ))
-    })?;
-    Ok(e.shape
-        .rotated(arc_core::angle::diff(e.shape.head_yaw(), yaw)))
-}
-
 /// The tables: read from `--tables` (and checked against the chain) or generated.
 pub fn load_tables(
     path: Option<&PathBuf>,
@@ -205,27 +176,12 @@ pub fn load_tables(
 pub fn run(a: PlanArgs) -> CliResult {
     check(&a)?;
     let loaded = a.map.load()?;
-    let sc = loaded.scenario.as_ref();
-    let units = a
-        .chain
-        .units
-        .or(sc.map(|s| s.default_units))
-        .ok_or_else(|| CliError::input("--units is required with --map"))?;
-    let params = a.chain.params(units)?;
-    let start = a
-        .start
-        .or(sc.map(|s| s.start))
-        .ok_or_else(|| CliError::input("--start is required with --map"))?;
-    let goal = a
-        .goal
-        .or(sc.map(|s| s.goal))
-        .ok_or_else(|| CliError::input("--goal is required with --map"))?;
-    let yaw = a
-        .start_yaw_deg
-        .map(f64::to_radians)
-        .or(sc.map(|s| s.start_yaw))
-        .unwrap_or(0.0);
-    let shape = start_shape(&params, &a.start_shape, yaw as f32)?;
+    let Query {
+        params,
+        start,
+        shape,
+        goal,
+    } = a.query.resolve(&a.chain, loaded.scenario.as_ref())?;
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
     let (resolution, unknown_occ) = (loaded.grid.resolution(), loaded.grid.unknown_is_occupied());
     let (field, _) = loaded.into_field();
