@@ -63,7 +63,10 @@ fn draw_one<DB: DrawingBackend>(
     macro_rules! body {
         ($chart:expr) => {{
             let mut ch = $chart;
+            let whole = |x: &f64| format!("{x:.0}");
             ch.configure_mesh()
+                .light_line_style(WHITE)
+                .x_label_formatter(&whole)
                 .x_desc(c.x_label.as_str())
                 .y_desc(c.y_label.as_str())
                 .draw()
@@ -128,7 +131,12 @@ pub fn svg(charts: &[Chart], rows: usize, cols: usize, size: (u32, u32)) -> Resu
         }
         root.present().map_err(|e| format!("plot: {e}"))?;
     }
-    Ok(buf)
+    // The rasteriser maps the generic "sans-serif" to Arial, which may be missing: name
+    // the fonts the project's pictures use first.
+    Ok(buf.replace(
+        "font-family=\"sans-serif\"",
+        "font-family=\"DejaVu Sans, Arial, sans-serif\"",
+    ))
 }
 
 /// `(x, median, q1, q3)` of the successful runs' query times (ms) of `sums`, by `x`.
@@ -201,5 +209,6 @@ mod tests {
         let s = svg(&charts, 1, 2, (800, 400)).unwrap();
         assert!(s.starts_with("<svg"));
         assert!(s.contains("</svg>"));
+        assert!(s.contains("DejaVu Sans") && !s.contains("font-family=\"sans-serif\""));
     }
 }

@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 
 use clap::{Args, Subcommand};
 
-use super::common::{parse_point, ChainArgs, MapArgs};
+use super::common::{ChainArgs, MapArgs, Query, QueryArgs};
 use super::{CliError, CliResult};
 use crate::baseline::{self, FullStatePrm, PrmError, PrmSettings};
 use crate::bench::{self, paper, scale};
@@ -95,18 +95,8 @@ pub struct PrmArgs {
     map: MapArgs,
     #[command(flatten)]
     chain: ChainArgs,
-    /// Head start position x,y,z (m); a scenario has its own.
-    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
-    start: Option<[f64; 3]>,
-    /// Start yaw (degrees); a scenario has its own.
-    #[arg(long, allow_hyphen_values = true)]
-    start_yaw_deg: Option<f64>,
-    /// Start shape: a library name (LI, SE, SM, SV, CA, PN) turned to the start yaw.
-    #[arg(long, default_value = "LI")]
-    start_shape: String,
-    /// Head goal position x,y,z (m); a scenario has its own.
-    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
-    goal: Option<[f64; 3]>,
+    #[command(flatten)]
+    query: QueryArgs,
     /// Goal tolerance for the head (m).
     #[arg(long, default_value_t = 0.3)]
     goal_tol: f64,
@@ -361,27 +351,12 @@ fn run_prm(a: PrmArgs) -> CliResult {
         )));
     }
     let loaded = a.map.load()?;
-    let sc = loaded.scenario.as_ref();
-    let units = a
-        .chain
-        .units
-        .or(sc.map(|s| s.default_units))
-        .ok_or_else(|| CliError::input("--units is required with --map"))?;
-    let params = a.chain.params(units)?;
-    let start = a
-        .start
-        .or(sc.map(|s| s.start))
-        .ok_or_else(|| CliError::input("--start is required with --map"))?;
-    let goal = a
-        .goal
-        .or(sc.map(|s| s.goal))
-        .ok_or_else(|| CliError::input("--goal is required with --map"))?;
-    let yaw = a
-        .start_yaw_deg
-        .map(f64::to_radians)
-        .or(sc.map(|s| s.start_yaw))
-        .unwrap_or(0.0);
-    let shape = super::common::start_shape(&params, &a.start_shape, yaw as f32)?;
+    let Query {
+        params,
+        start,
+        shape,
+        goal,
+    } = a.query.resolve(&a.chain, loaded.scenario.as_ref())?;
     let grid = loaded.grid.clone();
     let (field, _) = loaded.into_field();
     let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;
