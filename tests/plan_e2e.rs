@@ -360,3 +360,69 @@ fn plans_from_a_table_file_match_generated_tables() {
     assert_eq!(e.code, 2);
     assert!(e.message.contains("another chain"), "{e}");
 }
+
+/// Chains far longer than the room behind the window (N = 12: 5.5 m, N = 16: 7.5 m,
+/// room 3.8 m deep) cannot pass it as rigid shapes; they snake through
+/// (follow-the-leader), and every step still passes the exact check.
+#[test]
+fn long_chains_snake_through_the_window() {
+    let dir = tmp();
+    let sc = scenarios::build("window").expect("built-in scenario");
+    for units in [12u8, 16] {
+        let out = dir.path().join(format!("window-{units}.json"));
+        let n = units.to_string();
+        arc(&[
+            "plan",
+            "--scenario",
+            "window",
+            "--units",
+            &n,
+            "--start-shape",
+            "PN",
+            "--start-yaw-deg",
+            "90",
+            "--out",
+            s(&out),
+        ])
+        .unwrap_or_else(|e| panic!("window N={units}: no plan: {e}"));
+        let plan = Plan::read(&out).expect("plan file reads back");
+        let report = verify_plan(&sc.grid, &plan);
+        assert!(report.ok, "window N={units}: {:?}", report.violation);
+        let last = plan.waypoints[plan.waypoints.len() - 1].xi();
+        let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
+        assert!(
+            d <= 0.3 + 1e-9,
+            "window N={units}: ends {d} m from the goal"
+        );
+        let follow = plan.stats["follow_uses"].as_u64().expect("follow_uses");
+        assert!(follow > 0, "window N={units}: no follow-the-leader step");
+    }
+}
+
+/// `--follow-step 0` is the paper's planner (rigid shapes only): it still plans the
+/// window for N = 5, without a single follow-the-leader step.
+#[test]
+fn follow_step_zero_is_the_papers_planner() {
+    let dir = tmp();
+    let out = dir.path().join("window-5-paper.json");
+    arc(&[
+        "plan",
+        "--scenario",
+        "window",
+        "--units",
+        "5",
+        "--follow-step",
+        "0",
+        "--out",
+        s(&out),
+    ])
+    .expect("window N=5 plans without follow-the-leader");
+    let plan = Plan::read(&out).expect("plan file reads back");
+    let sc = scenarios::build("window").expect("built-in scenario");
+    assert!(verify_plan(&sc.grid, &plan).ok);
+    assert_eq!(plan.stats["follow_uses"].as_u64(), Some(0));
+    let sources = plan.stats["waypoint_sources"]
+        .as_array()
+        .expect("waypoint_sources");
+    assert!(sources.iter().all(|w| w.as_str() != Some("follow")));
+}

@@ -27,7 +27,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use arc_core::lsc::library;
+use arc_core::lsc::{library, LscKind};
 use arc_core::{ChainParams, Shape};
 use rayon::prelude::*;
 
@@ -332,10 +332,12 @@ pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, String> {
 
 /// A query for a chain that may not fit at the scenario's start as a straight line
 /// (long chains): the first of, in this order, the scenario's start with LI at its start
-/// yaw; the start with each library shape (LSC order: LI, SE, SM, SV, CA, PN) at the
+/// yaw; the start with each library shape (LI, then PN, then SE, SM, SV, CA) at the
 /// start yaw plus `j * 45` degrees, `j = 0..8`; the same at the lattice points (0.1 m,
 /// at the start's height) within 1.5 m of the start, nearest first; whose configuration
-/// is valid. The goal is the scenario's.
+/// is valid. The goal is the scenario's. PN comes second because its body bends
+/// evenly, so the chain can slide along it (follow-the-leader); the serpentines are
+/// zig-zags at the bend limit, along which no unit can slide.
 pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, String> {
     let params = *ctx.params();
     let lib = library(&params);
@@ -358,8 +360,15 @@ pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, Str
         ]
     }));
     let yaw0 = sc.start_yaw as f32;
+    let rank = |k: LscKind| match k {
+        LscKind::Li => 0,
+        LscKind::Pn => 1,
+        _ => 2,
+    };
+    let mut entries: Vec<_> = lib.entries.iter().collect();
+    entries.sort_by_key(|e| rank(e.kind));
     for p in positions {
-        for e in lib.entries.iter() {
+        for e in entries.iter() {
             for j in 0..8 {
                 let yaw = yaw0 + j as f32 * std::f32::consts::FRAC_PI_4;
                 let shape = e

@@ -61,7 +61,11 @@ pub struct PlanArgs {
     /// Clearance margin added to every body's radius (m): plans keep this far from walls.
     #[arg(long, default_value_t = DEFAULT_CLEARANCE)]
     clearance: f64,
-    /// Head edges the planner may drop per roadmap before it grows the roadmap.
+    /// Step (m) of follow-the-leader motion, where the body is laid back along the
+    /// head's track (long chains through windows and doors); 0 turns it off (the paper).
+    #[arg(long, default_value_t = 0.1)]
+    follow_step: f64,
+    /// Head edges the planner may drop without progress before it grows the roadmap.
     #[arg(long, default_value_t = 200)]
     max_replans: usize,
     /// How strongly head paths keep away from obstacles (0: shortest, as in the paper).
@@ -118,6 +122,13 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
     }
     if a.d_c.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
         return bad("--d-c", format!("{:?}", a.d_c), "a positive number");
+    }
+    if !(a.follow_step.is_finite() && (0.0..=1.0).contains(&a.follow_step)) {
+        return bad(
+            "--follow-step",
+            a.follow_step.to_string(),
+            "between 0 (off) and 1 m",
+        );
     }
     if !(a.goal_tol.is_finite() && a.goal_tol >= 0.0) {
         return bad("--goal-tol", a.goal_tol.to_string(), "a number >= 0");
@@ -199,6 +210,7 @@ pub fn run(a: PlanArgs) -> CliResult {
         max_growth: a.max_growth,
         clearance_weight: a.clearance_weight,
         goal_tol: a.goal_tol,
+        follow_step: a.follow_step,
     };
     let mut planner =
         Planner::new(ctx, tables, settings).map_err(|e| CliError::input(e.to_string()))?;
@@ -213,7 +225,7 @@ pub fn run(a: PlanArgs) -> CliResult {
         .map_err(|e| CliError::input(e.to_string()))?;
     let s = &solution.stats;
     println!(
-        "{}: solved on {} with N = {}: {} waypoints, {} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations), {} replans",
+        "{}: solved on {} with N = {}: {} waypoints, {} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations, {} follow), {} replans",
         a.out.display(),
         a.map.name(),
         params.units,
@@ -223,6 +235,7 @@ pub fn run(a: PlanArgs) -> CliResult {
         s.lsc_uses,
         s.srs_uses,
         s.rotations,
+        s.follow_uses,
         s.replans
     );
     println!(

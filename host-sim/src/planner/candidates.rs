@@ -20,6 +20,8 @@ pub enum Source {
     Srs(u16),
     /// A random shape turned about the head so that it trails behind the edge.
     SrsTurned(u16),
+    /// The chain laid back along the head's track (follow-the-leader).
+    Follow,
 }
 
 /// A shape with its origin.

@@ -14,6 +14,7 @@
 //! shape change itself, checked at `v`: a plan is "change shape, then translate".
 
 pub mod candidates;
+pub mod follow;
 pub mod motion;
 pub mod roadmap;
 pub mod srs_connect;
@@ -71,7 +72,8 @@ pub struct Settings {
     pub prefer: Preference,
     /// Seed of the roadmap sampler.
     pub seed: u64,
-    /// Replans (dropped head edges) allowed per roadmap before growing it.
+    /// Replans (dropped head edges) allowed without progress (the chain reaching a
+    /// vertex farther along its way than before) before the roadmap grows.
     pub max_replans: usize,
     /// Times a failing query may double the roadmap and try again.
     pub max_growth: usize,
@@ -80,6 +82,9 @@ pub struct Settings {
     pub clearance_weight: f64,
     /// Goal tolerance for the head (m).
     pub goal_tol: f64,
+    /// Step (m) of follow-the-leader motion ([`follow`]), tried after the library
+    /// and before SRSConnect; 0 turns it off (the paper's planner).
+    pub follow_step: f64,
 }
 
 impl Default for Settings {
@@ -97,6 +102,7 @@ impl Default for Settings {
             max_growth: 3,
             clearance_weight: 2.0,
             goal_tol: 0.3,
+            follow_step: 0.1,
         }
     }
 }
@@ -140,6 +146,8 @@ pub struct Stats {
     pub lsc_uses: usize,
     /// Random shapes used.
     pub srs_uses: usize,
+    /// Follow-the-leader shapes used (one per short step).
+    pub follow_uses: usize,
     /// SRSConnect calls.
     pub srs_connects: usize,
     /// Head edges dropped and routes asked again (in the final roadmap).
@@ -221,6 +229,11 @@ impl Checker<'_> {
     /// The shape is collision-free with the head at `xi` (shape known valid).
     pub fn placement(&mut self, xi: [f64; 3], s: &Shape) -> bool {
         self.timed(|c| c.check_placement(xi, s).is_ok())
+    }
+
+    /// The configuration is valid (joint limits, self-collision, map).
+    pub fn config(&mut self, xi: [f64; 3], s: &Shape) -> bool {
+        self.timed(|c| c.check_config(xi, s).is_ok())
     }
 
     /// The chain in shape `s` can translate from `a` to `b`.
@@ -377,6 +390,16 @@ fn trail_yaw(params: &arc_core::ChainParams, shape: &Shape) -> f32 {
     c.y.atan2(c.x)
 }
 
+/// One leg of a head edge: shape changes where the head is, then a translation.
+struct Leg {
+    changes: Vec<Candidate>,
+    to: [f64; 3],
+}
+
+fn dist3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
 /// Edges that may fail from one vertex before the chain backs up from it.
 const FAILS_BEFORE_BACKING_UP: usize = 4;
 
@@ -387,6 +410,8 @@ struct Construction<'p> {
     checker: Checker<'p>,
     start: VertexId,
     goals: Vec<VertexId>,
+    /// Cost-to-go of every vertex: the routes' heuristic.
+    to_go: Vec<f64>,
     banned: BTreeSet<(VertexId, VertexId)>,
     current: Candidate,
     steps: Vec<Step>,
@@ -418,6 +443,7 @@ impl<'p> Construction<'p> {
             shape,
             source: Source::Start,
         };
+        let to_go = roadmap.cost_to_go(&goals);
         Self {
             planner,
             roadmap,
@@ -427,6 +453,7 @@ impl<'p> Construction<'p> {
             },
             start: s,
             goals,
+            to_go,
             banned: BTreeSet::new(),
             current,
             steps: vec![Step {
@@ -444,7 +471,7 @@ impl<'p> Construction<'p> {
     fn route(&self, from: VertexId) -> Result<Vec<VertexId>, PlanError> {
         let banned = |a: VertexId, b: VertexId| self.banned.contains(&(a.min(b), a.max(b)));
         self.roadmap
-            .route(&self.planner.ctx, from, &self.goals, &banned)
+            .route(&self.planner.ctx, from, &self.goals, &self.to_go, &banned)
             .map_err(|e| match e {
                 RouteError::StartIsolated | RouteError::Unreachable => PlanError::Unreachable {
                     tol: self.planner.settings.goal_tol,
@@ -459,6 +486,9 @@ impl<'p> Construction<'p> {
         let mut trail = vec![(self.start, self.current, self.steps.len())];
         // Edges that failed from each vertex, in this query.
         let mut fails = vec![0usize; self.roadmap.total_vertices()];
+        // Replans since the trail was last longer than ever: the budget is per stretch
+        // of the way, so long routes get as many as short ones.
+        let (mut furthest, mut stuck_replans) = (1usize, 0usize);
         while i + 1 < path.len() {
             if self
                 .stop
@@ -470,9 +500,12 @@ impl<'p> Construction<'p> {
                 });
             }
             let (v, u) = (path[i], path[i + 1]);
-            if let Some(changes) = self.connect(v, u) {
-                self.accept(v, u, changes);
+            if let Some(legs) = self.connect(v, u) {
+                self.accept(legs);
                 trail.push((u, self.current, self.steps.len()));
+                if trail.len() > furthest {
+                    (furthest, stuck_replans) = (trail.len(), 0);
+                }
                 i += 1;
                 continue;
             }
@@ -486,7 +519,8 @@ impl<'p> Construction<'p> {
             path = loop {
                 self.banned.insert((bad.0.min(bad.1), bad.0.max(bad.1)));
                 self.stats.replans += 1;
-                if self.stats.replans > self.planner.settings.max_replans {
+                stuck_replans += 1;
+                if stuck_replans > self.planner.settings.max_replans {
                     return Err(PlanError::NoShape {
                         from,
                         to,
@@ -526,25 +560,31 @@ impl<'p> Construction<'p> {
         Ok((self.steps, self.stats))
     }
 
-    /// Appends the shape changes at `v`, then the translation to `u`.
-    fn accept(&mut self, v: VertexId, u: VertexId, changes: Vec<Candidate>) {
-        let xi = self.roadmap.point(v);
-        for c in changes {
+    /// Appends each leg: its shape changes where the head is, then its translation.
+    fn accept(&mut self, legs: Vec<Leg>) {
+        for leg in legs {
+            let xi = self
+                .steps
+                .last()
+                .map(|s| s.xi)
+                .expect("the start is a step");
+            for c in leg.changes {
+                self.steps.push(Step {
+                    xi,
+                    shape: c.shape,
+                    source: c.source,
+                    shape_change: true,
+                });
+                self.current = c;
+            }
+            let cur = self.current;
             self.steps.push(Step {
-                xi,
-                shape: c.shape,
-                source: c.source,
-                shape_change: true,
+                xi: leg.to,
+                shape: cur.shape,
+                source: cur.source,
+                shape_change: false,
             });
-            self.current = c;
         }
-        let cur = self.current;
-        self.steps.push(Step {
-            xi: self.roadmap.point(u),
-            shape: cur.shape,
-            source: cur.source,
-            shape_change: false,
-        });
     }
 
     /// Counts of the final plan's steps (after any backing up).
@@ -559,15 +599,30 @@ impl<'p> Construction<'p> {
                 Source::Rotation => self.stats.rotations += 1,
                 Source::Lsc(_) => self.stats.lsc_uses += 1,
                 Source::Srs(_) | Source::SrsTurned(_) => self.stats.srs_uses += 1,
+                Source::Follow => self.stats.follow_uses += 1,
                 Source::Start => {}
             }
         }
     }
 
-    /// The shape changes at `v` that let the chain fly `v -> u`, or None.
-    fn connect(&mut self, v: VertexId, u: VertexId) -> Option<Vec<Candidate>> {
-        let s = &self.planner.settings;
+    /// The legs that take the chain from `v` to `u`, or None.
+    fn connect(&mut self, v: VertexId, u: VertexId) -> Option<Vec<Leg>> {
         let (a, b) = (self.roadmap.point(v), self.roadmap.point(u));
+        if let Some(changes) = self.connect_rigid(a, b) {
+            return Some(vec![Leg { changes, to: b }]);
+        }
+        if self.planner.settings.follow_step > 0.0 {
+            if let Some(legs) = self.follow(a, b) {
+                return Some(legs);
+            }
+        }
+        self.connect_srs(a, b)
+            .map(|changes| vec![Leg { changes, to: b }])
+    }
+
+    /// The shape change at `a` to a kept, turned or library shape that flies `a -> b`.
+    fn connect_rigid(&mut self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<Candidate>> {
+        let s = &self.planner.settings;
         let cur = self.current;
         let edge_yaw = if (b[0] - a[0]).hypot(b[1] - a[1]) > 1e-6 {
             (b[1] - a[1]).atan2(b[0] - a[0]) as f32
@@ -599,13 +654,89 @@ impl<'p> Construction<'p> {
         } else {
             Vec::new()
         };
-        if let Some(c) = self.first_direct(a, b, &lib) {
-            return Some(vec![c]);
+        self.first_direct(a, b, &lib).map(|c| vec![c])
+    }
+
+    /// Follow-the-leader from `a` to `b` in steps of `follow_step`: before each step
+    /// the body is laid back along the head's track ([`follow::lay_along`]).
+    fn follow(&mut self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<Leg>> {
+        let params = *self.planner.ctx.params();
+        let len = dist3(a, b);
+        let n = ((len / self.planner.settings.follow_step).ceil() as usize).max(1);
+        let mut track = self.track(a);
+        let mut shape = self.current.shape;
+        let mut legs = Vec::with_capacity(n);
+        let mut p = a;
+        for j in 1..=n {
+            let t = j as f64 / n as f64;
+            let q = [0, 1, 2].map(|i| a[i] + t * (b[i] - a[i]));
+            let laid = follow::lay_along(&params, &track);
+            let mut changes = Vec::new();
+            if laid.max_angle_diff(&shape) > 1e-4 {
+                let ok =
+                    self.checker.config(p, &laid) && self.checker.shape_change(p, &shape, &laid);
+                if !ok {
+                    return None;
+                }
+                shape = laid;
+                changes.push(Candidate {
+                    shape,
+                    source: Source::Follow,
+                });
+            }
+            if !self.checker.translation(p, q, &shape) {
+                return None;
+            }
+            legs.push(Leg { changes, to: q });
+            track.insert(
+                0,
+                nalgebra::Vector3::new(q[0] as f32, q[1] as f32, q[2] as f32),
+            );
+            p = q;
         }
-        // (d) SRSConnect.
+        Some(legs)
+    }
+
+    /// The head's track behind `a`: the head positions of the follow-the-leader steps
+    /// that led here (newest first), then the body of the shape they started from.
+    fn track(&self, a: [f64; 3]) -> Vec<nalgebra::Vector3<f32>> {
+        let v = |p: [f64; 3]| nalgebra::Vector3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+        let params = self.planner.ctx.params();
+        let mut track = vec![v(a)];
+        let mut length = 0.0;
+        let need = params.reach() as f64 + 1.0;
+        for st in self.steps.iter().rev() {
+            if st.source == Source::Follow && length < need {
+                let last = track.last().expect("track starts at a");
+                let d = (v(st.xi) - last).norm();
+                if d > 1e-6 {
+                    length += d as f64;
+                    track.push(v(st.xi));
+                }
+                continue;
+            }
+            // The body of the rigid shape the chain had before it began to follow,
+            // its corners cut: a zig-zag at the bend limit cannot be slid along.
+            let body = arc_core::kinematics::offsets(params, &st.shape);
+            let body: Vec<_> = body.iter().take(params.n()).map(|o| v(st.xi) + o).collect();
+            track.extend(follow::cut_corners(&body));
+            break;
+        }
+        track
+    }
+
+    /// SRSConnect (d): a path through `G_Val` to a random shape that flies `a -> b`.
+    fn connect_srs(&mut self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<Candidate>> {
+        let s = &self.planner.settings;
         if s.mode == Mode::Lsc {
             return None;
         }
+        let cur = self.current;
+        let edge_yaw = if (b[0] - a[0]).hypot(b[1] - a[1]) > 1e-6 {
+            (b[1] - a[1]).atan2(b[0] - a[0]) as f32
+        } else {
+            cur.shape.head_yaw()
+        };
         self.stats.srs_connects += 1;
         let srs = &self.planner.tables.srs;
         let mut pool: Vec<Candidate> = Vec::with_capacity(2 * srs.len());

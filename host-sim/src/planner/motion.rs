@@ -20,6 +20,7 @@ pub fn source_label(s: &Source, shape_change: bool) -> String {
         (Source::Lsc(k), true) => format!("LSC:{}", k.name()),
         (Source::Srs(i), true) => format!("SRS:{i}"),
         (Source::SrsTurned(i), true) => format!("SRS:{i}:turned"),
+        (Source::Follow, true) => "follow".into(),
     }
 }
 
@@ -38,6 +39,7 @@ pub fn to_plan(
         ("rotations", st.rotations as u64),
         ("lsc_uses", st.lsc_uses as u64),
         ("srs_uses", st.srs_uses as u64),
+        ("follow_uses", st.follow_uses as u64),
         ("srs_connects", st.srs_connects as u64),
         ("replans", st.replans as u64),
         ("roadmap_growths", st.roadmap_growths as u64),

@@ -252,39 +252,76 @@ impl Roadmap {
         }
     }
 
+    /// The cost to reach the nearest of `goals` from every vertex over the edges not
+    /// known to be blocked (reverse Dijkstra; the graph is symmetric); infinite where
+    /// no goal can be reached. Blocking or banning edges only raises true costs, so
+    /// this stays a consistent A* heuristic for the rest of the query.
+    pub fn cost_to_go(&self, goals: &[VertexId]) -> Vec<f64> {
+        let mut cost = vec![f64::INFINITY; self.points.len()];
+        let mut open = BinaryHeap::new();
+        for &q in goals {
+            cost[q] = 0.0;
+            open.push(Open {
+                f: 0.0,
+                g: 0.0,
+                v: q,
+                via: usize::MAX,
+            });
+        }
+        while let Some(Open { g, v, .. }) = open.pop() {
+            if g > cost[v] {
+                continue;
+            }
+            for e in &self.edges[v] {
+                let ng = g + e.length;
+                if e.state.get() != EdgeState::Blocked && ng < cost[e.to] {
+                    cost[e.to] = ng;
+                    open.push(Open {
+                        f: ng,
+                        g: ng,
+                        v: e.to,
+                        via: v,
+                    });
+                }
+            }
+        }
+        cost
+    }
+
     /// The shortest head path from `from` to any vertex of `goals`, every edge on it
-    /// checked for the head's sphere. `banned` edges are skipped.
+    /// checked for the head's sphere. `banned` edges are skipped; `h` is the
+    /// heuristic, from [`Self::cost_to_go`] for these goals.
     ///
     /// Lazy Weighted A* (Cohen, Phillips, Likhachev 2014): a vertex enters the open
     /// list with the edge that reached it unchecked; the edge is checked only when
     /// that entry is popped. So one search returns a checked path, and only edges
-    /// leading to expanded vertices are ever checked.
+    /// leading to expanded vertices are ever checked. With the exact cost-to-go as
+    /// the heuristic, a search expands little more than the path it returns.
     pub fn route(
         &self,
         ctx: &CollisionContext,
         from: VertexId,
         goals: &[VertexId],
+        h: &[f64],
         banned: &dyn Fn(VertexId, VertexId) -> bool,
     ) -> Result<Vec<VertexId>, RouteError> {
         if self.edges[from].is_empty() {
             return Err(RouteError::StartIsolated);
         }
-        let target = self.points[goals[0]];
-        let slack = goals
-            .iter()
-            .map(|&g| dist(self.points[g], target))
-            .fold(0.0, f64::max);
-        let h = |v: VertexId| (dist(self.points[v], target) - slack).max(0.0);
         let n = self.points.len();
         let mut closed = vec![false; n];
         let mut parent = vec![usize::MAX; n];
+        // Best cost at which a vertex is queued through an edge known to be free:
+        // a costlier entry can never be needed (an unchecked edge may still fail, so
+        // entries through those are always queued).
+        let mut best_free = vec![f64::INFINITY; n];
         let mut is_goal = vec![false; n];
         for &q in goals {
             is_goal[q] = true;
         }
         let mut open = BinaryHeap::new();
         open.push(Open {
-            f: h(from),
+            f: h[from],
             g: 0.0,
             v: from,
             via: usize::MAX,
@@ -307,12 +344,19 @@ impl Roadmap {
                 return Ok(path);
             }
             for e in &self.edges[v] {
-                if closed[e.to] || e.state.get() == EdgeState::Blocked || banned(v, e.to) {
+                let state = e.state.get();
+                if closed[e.to] || state == EdgeState::Blocked || !h[e.to].is_finite() {
                     continue;
                 }
                 let ng = g + e.length;
+                if ng >= best_free[e.to] || banned(v, e.to) {
+                    continue;
+                }
+                if state == EdgeState::Free {
+                    best_free[e.to] = ng;
+                }
                 open.push(Open {
-                    f: ng + h(e.to),
+                    f: ng + h[e.to],
                     g: ng,
                     v: e.to,
                     via: v,
@@ -368,5 +412,73 @@ impl Ord for Open {
 impl PartialOrd for Open {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
         Some(self.cmp(o))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use arc_core::ChainParams;
+    use rand::SeedableRng;
+
+    use super::*;
+    use crate::map::distance::DistanceField;
+    use crate::map::scenarios;
+
+    fn window_roadmap() -> (CollisionContext, Roadmap, [f64; 3], [f64; 3]) {
+        let sc = scenarios::build("window").expect("built-in scenario");
+        let field = Arc::new(DistanceField::new(sc.grid.clone()));
+        let ctx = CollisionContext::new(field, ChainParams::new(5), 0.05).expect("context");
+        let mut rng = Pcg64::seed_from_u64(3);
+        let map = Roadmap::build(&ctx, 3000, (1.5, 30), (2.0, 1.0), &mut rng);
+        (ctx, map, sc.start, sc.goal)
+    }
+
+    fn cost(map: &Roadmap, path: &[VertexId]) -> f64 {
+        path.windows(2)
+            .map(|w| map.edge(w[0], w[1]).expect("path follows edges").length)
+            .sum()
+    }
+
+    #[test]
+    fn routes_are_checked_edges_and_no_cheaper_than_the_heuristic() {
+        let (ctx, mut map, start, goal) = window_roadmap();
+        let s = map.add_query_vertex(start);
+        let g = map.add_query_vertex(goal);
+        let h = map.cost_to_go(&[g]);
+        assert_eq!(h[g], 0.0);
+        // The heuristic never overestimates: weights are at least the length.
+        for (v, &hv) in h.iter().enumerate() {
+            assert!(hv + 1e-9 >= dist(map.point(v), goal) || !hv.is_finite());
+        }
+        let path = map.route(&ctx, s, &[g], &h, &|_, _| false).expect("route");
+        assert_eq!((path[0], path[path.len() - 1]), (s, g));
+        for w in path.windows(2) {
+            assert!(ctx.is_head_segment_free(map.point(w[0]), map.point(w[1])));
+        }
+        assert!(cost(&map, &path) + 1e-9 >= h[s]);
+    }
+
+    #[test]
+    fn banned_edges_are_avoided_and_the_route_stays_optimal_among_the_rest() {
+        let (ctx, mut map, start, goal) = window_roadmap();
+        let s = map.add_query_vertex(start);
+        let g = map.add_query_vertex(goal);
+        let h = map.cost_to_go(&[g]);
+        let first = map.route(&ctx, s, &[g], &h, &|_, _| false).expect("route");
+        let (a, b) = (first[0], first[1]);
+        let banned = move |x: VertexId, y: VertexId| (x, y) == (a, b) || (x, y) == (b, a);
+        let second = map
+            .route(&ctx, s, &[g], &h, &banned)
+            .expect("another route");
+        assert!(second.windows(2).all(|w| !banned(w[0], w[1])));
+        assert!(cost(&map, &second) + 1e-9 >= cost(&map, &first));
+        // The same search without the heuristic's help finds the same cost.
+        let zero = vec![0.0; map.total_vertices()];
+        let plain = map
+            .route(&ctx, s, &[g], &zero, &banned)
+            .expect("Dijkstra route");
+        assert!((cost(&map, &plain) - cost(&map, &second)).abs() < 1e-9);
     }
 }

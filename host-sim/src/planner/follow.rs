@@ -1,0 +1,223 @@
+//! Follow-the-leader shapes: the chain laid back along the way its head came.
+//!
+//! The paper's shape sources (library, random set) give rigid shapes, and a rigid
+//! shape passes a gap only if every unit's straight translation does. A chain longer
+//! than the room behind a window cannot line up with it, so it must snake: move the
+//! head a short step, then lay the body back along the head's own track, so every
+//! unit slides along the curve the head drew. Each step is still "change shape, then
+//! translate" (ARC-MODEL.md): the translation moves the body off its track by at most
+//! one step, the next shape change puts it back.
+
+use arc_core::kinematics::link_direction;
+use arc_core::{ChainParams, Shape};
+use nalgebra::Vector3;
+
+/// The shape whose units lie on `track` (head at `track[0]`, then back along the
+/// polyline), each `l` from the one before; past the track's end the chain goes on
+/// straight. Link pitches are clamped to the limit, so a steep track is followed
+/// as closely as the joints allow (the caller checks validity anyway).
+///
+/// Each unit goes to the point `l` from the unit before whose distance along the
+/// track is nearest to one link more: on a zig-zag track (a serpentine body laid
+/// down earlier) units stay on its corners instead of cutting across them.
+pub fn lay_along(params: &ChainParams, track: &[Vector3<f32>]) -> Shape {
+    let l = params.link_length;
+    let mut shape = Shape::line(params.units, 0.0);
+    let Some(&head) = track.first() else {
+        return shape;
+    };
+    // Distance along the track to each vertex.
+    let mut along = Vec::with_capacity(track.len());
+    along.push(0.0f32);
+    for w in track.windows(2) {
+        along.push(along[along.len() - 1] + (w[1] - w[0]).norm());
+    }
+    let mut prev = Place {
+        seg: 0,
+        t: 0.0,
+        s: 0.0,
+        p: head,
+    };
+    let mut last_dir = Vector3::new(1.0, 0.0, 0.0);
+    for k in 0..params.links() {
+        let next = next_unit(track, &along, &prev, l).unwrap_or(Place {
+            p: prev.p - l * last_dir,
+            s: f32::INFINITY,
+            ..prev
+        });
+        // Link direction points from the back unit to the front one.
+        let d = (prev.p - next.p) / l;
+        let pitch = (-d.z)
+            .clamp(-1.0, 1.0)
+            .asin()
+            .clamp(-params.theta_max, params.theta_max);
+        let yaw = d.y.atan2(d.x);
+        shape.set_link(k, pitch, yaw);
+        last_dir = link_direction(pitch, yaw);
+        prev = Place {
+            p: prev.p - l * last_dir,
+            ..next
+        };
+    }
+    shape.set_head_yaw(shape.yaw(0));
+    shape
+}
+
+/// The polyline with its corners cut (one round of Chaikin's scheme: the points
+/// at a quarter and three quarters of every segment), its ends kept.
+pub fn cut_corners(line: &[Vector3<f32>]) -> Vec<Vector3<f32>> {
+    let Some((&first, &last)) = line.first().zip(line.last()) else {
+        return Vec::new();
+    };
+    let mut out = vec![first];
+    for w in line.windows(2) {
+        out.push(0.75 * w[0] + 0.25 * w[1]);
+        out.push(0.25 * w[0] + 0.75 * w[1]);
+    }
+    out.push(last);
+    out
+}
+
+/// A unit's place on the track: segment, parameter on it, distance along the
+/// track, and the point.
+#[derive(Clone, Copy)]
+struct Place {
+    seg: usize,
+    t: f32,
+    s: f32,
+    p: Vector3<f32>,
+}
+
+/// The point of the track after `prev`, `l` from `prev.p`, whose distance along the
+/// track is nearest to `prev.s + l`.
+fn next_unit(track: &[Vector3<f32>], along: &[f32], prev: &Place, l: f32) -> Option<Place> {
+    let target = prev.s + l;
+    let mut best: Option<Place> = None;
+    for i in prev.seg..track.len().saturating_sub(1) {
+        let err = |s: f32| (s - target).abs();
+        if best.is_some_and(|b| along[i] - target > err(b.s)) {
+            break;
+        }
+        let (a, b) = (track[i], track[i + 1]);
+        let d = b - a;
+        let dd = d.norm_squared();
+        if dd < 1e-12 {
+            continue;
+        }
+        // |a + t d - c|^2 = l^2, both roots.
+        let f = a - prev.p;
+        let (bh, c) = (f.dot(&d), f.norm_squared() - l * l);
+        let disc = bh * bh - dd * c;
+        if disc < 0.0 {
+            continue;
+        }
+        let lo = if i == prev.seg { prev.t } else { 0.0 };
+        // A body laid along the track before has its units exactly on the track's
+        // vertices: rounding must not push them past the segment's end.
+        let slack = 1e-4 * l / dd.sqrt();
+        for t in [(-bh - disc.sqrt()) / dd, (-bh + disc.sqrt()) / dd] {
+            if t < lo || t > 1.0 + slack {
+                continue;
+            }
+            let t = t.min(1.0);
+            let s = along[i] + t * dd.sqrt();
+            if s > prev.s && best.is_none_or(|b| err(s) < err(b.s)) {
+                best = Some(Place {
+                    seg: i,
+                    t,
+                    s,
+                    p: a + t * d,
+                });
+            }
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use arc_core::kinematics::offsets;
+
+    fn v(x: f32, y: f32, z: f32) -> Vector3<f32> {
+        Vector3::new(x, y, z)
+    }
+
+    #[test]
+    fn straight_track_gives_a_line_trailing_behind() {
+        let p = ChainParams::new(5);
+        let s = lay_along(&p, &[v(0.0, 0.0, 1.0), v(-10.0, 0.0, 1.0)]);
+        let o = offsets(&p, &s);
+        for (k, u) in o.iter().take(5).enumerate() {
+            assert!(
+                (u - v(-0.5 * k as f32, 0.0, 0.0)).norm() < 1e-5,
+                "unit {k}: {u}"
+            );
+        }
+        assert!(s.head_yaw().abs() < 1e-6);
+    }
+
+    #[test]
+    fn units_sit_on_a_bent_track_one_link_apart() {
+        let p = ChainParams::new(6);
+        // Back 0.8 m along -x, then along +y.
+        let track = [v(0.0, 0.0, 0.0), v(-0.8, 0.0, 0.0), v(-0.8, 5.0, 0.0)];
+        let s = lay_along(&p, &track);
+        let o = offsets(&p, &s);
+        for u in o.iter().take(6) {
+            let on_first = u.y.abs() < 1e-4 && u.x <= 1e-4 && u.x >= -0.8 - 1e-4;
+            let on_second = (u.x + 0.8).abs() < 1e-4 && u.y >= -1e-4;
+            assert!(on_first || on_second, "unit off the track: {u}");
+        }
+        for k in 0..5 {
+            assert!(((o[k] - o[k + 1]).norm() - 0.5).abs() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn units_keep_to_the_corners_of_a_zig_zag() {
+        // A zig-zag whose every other corner is exactly one link from the last.
+        let p = ChainParams::new(6);
+        let (dx, dy) = (0.25f32, 0.5 * 3f32.sqrt() / 2.0 * 2.0 / 2.0);
+        let track: Vec<_> = (0..12)
+            .map(|k| v(-dx * k as f32, if k % 2 == 0 { 0.0 } else { dy }, 0.0))
+            .collect();
+        let s = lay_along(&p, &track);
+        let o = offsets(&p, &s);
+        for (k, u) in o.iter().take(6).enumerate() {
+            assert!(
+                (u - track[k]).norm() < 1e-3,
+                "unit {k} at {u}, corner {}",
+                track[k]
+            );
+        }
+    }
+
+    #[test]
+    fn cutting_corners_keeps_ends_and_straight_lines() {
+        let line = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(2.0, 0.0, 0.0)];
+        let cut = cut_corners(&line);
+        assert_eq!(cut.first(), Some(&line[0]));
+        assert_eq!(cut.last(), Some(&line[2]));
+        assert!(cut.iter().all(|p| p.y == 0.0 && p.z == 0.0));
+        let bent = cut_corners(&[v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(1.0, 1.0, 0.0)]);
+        assert!(bent.iter().all(|p| (p - v(1.0, 0.0, 0.0)).norm() > 0.2));
+    }
+
+    #[test]
+    fn short_track_goes_on_straight() {
+        let p = ChainParams::new(4);
+        let s = lay_along(&p, &[v(0.0, 0.0, 0.0), v(0.0, -0.6, 0.0)]);
+        let o = offsets(&p, &s);
+        assert!((o[3] - v(0.0, -1.5, 0.0)).norm() < 1e-4, "{}", o[3]);
+    }
+
+    #[test]
+    fn steep_track_is_clamped_to_the_pitch_limit() {
+        let p = ChainParams::new(3);
+        let s = lay_along(&p, &[v(0.0, 0.0, 3.0), v(0.0, 0.0, 0.0)]);
+        for k in 0..2 {
+            assert!(s.pitch(k).abs() <= p.theta_max + 1e-6);
+        }
+    }
+}
