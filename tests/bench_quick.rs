@@ -46,6 +46,7 @@ fn quick_paper_writes_tables_and_csv() {
         "full-state PRM",
         "window-wide:1.6",
         "Profile",
+        "Both+follow",
     ] {
         assert!(md.contains(want), "paper.md lacks {want}");
     }
@@ -53,9 +54,10 @@ fn quick_paper_writes_tables_and_csv() {
     let header = runs.lines().next().unwrap();
     assert!(header.starts_with("study,scenario,units,method"));
     let cols = header.split(',').count();
-    // Quick: 12 ablation groups x 2 seeds; Table 3: window (its ARCplanner runs are
-    // Table 1's) with 2 PRM budgets x 2 seeds, the wide window with ARC + 2 PRM budgets.
-    assert_eq!(runs.lines().count(), 1 + 12 * 2 + 2 * 2 + 3 * 2);
+    // Quick: 16 ablation groups (4 chains x LSC, SRS, Both, Both+follow) x 2 seeds;
+    // Table 3: window (its ARCplanner runs are Table 1's) with 2 PRM budgets x 2 seeds,
+    // the wide window with 2 ARCplanner variants + 2 PRM budgets.
+    assert_eq!(runs.lines().count(), 1 + 16 * 2 + 2 * 2 + 4 * 2);
     for line in runs.lines().skip(1) {
         if !line.contains('"') {
             assert_eq!(line.split(',').count(), cols, "{line}");
@@ -75,7 +77,7 @@ fn quick_paper_writes_tables_and_csv() {
     }
     assert!(solved > 0);
     let summary = std::fs::read_to_string(d.join("paper_summary.csv")).unwrap();
-    assert_eq!(summary.lines().count(), 1 + 12 + 2 + 3);
+    assert_eq!(summary.lines().count(), 1 + 16 + 2 + 4);
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -54,8 +54,10 @@ pub enum ArcMode {
     Lsc,
     /// Random shapes only ("SRS").
     Srs,
-    /// Both ("Both", the full ARCplanner).
+    /// Both ("Both", the paper's full ARCplanner: rigid shapes only).
     Both,
+    /// Both plus follow-the-leader steps ("Both+follow", `arc plan`'s default).
+    Follow,
 }
 
 impl ArcMode {
@@ -64,18 +66,37 @@ impl ArcMode {
         match self {
             ArcMode::Lsc => Mode::Lsc,
             ArcMode::Srs => Mode::Srs,
-            ArcMode::Both => Mode::Both,
+            ArcMode::Both | ArcMode::Follow => Mode::Both,
+        }
+    }
+
+    /// The planner's follow-the-leader step (0: off, the paper's planner).
+    pub fn follow_step(self) -> f64 {
+        match self {
+            ArcMode::Follow => Settings::default().follow_step,
+            _ => 0.0,
+        }
+    }
+
+    /// Row label in the tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            ArcMode::Lsc => "LSC",
+            ArcMode::Srs => "SRS",
+            ArcMode::Both => "Both",
+            ArcMode::Follow => "Both+follow",
         }
     }
 }
 
 impl Method {
-    /// Short label: `ARC-lsc`, `ARC-srs`, `ARC-both`, `PRM`.
+    /// Short label: `ARC-lsc`, `ARC-srs`, `ARC-both`, `ARC-follow`, `PRM`.
     pub fn label(self) -> &'static str {
         match self {
             Method::Arc(ArcMode::Lsc) => "ARC-lsc",
             Method::Arc(ArcMode::Srs) => "ARC-srs",
             Method::Arc(ArcMode::Both) => "ARC-both",
+            Method::Arc(ArcMode::Follow) => "ARC-follow",
             Method::FullPrm => "PRM",
         }
     }
@@ -467,6 +488,7 @@ fn run_arc(
     let settings = Settings {
         vertices: spec.vertices,
         mode: mode.mode(),
+        follow_step: mode.follow_step(),
         seed: spec.seed,
         ..Default::default()
     };

@@ -74,7 +74,10 @@ pub const ABLATION: [(&str, &str, u8); 4] = [
     ("table2", "maze", 6),
 ];
 
-const MODES: [ArcMode; 3] = [ArcMode::Lsc, ArcMode::Srs, ArcMode::Both];
+const MODES: [ArcMode; 4] = [ArcMode::Lsc, ArcMode::Srs, ArcMode::Both, ArcMode::Follow];
+
+/// The ARCplanner's variants in Table 3: the paper's, and ours with follow-the-leader.
+const TABLE3_ARC: [ArcMode; 2] = [ArcMode::Both, ArcMode::Follow];
 
 /// Every run of the study: Tables 1 and 2 first, then Table 3's PRM runs.
 pub fn specs(o: &PaperOptions) -> Vec<RunSpec> {
@@ -111,16 +114,16 @@ pub fn specs(o: &PaperOptions) -> Vec<RunSpec> {
         for &units in &o.prm_units {
             // Table 3 compares against the full ARCplanner on the same problem: add its
             // runs when Table 1 does not have them.
-            if !(scenario == "window"
+            let in_table1 = scenario == "window"
                 && o.tables.contains(&1)
-                && ABLATION.contains(&("table1", "window", units)))
-            {
+                && ABLATION.contains(&("table1", "window", units));
+            for mode in TABLE3_ARC.into_iter().filter(|_| !in_table1) {
                 for seed in 1..=o.seeds {
                     v.push(RunSpec {
                         study: study.into(),
                         scenario: scenario.clone(),
                         units,
-                        method: Method::Arc(ArcMode::Both),
+                        method: Method::Arc(mode),
                         vertices: o.vertices,
                         srs: o.srs,
                         seed,
@@ -211,6 +214,8 @@ fn find<'a>(
 pub struct Speedup {
     /// Scenario.
     pub scenario: String,
+    /// The ARCplanner's variant.
+    pub arc: ArcMode,
     /// N.
     pub units: u8,
     /// The PRM budget with the best success rate (the smaller on ties).
@@ -239,11 +244,12 @@ pub struct Speedup {
 /// Speed-ups for every Table 3 chain size.
 pub fn speedups(sums: &[Summary], o: &PaperOptions) -> Vec<Speedup> {
     let mut out = Vec::new();
-    for ((_, scenario), &units) in table3_scenarios(o)
+    for (((_, scenario), &units), mode) in table3_scenarios(o)
         .iter()
         .flat_map(|sc| o.prm_units.iter().map(move |u| (sc, u)))
+        .flat_map(|x| TABLE3_ARC.into_iter().map(move |m| (x, m)))
     {
-        let arc = find(sums, scenario, units, Method::Arc(ArcMode::Both), None);
+        let arc = find(sums, scenario, units, Method::Arc(mode), None);
         let prm = sums
             .iter()
             .filter(|s| &s.scenario == scenario && s.units == units && s.method == Method::FullPrm)
@@ -256,6 +262,7 @@ pub fn speedups(sums: &[Summary], o: &PaperOptions) -> Vec<Speedup> {
             let ok_total = (p.successes > 0).then_some(p.total_ok.median);
             out.push(Speedup {
                 scenario: scenario.clone(),
+                arc: mode,
                 units,
                 prm_vertices: p.vertices,
                 prm_success: p.success_rate(),
@@ -330,11 +337,7 @@ pub fn markdown(sums: &[Summary], o: &PaperOptions, meta: &str) -> String {
                 let _ = writeln!(
                     s,
                     "| {units} | {} | {} | {}/{} | {}/{} | {} | {} | {} | {} | {} | {} |",
-                    match mode {
-                        ArcMode::Lsc => "LSC",
-                        ArcMode::Srs => "SRS",
-                        ArcMode::Both => "Both",
-                    },
+                    mode.name(),
                     paper_tp(sc, units, mode).map_or("-".into(), |x| x.to_string()),
                     g.successes,
                     g.runs,
@@ -393,14 +396,28 @@ pub fn markdown(sums: &[Summary], o: &PaperOptions, meta: &str) -> String {
                     rows.push((g, p));
                 }
             }
-            if let Some(g) = find(sums, &scenario, units, Method::Arc(ArcMode::Both), None) {
-                let r = PAPER_TABLE3[2];
-                rows.push((g, (r.2, r.3, r.4)));
+            for mode in TABLE3_ARC {
+                if let Some(g) = find(sums, &scenario, units, Method::Arc(mode), None) {
+                    let r = PAPER_TABLE3[2];
+                    let nan = (f64::NAN, f64::NAN, f64::NAN);
+                    rows.push((
+                        g,
+                        if mode == ArcMode::Both {
+                            (r.2, r.3, r.4)
+                        } else {
+                            nan
+                        },
+                    ));
+                }
             }
             for (g, p) in rows {
                 let (name, budget) = match g.method {
                     Method::FullPrm => ("full-state PRM", format!("M_F = {}", g.vertices)),
-                    _ => (
+                    Method::Arc(ArcMode::Follow) => (
+                        "ARCplanner + follow",
+                        format!("M_VT = {}, N_SRS = {}", g.vertices, g.srs),
+                    ),
+                    Method::Arc(_) => (
                         "ARCplanner",
                         format!("M_VT = {}, N_SRS = {}", g.vertices, g.srs),
                     ),
@@ -427,9 +444,10 @@ pub fn markdown(sums: &[Summary], o: &PaperOptions, meta: &str) -> String {
     s.push('\n');
     for sp in speedups(sums, o) {
         let head = format!(
-            "**{}, N = {}:** the full-state PRM's best success rate is {} (M_F = {}), the ARCplanner's {}.",
+            "**{}, N = {}, {}:** the full-state PRM's best success rate is {} (M_F = {}), the ARCplanner's {}.",
             sp.scenario,
             sp.units,
+            sp.arc.name(),
             pct(sp.prm_success),
             sp.prm_vertices,
             pct(sp.arc_success)
