@@ -141,6 +141,36 @@ impl Waypoint {
 }
 
 impl Plan {
+    /// A plan through `steps` (head position and shape, the start first) for chain
+    /// `params` on a map of `resolution` m, with `counts` and `timing` (seconds) as
+    /// its statistics.
+    pub fn from_steps<'a>(
+        params: &ChainParams,
+        (resolution, unknown_is_occupied): (f64, bool),
+        steps: impl IntoIterator<Item = ([f64; 3], &'a Shape)>,
+        counts: &[(&str, u64)],
+        timing: serde_json::Value,
+    ) -> Self {
+        let mut stats: serde_json::Map<_, _> = counts
+            .iter()
+            .map(|&(k, v)| (k.to_string(), serde_json::Value::from(v)))
+            .collect();
+        stats.insert("timing".into(), timing);
+        Plan {
+            format: FORMAT.into(),
+            chain: ChainSection::from_params(params),
+            map: MapSection {
+                resolution,
+                unknown_is_occupied,
+            },
+            waypoints: steps
+                .into_iter()
+                .map(|(xi, shape)| Waypoint::new(xi, shape))
+                .collect(),
+            stats,
+        }
+    }
+
     /// Reads and checks a plan file: format tag, chain parameters, every waypoint's
     /// length and finiteness.
     pub fn read(path: &Path) -> Result<Self, PlanError> {

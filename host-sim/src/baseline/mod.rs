@@ -48,10 +48,10 @@ use std::time::{Duration, Instant};
 use arc_core::{ChainParams, Shape};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use serde_json::{json, Map};
+use serde_json::json;
 
 use crate::collision::CollisionContext;
-use crate::plan::{ChainSection, MapSection, Plan, Waypoint, FORMAT};
+use crate::plan::Plan;
 use crate::planner::Termination;
 use metric::{embed, embedding_dim, Neighbours};
 
@@ -713,8 +713,6 @@ pub fn to_plan(
     unknown_is_occupied: bool,
 ) -> Plan {
     let st = &solution.stats;
-    let mut stats = Map::new();
-    stats.insert("planner".into(), json!("full-state lazy PRM"));
     let counts = [
         ("vertices", st.vertices as u64),
         ("goal_samples", st.goal_samples as u64),
@@ -728,31 +726,23 @@ pub fn to_plan(
         ("shape_changes", st.shape_changes as u64),
         ("collision_checks", st.collision_checks),
     ];
-    for (k, v) in counts {
-        stats.insert(k.into(), json!(v));
-    }
-    stats.insert("build_capped".into(), json!(st.build_capped));
-    stats.insert(
-        "timing".into(),
-        json!({
-            "roadmap_build_s": st.roadmap_s,
-            "planning_s": st.planning_s,
-            "collision_checks_s": st.collision_s,
-            "search_s": (st.planning_s - st.collision_s).max(0.0),
-        }),
+    let timing = json!({
+        "roadmap_build_s": st.roadmap_s,
+        "planning_s": st.planning_s,
+        "collision_checks_s": st.collision_s,
+        "search_s": (st.planning_s - st.collision_s).max(0.0),
+    });
+    let steps = solution.steps.iter().map(|s| (s.xi, &s.shape));
+    let mut plan = Plan::from_steps(
+        params,
+        (resolution, unknown_is_occupied),
+        steps,
+        &counts,
+        timing,
     );
-    Plan {
-        format: FORMAT.into(),
-        chain: ChainSection::from_params(params),
-        map: MapSection {
-            resolution,
-            unknown_is_occupied,
-        },
-        waypoints: solution
-            .steps
-            .iter()
-            .map(|s| Waypoint::new(s.xi, &s.shape))
-            .collect(),
-        stats,
-    }
+    plan.stats
+        .insert("planner".into(), json!("full-state lazy PRM"));
+    plan.stats
+        .insert("build_capped".into(), json!(st.build_capped));
+    plan
 }

@@ -5,11 +5,11 @@
 //! part of a plan that differs between two runs with the same seed.
 
 use arc_core::ChainParams;
-use serde_json::{json, Map, Value};
+use serde_json::{json, Value};
 
 use super::candidates::Source;
 use super::Solution;
-use crate::plan::{ChainSection, MapSection, Plan, Waypoint, FORMAT};
+use crate::plan::Plan;
 
 /// A short label of where a waypoint's shape came from.
 pub fn source_label(s: &Source, shape_change: bool) -> String {
@@ -32,7 +32,6 @@ pub fn to_plan(
     unknown_is_occupied: bool,
 ) -> Plan {
     let st = &solution.stats;
-    let mut stats = Map::new();
     let counts = [
         ("edges", st.edges as u64),
         ("shape_changes", st.shape_changes as u64),
@@ -47,36 +46,26 @@ pub fn to_plan(
         ("roadmap_vertices", st.roadmap_vertices as u64),
         ("roadmap_edges", st.roadmap_edges as u64),
     ];
-    for (k, v) in counts {
-        stats.insert(k.into(), json!(v));
-    }
-    stats.insert(
-        "timing".into(),
-        json!({
-            "roadmap_build_s": st.roadmap_s,
-            "planning_s": st.planning_s,
-            "collision_checks_s": st.collision_s,
-            "shape_search_s": (st.planning_s - st.collision_s).max(0.0),
-        }),
+    let timing = json!({
+        "roadmap_build_s": st.roadmap_s,
+        "planning_s": st.planning_s,
+        "collision_checks_s": st.collision_s,
+        "shape_search_s": (st.planning_s - st.collision_s).max(0.0),
+    });
+    let steps = solution.steps.iter().map(|s| (s.xi, &s.shape));
+    let mut plan = Plan::from_steps(
+        params,
+        (resolution, unknown_is_occupied),
+        steps,
+        &counts,
+        timing,
     );
     let labels: Vec<Value> = solution
         .steps
         .iter()
         .map(|s| Value::String(source_label(&s.source, s.shape_change)))
         .collect();
-    stats.insert("waypoint_sources".into(), Value::Array(labels));
-    Plan {
-        format: FORMAT.into(),
-        chain: ChainSection::from_params(params),
-        map: MapSection {
-            resolution,
-            unknown_is_occupied,
-        },
-        waypoints: solution
-            .steps
-            .iter()
-            .map(|s| Waypoint::new(s.xi, &s.shape))
-            .collect(),
-        stats,
-    }
+    plan.stats
+        .insert("waypoint_sources".into(), Value::Array(labels));
+    plan
 }

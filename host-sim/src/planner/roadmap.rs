@@ -103,9 +103,11 @@ impl Roadmap {
         let mut adjacent: Vec<Vec<usize>> = vec![Vec::new(); points.len()];
         let k1 = std::num::NonZero::new(k.saturating_add(1)).expect("k + 1 > 0");
         for (i, p) in points.iter().enumerate() {
-            for n in tree.nearest_n_within::<SquaredEuclidean>(p, r_t * r_t, k1, true) {
+            // The k nearest, then the radius: a bounded heap of k, cheaper than
+            // collecting every point within r_T first.
+            for n in tree.nearest_n::<SquaredEuclidean>(p, k1) {
                 let j = n.item as usize;
-                if j != i {
+                if j != i && n.distance <= r_t * r_t {
                     adjacent[i].push(j);
                     adjacent[j].push(i);
                 }
@@ -141,20 +143,15 @@ impl Roadmap {
         map
     }
 
-    /// Applies the clearance factor to the edges of vertices `from..`.
+    /// Applies the clearance factor to the edges of vertices `from..`. The factor
+    /// depends only on the edge's two ends, so both directions get the same weight.
     fn weigh_edges(&mut self, from: VertexId) {
         let (w, r) = (self.clearance_weight, self.clearance_ref.max(1e-9));
         for v in from..self.points.len() {
-            for k in 0..self.edges[v].len() {
-                let u = self.edges[v][k].to;
-                let c = self.clearance[v].min(self.clearance[u]);
-                let f = 1.0 + w * (1.0 - c / r).max(0.0);
-                let e = &mut self.edges[v][k];
-                e.length = dist(self.points[v], self.points[u]) * f;
-                // Keep both directions equal.
-                if let Some(back) = self.edges[u].iter_mut().find(|x| x.to == v) {
-                    back.length = dist(self.points[v], self.points[u]) * f;
-                }
+            for e in self.edges[v].iter_mut() {
+                let c = self.clearance[v].min(self.clearance[e.to]);
+                e.length =
+                    dist(self.points[v], self.points[e.to]) * (1.0 + w * (1.0 - c / r).max(0.0));
             }
         }
     }
