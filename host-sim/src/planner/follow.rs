@@ -63,18 +63,25 @@ pub fn lay_along(params: &ChainParams, track: &[Vector3<f32>]) -> Shape {
     shape
 }
 
-/// The polyline with its corners cut (one round of Chaikin's scheme: the points
-/// at a quarter and three quarters of every segment), its ends kept.
-pub fn cut_corners(line: &[Vector3<f32>]) -> Vec<Vector3<f32>> {
-    let Some((&first, &last)) = line.first().zip(line.last()) else {
-        return Vec::new();
-    };
-    let mut out = vec![first];
-    for w in line.windows(2) {
-        out.push(0.75 * w[0] + 0.25 * w[1]);
-        out.push(0.25 * w[0] + 0.75 * w[1]);
+/// The polyline with its sharp corners cut: a vertex where the line turns by more
+/// than `max_turn` (rad) is replaced by the points a quarter of the way along its two
+/// segments. Gentle corners and the ends stay, so the line loses little length.
+pub fn cut_sharp_corners(line: &[Vector3<f32>], max_turn: f32) -> Vec<Vector3<f32>> {
+    let mut out: Vec<Vector3<f32>> = line.iter().take(1).copied().collect();
+    for w in line.windows(3) {
+        let (a, b, c) = (w[0], w[1], w[2]);
+        let (u, v) = (b - a, c - b);
+        let cos = u.dot(&v) / (u.norm() * v.norm()).max(1e-12);
+        if cos < max_turn.cos() {
+            out.push(b + 0.25 * (a - b));
+            out.push(b + 0.25 * (c - b));
+        } else {
+            out.push(b);
+        }
     }
-    out.push(last);
+    if line.len() > 1 {
+        out.push(line[line.len() - 1]);
+    }
     out
 }
 
@@ -194,14 +201,19 @@ mod tests {
     }
 
     #[test]
-    fn cutting_corners_keeps_ends_and_straight_lines() {
+    fn only_sharp_corners_are_cut() {
+        let right = std::f32::consts::FRAC_PI_2;
         let line = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(2.0, 0.0, 0.0)];
-        let cut = cut_corners(&line);
-        assert_eq!(cut.first(), Some(&line[0]));
-        assert_eq!(cut.last(), Some(&line[2]));
-        assert!(cut.iter().all(|p| p.y == 0.0 && p.z == 0.0));
-        let bent = cut_corners(&[v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(1.0, 1.0, 0.0)]);
-        assert!(bent.iter().all(|p| (p - v(1.0, 0.0, 0.0)).norm() > 0.2));
+        assert_eq!(cut_sharp_corners(&line, right), line.to_vec());
+        // A gentle 45 degree bend stays.
+        let gentle = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(2.0, 1.0, 0.0)];
+        assert_eq!(cut_sharp_corners(&gentle, right), gentle.to_vec());
+        // A 135 degree turn is cut; the ends stay.
+        let sharp = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)];
+        let cut = cut_sharp_corners(&sharp, right);
+        assert_eq!(cut.len(), 4);
+        assert_eq!((cut[0], cut[3]), (sharp[0], sharp[2]));
+        assert!(cut.iter().all(|p| (p - v(1.0, 0.0, 0.0)).norm() > 0.2));
     }
 
     #[test]

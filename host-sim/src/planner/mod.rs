@@ -698,13 +698,16 @@ impl<'p> Construction<'p> {
     }
 
     /// The head's track behind `a`: the head positions of the follow-the-leader steps
-    /// that led here (newest first), then the body of the shape they started from.
+    /// that led here (newest first), then the body of the chain where that run of
+    /// steps began. A rigid body's corners sharper than 90 degrees are cut first: a
+    /// zig-zag at the bend limit (the serpentines) cannot be slid along.
     fn track(&self, a: [f64; 3]) -> Vec<nalgebra::Vector3<f32>> {
         let v = |p: [f64; 3]| nalgebra::Vector3::new(p[0] as f32, p[1] as f32, p[2] as f32);
         let params = self.planner.ctx.params();
         let mut track = vec![v(a)];
         let mut length = 0.0;
-        let need = params.reach() as f64 + 1.0;
+        // Twice the chain's reach: a winding track takes more than one reach of chords.
+        let need = 2.0 * (params.reach() as f64 + 1.0);
         for st in self.steps.iter().rev() {
             if st.source == Source::Follow && length < need {
                 let last = track.last().expect("track starts at a");
@@ -715,11 +718,16 @@ impl<'p> Construction<'p> {
                 }
                 continue;
             }
-            // The body of the rigid shape the chain had before it began to follow,
-            // its corners cut: a zig-zag at the bend limit cannot be slid along.
             let body = arc_core::kinematics::offsets(params, &st.shape);
             let body: Vec<_> = body.iter().take(params.n()).map(|o| v(st.xi) + o).collect();
-            track.extend(follow::cut_corners(&body));
+            if st.source == Source::Follow {
+                track.extend(body);
+            } else {
+                track.extend(follow::cut_sharp_corners(
+                    &body,
+                    std::f32::consts::FRAC_PI_2,
+                ));
+            }
             break;
         }
         track
