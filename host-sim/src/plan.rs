@@ -45,6 +45,32 @@ pub struct Waypoint {
     pub zeta: Vec<f64>,
 }
 
+/// Where a planner's time went (seconds); the only part of a plan that differs
+/// between two runs with the same seed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Timing {
+    /// Roadmap build.
+    pub roadmap_s: f64,
+    /// The query.
+    pub planning_s: f64,
+    /// Of the query, full-chain collision checks.
+    pub collision_s: f64,
+    /// Name of the rest of the query in the file (`shape_search_s`, `search_s`).
+    pub rest: &'static str,
+}
+
+impl Timing {
+    fn to_json(self) -> serde_json::Value {
+        let mut m = serde_json::Map::new();
+        m.insert("roadmap_build_s".into(), self.roadmap_s.into());
+        m.insert("planning_s".into(), self.planning_s.into());
+        m.insert("collision_checks_s".into(), self.collision_s.into());
+        let rest = (self.planning_s - self.collision_s).max(0.0);
+        m.insert(self.rest.into(), rest.into());
+        serde_json::Value::Object(m)
+    }
+}
+
 /// A plan as stored in the file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Plan {
@@ -142,20 +168,20 @@ impl Waypoint {
 
 impl Plan {
     /// A plan through `steps` (head position and shape, the start first) for chain
-    /// `params` on a map of `resolution` m, with `counts` and `timing` (seconds) as
-    /// its statistics.
+    /// `params` on a map of `resolution` m, with `counts` and `timing` as its
+    /// statistics.
     pub fn from_steps<'a>(
         params: &ChainParams,
         (resolution, unknown_is_occupied): (f64, bool),
         steps: impl IntoIterator<Item = ([f64; 3], &'a Shape)>,
         counts: &[(&str, u64)],
-        timing: serde_json::Value,
+        timing: &Timing,
     ) -> Self {
         let mut stats: serde_json::Map<_, _> = counts
             .iter()
             .map(|&(k, v)| (k.to_string(), serde_json::Value::from(v)))
             .collect();
-        stats.insert("timing".into(), timing);
+        stats.insert("timing".into(), timing.to_json());
         Plan {
             format: FORMAT.into(),
             chain: ChainSection::from_params(params),

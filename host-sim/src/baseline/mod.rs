@@ -51,7 +51,7 @@ use rand_pcg::Pcg64;
 use serde_json::json;
 
 use crate::collision::CollisionContext;
-use crate::plan::Plan;
+use crate::plan::{Plan, Timing};
 use crate::planner::Termination;
 use metric::{embed, embedding_dim, Neighbours};
 
@@ -726,19 +726,19 @@ pub fn to_plan(
         ("shape_changes", st.shape_changes as u64),
         ("collision_checks", st.collision_checks),
     ];
-    let timing = json!({
-        "roadmap_build_s": st.roadmap_s,
-        "planning_s": st.planning_s,
-        "collision_checks_s": st.collision_s,
-        "search_s": (st.planning_s - st.collision_s).max(0.0),
-    });
+    let timing = Timing {
+        roadmap_s: st.roadmap_s,
+        planning_s: st.planning_s,
+        collision_s: st.collision_s,
+        rest: "search_s",
+    };
     let steps = solution.steps.iter().map(|s| (s.xi, &s.shape));
     let mut plan = Plan::from_steps(
         params,
         (resolution, unknown_is_occupied),
         steps,
         &counts,
-        timing,
+        &timing,
     );
     plan.stats
         .insert("planner".into(), json!("full-state lazy PRM"));

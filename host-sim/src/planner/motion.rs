@@ -5,11 +5,11 @@
 //! part of a plan that differs between two runs with the same seed.
 
 use arc_core::ChainParams;
-use serde_json::{json, Value};
+use serde_json::Value;
 
 use super::candidates::Source;
 use super::Solution;
-use crate::plan::Plan;
+use crate::plan::{Plan, Timing};
 
 /// A short label of where a waypoint's shape came from.
 pub fn source_label(s: &Source, shape_change: bool) -> String {
@@ -46,19 +46,19 @@ pub fn to_plan(
         ("roadmap_vertices", st.roadmap_vertices as u64),
         ("roadmap_edges", st.roadmap_edges as u64),
     ];
-    let timing = json!({
-        "roadmap_build_s": st.roadmap_s,
-        "planning_s": st.planning_s,
-        "collision_checks_s": st.collision_s,
-        "shape_search_s": (st.planning_s - st.collision_s).max(0.0),
-    });
+    let timing = Timing {
+        roadmap_s: st.roadmap_s,
+        planning_s: st.planning_s,
+        collision_s: st.collision_s,
+        rest: "shape_search_s",
+    };
     let steps = solution.steps.iter().map(|s| (s.xi, &s.shape));
     let mut plan = Plan::from_steps(
         params,
         (resolution, unknown_is_occupied),
         steps,
         &counts,
-        timing,
+        &timing,
     );
     let labels: Vec<Value> = solution
         .steps
