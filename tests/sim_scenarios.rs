@@ -27,12 +27,17 @@ fn s(p: &Path) -> &str {
 }
 
 fn plan_and_fly(scenario: &str, units: u8) {
+    plan_and_fly_with(scenario, units, &[]);
+}
+
+/// Plans `scenario` for `units` with the extra `arc plan` flags, flies it, checks it.
+fn plan_and_fly_with(scenario: &str, units: u8, flags: &[&str]) {
     let dir = tempfile::tempdir().expect("temporary directory");
     let plan = dir.path().join("plan.json");
     let out = dir.path().join("sim.json");
     let pic = dir.path().join("sim.svg");
     let n = units.to_string();
-    arc(&[
+    let mut args = vec![
         "plan",
         "--scenario",
         scenario,
@@ -40,8 +45,9 @@ fn plan_and_fly(scenario: &str, units: u8) {
         &n,
         "--out",
         s(&plan),
-    ])
-    .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
+    ];
+    args.extend_from_slice(flags);
+    arc(&args).unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
     arc(&[
         "sim",
         "--scenario",
@@ -110,6 +116,17 @@ fn silos_n4() {
 #[test]
 fn silos_n6() {
     plan_and_fly("silos", 6);
+}
+
+/// A 5.5 m chain snakes through the window (follow-the-leader, hundreds of short
+/// steps) and flies it the same way.
+#[test]
+fn window_n12_snakes_through() {
+    plan_and_fly_with(
+        "window",
+        12,
+        &["--start-shape", "PN", "--start-yaw-deg", "90"],
+    );
 }
 
 #[test]

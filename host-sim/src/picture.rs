@@ -34,6 +34,8 @@ pub mod palette {
     pub const GOAL: Colour = "#ff7f0e";
     /// Sensor headings.
     pub const SENSOR: Colour = "#17becf";
+    /// Follow-the-leader shapes.
+    pub const FOLLOW: Colour = "#8c564b";
     /// Axis and text.
     pub const INK: Colour = "#222222";
 }

@@ -125,8 +125,16 @@ pub fn draw(grid: &Grid, plan: &Plan, title: &str, goal: Option<[f64; 3]>) -> Fi
         }
         let pts: Vec<(f64, f64)> = heads.iter().map(|q| (q[u], q[v])).collect();
         p.polyline(&pts, palette::PATH, 2.0, false);
+        // Follow-the-leader changes come every 0.1 m: draw about FOLLOW_DRAWN of them.
+        let total = sources.iter().filter(|s| *s == "follow").count();
+        let every = total.div_ceil(FOLLOW_DRAWN).max(1);
+        let mut follows = 0usize;
         for (i, body) in bodies.iter().enumerate() {
             let src = sources.get(i).map(String::as_str).unwrap_or("");
+            let follow = src == "follow";
+            if follow {
+                follows += 1;
+            }
             let colour: Option<Colour> = if i == 0 {
                 Some(palette::START)
             } else if i + 1 == bodies.len() {
@@ -137,6 +145,8 @@ pub fn draw(grid: &Grid, plan: &Plan, title: &str, goal: Option<[f64; 3]>) -> Fi
                 Some(palette::SRS)
             } else if src == "rotation" {
                 Some(palette::SENSOR)
+            } else if follow && follows % every == 0 {
+                Some(palette::FOLLOW)
             } else {
                 None
             };
@@ -154,6 +164,7 @@ pub fn draw(grid: &Grid, plan: &Plan, title: &str, goal: Option<[f64; 3]>) -> Fi
     fig.legend(palette::LSC, "library shape (LSC)");
     fig.legend(palette::SRS, "random shape (SRS)");
     fig.legend(palette::SENSOR, "yaw rotation");
+    fig.legend(palette::FOLLOW, "follow-the-leader (some)");
     fig.legend(palette::GOAL, "end");
     fig.legend(
         palette::OBSTACLE,
@@ -161,6 +172,9 @@ pub fn draw(grid: &Grid, plan: &Plan, title: &str, goal: Option<[f64; 3]>) -> Fi
     );
     fig
 }
+
+/// How many follow-the-leader shapes a picture shows, evenly spread over the plan.
+const FOLLOW_DRAWN: usize = 4;
 
 fn chain(p: &mut Panel, body: &[[f64; 3]], u: usize, v: usize, r: f64, c: Colour) {
     for w in body.windows(2) {

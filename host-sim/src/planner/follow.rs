@@ -12,10 +12,14 @@ use arc_core::kinematics::link_direction;
 use arc_core::{ChainParams, Shape};
 use nalgebra::Vector3;
 
+/// How far inside the pitch limit a clamped link stays (rad): a controller tracking a
+/// shape right at the limit would overshoot it.
+const PITCH_MARGIN: f32 = 0.02;
+
 /// The shape whose units lie on `track` (head at `track[0]`, then back along the
 /// polyline), each `l` from the one before; past the track's end the chain goes on
-/// straight. Link pitches are clamped to the limit, so a steep track is followed
-/// as closely as the joints allow (the caller checks validity anyway).
+/// straight. Link pitches are clamped just inside the limit, so a steep track is
+/// followed as closely as the joints allow (the caller checks validity anyway).
 ///
 /// Each unit goes to the point `l` from the unit before whose distance along the
 /// track is nearest to one link more: on a zig-zag track (a serpentine body laid
@@ -47,10 +51,8 @@ pub fn lay_along(params: &ChainParams, track: &[Vector3<f32>]) -> Shape {
         });
         // Link direction points from the back unit to the front one.
         let d = (prev.p - next.p) / l;
-        let pitch = (-d.z)
-            .clamp(-1.0, 1.0)
-            .asin()
-            .clamp(-params.theta_max, params.theta_max);
+        let limit = params.theta_max - PITCH_MARGIN;
+        let pitch = (-d.z).clamp(-1.0, 1.0).asin().clamp(-limit, limit);
         let yaw = d.y.atan2(d.x);
         shape.set_link(k, pitch, yaw);
         last_dir = link_direction(pitch, yaw);
@@ -229,7 +231,7 @@ mod tests {
         let p = ChainParams::new(3);
         let s = lay_along(&p, &[v(0.0, 0.0, 3.0), v(0.0, 0.0, 0.0)]);
         for k in 0..2 {
-            assert!(s.pitch(k).abs() <= p.theta_max + 1e-6);
+            assert!(s.pitch(k).abs() <= p.theta_max - PITCH_MARGIN + 1e-6);
         }
     }
 }
