@@ -737,6 +737,23 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// The cells every results table shares, in this order: success, verified, t_G,
+    /// t_P, t_P CPU, shape changes, replans.
+    pub fn outcome_cells(&self) -> String {
+        format!(
+            "{}/{} | {}/{} | {} | {} | {} | {} | {}",
+            self.successes,
+            self.runs,
+            self.verified,
+            self.successes,
+            ms(&self.roadmap),
+            ms(&self.planning),
+            ms(&self.planning_cpu),
+            count(&self.shape_changes),
+            count(&self.replans)
+        )
+    }
+
     /// Success rate (0..=1).
     pub fn success_rate(&self) -> f64 {
         if self.runs == 0 {

@@ -10,7 +10,7 @@
 
 use std::fmt::Write as _;
 
-use super::{count, fmt_ms, ms, ArcMode, Method, RunSpec, Summary};
+use super::{fmt_ms, ms, ArcMode, Method, RunSpec, Summary};
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
@@ -336,18 +336,10 @@ pub fn markdown(sums: &[Summary], o: &PaperOptions, meta: &str) -> String {
                 };
                 let _ = writeln!(
                     s,
-                    "| {units} | {} | {} | {}/{} | {}/{} | {} | {} | {} | {} | {} | {} |",
+                    "| {units} | {} | {} | {} | {} |",
                     mode.name(),
                     paper_tp(sc, units, mode).map_or("-".into(), |x| x.to_string()),
-                    g.successes,
-                    g.runs,
-                    g.verified,
-                    g.successes,
-                    ms(&g.roadmap),
-                    ms(&g.planning),
-                    ms(&g.planning_cpu),
-                    count(&g.shape_changes),
-                    count(&g.replans),
+                    g.outcome_cells(),
                     if mode == ArcMode::Lsc {
                         "-".into()
                     } else {

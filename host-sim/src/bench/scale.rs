@@ -17,7 +17,7 @@ use arc_core::lsc::library;
 use plotters::style::RGBColor;
 
 use super::plot::{self, Chart, Curve};
-use super::{count, fitting_query, ms, ArcMode, Envs, Method, Query, RunSpec, Summary};
+use super::{fitting_query, ArcMode, Envs, Method, Query, RunSpec, Summary};
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
@@ -185,7 +185,7 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
         let st = starts.iter().find(|x| x.0 == g.units);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {}/{} | {}/{} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} |",
             g.units,
             st.map_or("-".into(), |x| format!(
                 "({:.1}, {:.1}, {:.1})",
@@ -196,15 +196,7 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
                 x.2,
                 (x.1.shape.head_yaw() as f64).to_degrees()
             )),
-            g.successes,
-            g.runs,
-            g.verified,
-            g.successes,
-            ms(&g.roadmap),
-            ms(&g.planning),
-            ms(&g.planning_cpu),
-            count(&g.shape_changes),
-            count(&g.replans),
+            g.outcome_cells(),
             g.time_limited
         );
     }
@@ -225,18 +217,10 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
     for g in sums.iter().filter(|g| g.study == "scale-map") {
         let _ = writeln!(
             s,
-            "| {} | {} | {}/{} | {}/{} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} |",
             corridor_length(g),
             g.vertices,
-            g.successes,
-            g.runs,
-            g.verified,
-            g.successes,
-            ms(&g.roadmap),
-            ms(&g.planning),
-            ms(&g.planning_cpu),
-            count(&g.shape_changes),
-            count(&g.replans),
+            g.outcome_cells(),
             g.time_limited
         );
     }
