@@ -396,8 +396,13 @@ struct Leg {
     to: [f64; 3],
 }
 
-fn dist3(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+/// The yaw of the edge `a -> b`; for a vertical edge, the shape's own heading.
+fn edge_yaw(a: [f64; 3], b: [f64; 3], shape: &Shape) -> f32 {
+    if (b[0] - a[0]).hypot(b[1] - a[1]) > 1e-6 {
+        (b[1] - a[1]).atan2(b[0] - a[0]) as f32
+    } else {
+        shape.head_yaw()
+    }
 }
 
 /// Edges that may fail from one vertex before the chain backs up from it.
@@ -624,11 +629,7 @@ impl<'p> Construction<'p> {
     fn connect_rigid(&mut self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<Candidate>> {
         let s = &self.planner.settings;
         let cur = self.current;
-        let edge_yaw = if (b[0] - a[0]).hypot(b[1] - a[1]) > 1e-6 {
-            (b[1] - a[1]).atan2(b[0] - a[0]) as f32
-        } else {
-            cur.shape.head_yaw()
-        };
+        let edge_yaw = edge_yaw(a, b, &cur.shape);
         let lsc = &self.planner.tables.lsc;
         let use_lsc = s.mode != Mode::Srs;
         let is_pn = matches!(cur.source, Source::Lsc(LscKind::Pn));
@@ -661,7 +662,7 @@ impl<'p> Construction<'p> {
     /// the body is laid back along the head's track ([`follow::lay_along`]).
     fn follow(&mut self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<Leg>> {
         let params = *self.planner.ctx.params();
-        let len = dist3(a, b);
+        let len = roadmap::dist(a, b);
         let n = ((len / self.planner.settings.follow_step).ceil() as usize).max(1);
         let mut track = self.track(a);
         let mut shape = self.current.shape;
@@ -740,11 +741,7 @@ impl<'p> Construction<'p> {
             return None;
         }
         let cur = self.current;
-        let edge_yaw = if (b[0] - a[0]).hypot(b[1] - a[1]) > 1e-6 {
-            (b[1] - a[1]).atan2(b[0] - a[0]) as f32
-        } else {
-            cur.shape.head_yaw()
-        };
+        let edge_yaw = edge_yaw(a, b, &cur.shape);
         self.stats.srs_connects += 1;
         let srs = &self.planner.tables.srs;
         let mut pool: Vec<Candidate> = Vec::with_capacity(2 * srs.len());

@@ -62,7 +62,8 @@ pub enum RouteError {
     Unreachable,
 }
 
-fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+/// Euclidean distance between two points (m).
+pub(super) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 

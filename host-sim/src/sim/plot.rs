@@ -2,6 +2,7 @@
 //! reference over time, link pitch and yaw against their references, and the flown
 //! chain seen from above over the map's obstacles.
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::flight::Flight;
@@ -38,6 +39,43 @@ const AXIS: [RGBColor; 3] = [
     RGBColor(40, 70, 200),
 ];
 
+/// The charts here: time or metres on both axes.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A chart on `area` in the project's style: caption, margins, fonts, mesh, axis names.
+fn chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, plotters::coord::Shift>,
+    caption: &str,
+    (x, y): (std::ops::Range<f64>, std::ops::Range<f64>),
+    (x_desc, y_desc): (&str, &str),
+) -> Result<Chart<'a, DB>, String> {
+    let mut c = ChartBuilder::on(area)
+        .caption(caption, (FONT, 16))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(50)
+        .build_cartesian_2d(x, y)
+        .map_err(err)?;
+    c.configure_mesh()
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 13))
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .draw()
+        .map_err(err)?;
+    Ok(c)
+}
+
+/// The legend box of `c`'s labelled series.
+fn legend<'a, DB: DrawingBackend + 'a>(c: &mut Chart<'a, DB>) -> Result<(), String> {
+    c.configure_series_labels()
+        .label_font((FONT, 12))
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)
+}
+
 fn link_color(k: usize) -> RGBColor {
     const P: [RGBColor; 8] = [
         RGBColor(31, 119, 180),
@@ -70,23 +108,12 @@ pub fn flight_svg(flight: &Flight, obstacles: &[Footprint], title: &str) -> Resu
         let (lo, hi) = range(samples.iter().flat_map(|s| {
             (0..3).flat_map(move |i| [s.units[0].p[i] as f64, s.head_ref[i] as f64])
         }));
-        let mut c = ChartBuilder::on(&panels[0])
-            .caption(
-                "head position (solid) and reference (thin black)",
-                (FONT, 16),
-            )
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(50)
-            .build_cartesian_2d(0.0..t_end, lo..hi)
-            .map_err(err)?;
-        c.configure_mesh()
-            .label_style((FONT, 12))
-            .axis_desc_style((FONT, 13))
-            .x_desc("t (s)")
-            .y_desc("m")
-            .draw()
-            .map_err(err)?;
+        let mut c = chart(
+            &panels[0],
+            "head position (solid) and reference (thin black)",
+            (0.0..t_end, lo..hi),
+            ("t (s)", "m"),
+        )?;
         for (i, name) in ["x", "y", "z"].iter().enumerate() {
             c.draw_series(LineSeries::new(
                 samples.iter().map(|s| (s.t, s.head_ref[i] as f64)),
@@ -103,12 +130,7 @@ pub fn flight_svg(flight: &Flight, obstacles: &[Footprint], title: &str) -> Resu
                 PathElement::new(vec![(x, y), (x + 16, y)], AXIS[i].stroke_width(2))
             });
         }
-        c.configure_series_labels()
-            .label_font((FONT, 12))
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        legend(&mut c)?;
 
         // (b), (c) Link pitch and yaw against their references (degrees).
         for (panel, which, name) in [(1usize, 0usize, "link pitch"), (2, 1, "link yaw")] {
@@ -118,23 +140,12 @@ pub fn flight_svg(flight: &Flight, obstacles: &[Footprint], title: &str) -> Resu
                     .chain(s.links_ref.iter())
                     .map(move |a| (a[which] as f64).to_degrees())
             }));
-            let mut c = ChartBuilder::on(&panels[panel])
-                .caption(
-                    format!("{name} (solid) and reference (thin black), deg"),
-                    (FONT, 16),
-                )
-                .margin(10)
-                .x_label_area_size(35)
-                .y_label_area_size(50)
-                .build_cartesian_2d(0.0..t_end, lo..hi)
-                .map_err(err)?;
-            c.configure_mesh()
-                .label_style((FONT, 12))
-                .axis_desc_style((FONT, 13))
-                .x_desc("t (s)")
-                .y_desc("deg")
-                .draw()
-                .map_err(err)?;
+            let mut c = chart(
+                &panels[panel],
+                &format!("{name} (solid) and reference (thin black), deg"),
+                (0.0..t_end, lo..hi),
+                ("t (s)", "deg"),
+            )?;
             for k in 0..n_links {
                 c.draw_series(LineSeries::new(
                     samples
@@ -156,12 +167,7 @@ pub fn flight_svg(flight: &Flight, obstacles: &[Footprint], title: &str) -> Resu
                     PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2))
                 });
             }
-            c.configure_series_labels()
-                .label_font((FONT, 12))
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()
-                .map_err(err)?;
+            legend(&mut c)?;
         }
 
         // (d) Top view: obstacles, the reference head path, the flown units' paths and
@@ -185,23 +191,12 @@ pub fn flight_svg(flight: &Flight, obstacles: &[Footprint], title: &str) -> Resu
             x0 -= g;
             x1 += g;
         }
-        let mut c = ChartBuilder::on(&panels[3])
-            .caption(
-                "flown chain, top view (grey: obstacles in the flight's height band)",
-                (FONT, 16),
-            )
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(50)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(err)?;
-        c.configure_mesh()
-            .label_style((FONT, 12))
-            .axis_desc_style((FONT, 13))
-            .x_desc("x (m)")
-            .y_desc("y (m)")
-            .draw()
-            .map_err(err)?;
+        let mut c = chart(
+            &panels[3],
+            "flown chain, top view (grey: obstacles in the flight's height band)",
+            (x0..x1, y0..y1),
+            ("x (m)", "y (m)"),
+        )?;
         let visible = obstacles
             .iter()
             .filter(|o| o[2] >= x0 && o[0] <= x1 && o[3] >= y0 && o[1] <= y1);
