@@ -105,7 +105,7 @@ mod tables {
     /// (`arc_host_sim::tables::DEGREE`), so both make the same bytes.
     const DEGREE: usize = 12;
 
-    /// The table for `units` units (ARC-MODEL.md default parameters): the full
+    /// The table for `units` units (docs/model.md default parameters): the full
     /// library, `n_srs` random shapes from `seed` and their roadmap, built as
     /// `arc tables build --units N --srs N_SRS --seed SEED` builds it (same
     /// sampler, same roadmap radius and degree, same encoder), so the two give

@@ -1,5 +1,5 @@
 //! End to end: `arc plan` on every built-in scenario, checked by the exact validity
-//! test of ARC-MODEL.md (`arc verify` and `verify_plan`), never by the planner's own
+//! test of docs/model.md (`arc verify` and `verify_plan`), never by the planner's own
 //! conservative shortcuts; failures and bad input give the right exit codes.
 
 use std::path::{Path, PathBuf};

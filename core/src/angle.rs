@@ -1,4 +1,4 @@
-//! Angle wrapping. ARC-MODEL.md wraps every angle difference to `(-pi, pi]`.
+//! Angle wrapping. docs/model.md wraps every angle difference to `(-pi, pi]`.
 
 use core::f32::consts::{PI, TAU};
 

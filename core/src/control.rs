@@ -6,7 +6,7 @@
 //! - a unit's attitude: the desired attitude comes from a thrust direction and a yaw
 //!   ([`desired_attitude`]) or from roll, pitch and yaw ([`from_euler_zyx`]);
 //! - a link's direction: the desired attitude comes from the planned link pitch and
-//!   yaw ([`link_attitude`]); its body x axis is ARC-MODEL.md's link direction
+//!   yaw ([`link_attitude`]); its body x axis is docs/model.md's link direction
 //!   `d = [cos psi cos theta, sin psi cos theta, -sin theta]`. A link cannot be twisted
 //!   about its own axis by forces at its ends, so a link controller usually sets the
 //!   x components of both gains to zero.
@@ -79,7 +79,7 @@ pub fn rot_z(a: f32) -> Mat3 {
     Mat3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
-/// `R = Rz(yaw) Ry(pitch) Rx(roll)` (zyx Euler angles, ARC-MODEL.md's order).
+/// `R = Rz(yaw) Ry(pitch) Rx(roll)` (zyx Euler angles, docs/model.md's order).
 pub fn from_euler_zyx(roll: f32, pitch: f32, yaw: f32) -> Mat3 {
     rot_z(yaw) * rot_y(pitch) * rot_x(roll)
 }
@@ -220,7 +220,7 @@ pub fn desired_attitude(thrust: &Vec3, yaw: f32) -> Mat3 {
 }
 
 /// The desired attitude of a link with pitch `pitch` and yaw `yaw`:
-/// `Rz(yaw) Ry(pitch)`, whose body x axis is ARC-MODEL.md's link direction
+/// `Rz(yaw) Ry(pitch)`, whose body x axis is docs/model.md's link direction
 /// `[cos yaw cos pitch, sin yaw cos pitch, -sin pitch]` (pointing from the link's back
 /// unit to its front unit; see `kinematics::link_direction`). Non-finite angles count
 /// as 0.
@@ -237,7 +237,7 @@ pub fn link_angles(r: &Mat3) -> (f32, f32) {
     direction_angles(&r.column(0).into_owned())
 }
 
-/// The pitch and yaw `(theta, psi)` of a direction `d` in ARC-MODEL.md's convention
+/// The pitch and yaw `(theta, psi)` of a direction `d` in docs/model.md's convention
 /// `d = [cos psi cos theta, sin psi cos theta, -sin theta]` (`d` need not be unit).
 /// A zero or non-finite `d` gives `(0, 0)`.
 pub fn direction_angles(d: &Vec3) -> (f32, f32) {

@@ -1,4 +1,4 @@
-//! Forward kinematics of the chain (paper Eq. 2, ARC-MODEL.md):
+//! Forward kinematics of the chain (paper Eq. 2, docs/model.md):
 //! `p_{i+1} = p_i - l * [cos(psi_i) cos(theta_i), sin(psi_i) cos(theta_i), -sin(theta_i)]`.
 
 use nalgebra::Vector3;

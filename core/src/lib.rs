@@ -17,7 +17,7 @@
 //! - [`control`]: the geometric SO(3) attitude controller.
 //!
 //! Everything is plain data and pure functions in `f32`: no I/O, no clocks, no
-//! allocation, no globals. The contract all of it follows is `shared/ARC-MODEL.md`.
+//! allocation, no globals. The contract all of it follows is `docs/model.md`.
 #![no_std]
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]

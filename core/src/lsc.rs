@@ -1,4 +1,4 @@
-//! The library of shape configurations (LSC, paper Sec. 3.2, ARC-MODEL.md).
+//! The library of shape configurations (LSC, paper Sec. 3.2, docs/model.md).
 //!
 //! For any N the library tries six shapes, all drawn with the head at the origin
 //! and the chain trailing behind it along -x:

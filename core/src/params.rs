@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Largest number of units a chain may have (ARC-MODEL.md: 2 <= N <= 16).
+/// Largest number of units a chain may have (docs/model.md: 2 <= N <= 16).
 pub const MAX_UNITS: usize = 16;
 /// Largest number of links (`MAX_UNITS - 1`).
 pub const MAX_LINKS: usize = MAX_UNITS - 1;
@@ -13,7 +13,7 @@ pub const MIN_UNITS: usize = 2;
 
 /// The physical parameters of a chain. Lengths in metres, angles in radians.
 ///
-/// Build with [`ChainParams::new`] (the ARC-MODEL.md defaults for `units`) and
+/// Build with [`ChainParams::new`] (the docs/model.md defaults for `units`) and
 /// check with [`ChainParams::validate`] before use: every function in this crate
 /// assumes validated parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -68,18 +68,18 @@ impl core::fmt::Display for ParamError {
 }
 
 impl ChainParams {
-    /// ARC-MODEL.md default link length `l` (m).
+    /// docs/model.md default link length `l` (m).
     pub const DEFAULT_LINK_LENGTH: f32 = 0.50;
-    /// ARC-MODEL.md default unit radius `r_u` (m).
+    /// docs/model.md default unit radius `r_u` (m).
     pub const DEFAULT_UNIT_RADIUS: f32 = 0.15;
-    /// ARC-MODEL.md default link radius `r_l` (m).
+    /// docs/model.md default link radius `r_l` (m).
     pub const DEFAULT_LINK_RADIUS: f32 = 0.01;
-    /// ARC-MODEL.md default pitch limit (60 degrees).
+    /// docs/model.md default pitch limit (60 degrees).
     pub const DEFAULT_THETA_MAX: f32 = core::f32::consts::FRAC_PI_3;
-    /// ARC-MODEL.md default bend limit (120 degrees).
+    /// docs/model.md default bend limit (120 degrees).
     pub const DEFAULT_BETA_MAX: f32 = 2.0 * core::f32::consts::FRAC_PI_3;
 
-    /// The ARC-MODEL.md defaults for a chain of `units` units (not yet validated).
+    /// The docs/model.md defaults for a chain of `units` units (not yet validated).
     pub const fn new(units: u8) -> Self {
         Self {
             units,

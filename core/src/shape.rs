@@ -44,7 +44,7 @@ impl Shape {
         s
     }
 
-    /// A shape from its `2N - 1` angles, in ARC-MODEL.md order.
+    /// A shape from its `2N - 1` angles, in docs/model.md order.
     pub fn from_slice(units: u8, eta: &[f32]) -> Result<Self, ShapeError> {
         if !(2..=MAX_UNITS as u8).contains(&units) {
             return Err(ShapeError::UnitsOutOfRange);
@@ -116,7 +116,7 @@ impl Shape {
     }
 
     /// The point at fraction `t` of the straight motion from `self` to `to`, each angle
-    /// moving along its shortest signed difference (ARC-MODEL.md shape-change edge).
+    /// moving along its shortest signed difference (docs/model.md shape-change edge).
     pub fn lerp(&self, to: &Shape, t: f32) -> Shape {
         debug_assert_eq!(self.units, to.units);
         let mut s = *self;

@@ -1,4 +1,4 @@
-//! Shape validity without a map: joint limits and self-collision (ARC-MODEL.md
+//! Shape validity without a map: joint limits and self-collision (docs/model.md
 //! items 1 and 2), for one shape exactly and for a straight shape transition
 //! conservatively.
 //!

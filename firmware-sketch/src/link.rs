@@ -4,7 +4,7 @@
 //! unit `i + 1`; the tail unit `N` leads no link and tracks link `N - 1`, the
 //! one it trails. A shape command therefore gives each unit one direction to
 //! reach: the pitch `theta` and yaw `psi` of its link in the world frame
-//! (ARC-MODEL.md), i.e. the desired attitude `R_d = Rz(psi) Ry(theta)` whose
+//! (docs/model.md), i.e. the desired attitude `R_d = Rz(psi) Ry(theta)` whose
 //! body x axis is the link direction (`arc_core::control::link_attitude`).
 //!
 //! The loop is the core's Lee-Leok-McClamroch SO(3) controller

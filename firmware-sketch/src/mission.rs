@@ -3,7 +3,7 @@
 //!
 //! A command moves the whole chain's shape linearly from the last commanded
 //! shape to shape `k`, each angle along its shortest signed difference
-//! (ARC-MODEL.md's shape-change edge), at most [`SHAPE_RATE`] on the angle that
+//! (docs/model.md's shape-change edge), at most [`SHAPE_RATE`] on the angle that
 //! moves most. Every unit knows the whole shape from its own copy of the table,
 //! so every unit computes the same duration and all links arrive together
 //! without talking. This unit's link reference follows its own two angles on

@@ -3,7 +3,7 @@
 //! Maps (OctoMap `.bt` files, occupancy grids, distance fields, scenario
 //! generators), collision of the chain against a map, the ARCplanner, the chain's
 //! simulation, plan files and pictures, and the `arc` command line.
-//! The contract everything here follows is `shared/ARC-MODEL.md`.
+//! The contract everything here follows is `docs/model.md`.
 
 pub mod baseline;
 pub mod bench;

@@ -1,4 +1,4 @@
-//! Plan files: JSON, `"format": "arc-plan/1"` (ARC-MODEL.md, "Files").
+//! Plan files: JSON, `"format": "arc-plan/1"` (docs/model.md, "Files").
 //!
 //! Values are `f64` in the file; shapes come from the `f32` core and are widened
 //! exactly, head positions are kept in `f64` so a start given on the command line

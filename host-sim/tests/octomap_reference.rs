@@ -5,7 +5,7 @@
 //!   `*_bt.txt`/`*_ot.txt` hold what OctoMap reports for them: node and leaf counts,
 //!   getMetricMin/Max, a hash of every leaf (centre, size, depth, state, in iterator order)
 //!   and `search` results for sample points. We must report exactly the same values.
-//! * `geb079.bt` (a real map, `/work/shared/maps/`, or `$ARC_GEB079`) likewise, when present.
+//! * `geb079.bt` (the real scan in `maps/`) likewise.
 //! * Files our writer makes are read by OctoMap itself (the checker is compiled from
 //!   `make_fixtures.cpp` with g++), which must report what we report, and OctoMap's own
 //!   `writeBinary` of what it read must give our bytes back (so we prune as OctoMap does).
@@ -202,19 +202,14 @@ fn our_writer_gives_octomaps_bytes_back() {
     assert_eq!(ot, bt);
 }
 
-fn geb079_path() -> Option<PathBuf> {
-    let p = std::env::var_os("ARC_GEB079")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("/work/shared/maps/geb079.bt"));
-    p.exists().then_some(p)
+/// The real scan shipped with the repository (`maps/geb079.bt`).
+fn geb079_path() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../maps/geb079.bt")
 }
 
 #[test]
 fn real_map_geb079_reads_as_octomap_reads_it() {
-    let Some(path) = geb079_path() else {
-        eprintln!("SKIPPED: geb079.bt not found (set ARC_GEB079 to its path)");
-        return;
-    };
+    let path = geb079_path();
     let bytes = std::fs::read(&path).unwrap();
     let tree = OcTree::from_bt_bytes(&bytes, "geb079.bt").unwrap_or_else(|e| panic!("{e}"));
     // Best of a few decodes: the machine is shared.

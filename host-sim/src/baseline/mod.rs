@@ -13,7 +13,7 @@
 //! shape), as OMPL's planners sample a goal region; sampled vertices that happen to lie
 //! in the ball are goals too.
 //!
-//! # Edges (ARC-MODEL.md "Motion between two configurations")
+//! # Edges (docs/model.md "Motion between two configurations")
 //! The roadmap joins every vertex to its `k` nearest neighbours (and the relation is
 //! made symmetric) in the weighted zeta metric of [`metric`] (RMS displacement of the
 //! units, `C_T` weights, exact k-d tree), `k` by the PRM* rule

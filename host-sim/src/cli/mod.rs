@@ -70,7 +70,7 @@ enum Command {
     Shapes(tables::ShapesArgs),
     /// Plan a collision-free motion with shape changes (the ARCplanner).
     Plan(Box<plan::PlanArgs>),
-    /// Check a plan exactly against a map (ARC-MODEL.md), independent of the planner.
+    /// Check a plan exactly against a map (docs/model.md), independent of the planner.
     Verify(verify::VerifyArgs),
     /// Maps: export built-in scenarios as OctoMap files, inspect and draw maps.
     #[command(subcommand)]

@@ -1,4 +1,4 @@
-//! `arc verify`: the exact check of ARC-MODEL.md, independent of the planner.
+//! `arc verify`: the exact check of docs/model.md, independent of the planner.
 
 use std::path::PathBuf;
 

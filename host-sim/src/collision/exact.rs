@@ -192,7 +192,7 @@ pub fn positions_f64(link_length: f64, head: [f64; 3], eta: &[f64]) -> Vec<[f64;
 /// Why a configuration is invalid by the exact test.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ExactViolation {
-    /// Limits or self-collision (ARC-MODEL.md items 1-2), by the core's checks.
+    /// Limits or self-collision (docs/model.md items 1-2), by the core's checks.
     Shape(Violation),
     /// A unit centre lies outside the map's bounding box (item 4).
     OutOfBounds {
@@ -249,7 +249,7 @@ pub struct ExactClearance {
     pub body: Body,
 }
 
-/// The exact validity test of one configuration (ARC-MODEL.md "Validity of one
+/// The exact validity test of one configuration (docs/model.md "Validity of one
 /// configuration"), in `f64` for positions; limits and self-collision use the core's
 /// `f32` checks on the shape rounded to `f32`. `horizon` (m) caps how far beyond a
 /// body's radius obstacles are searched: the clearance reported is `min(true, horizon)`.

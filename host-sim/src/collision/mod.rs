@@ -1,4 +1,4 @@
-//! Collision of the chain against a map (ARC-MODEL.md "Validity of one configuration",
+//! Collision of the chain against a map (docs/model.md "Validity of one configuration",
 //! "Motion between two configurations").
 //!
 //! Two checkers:
@@ -6,7 +6,7 @@
 //!   distance field's proven lower bounds, for the planner: it may reject a valid
 //!   configuration or edge, never accept an invalid one;
 //! - the EXACT one ([`exact`], [`verify`]), independent of the distance field, for
-//!   verifying plans: exact point/segment-to-voxel-cube distances and ARC-MODEL.md's
+//!   verifying plans: exact point/segment-to-voxel-cube distances and docs/model.md's
 //!   edge sampling rule.
 //!
 //! # Conservative checks

@@ -1,4 +1,4 @@
-//! Exact verification of a plan against a map (ARC-MODEL.md "Motion between two
+//! Exact verification of a plan against a map (docs/model.md "Motion between two
 //! configurations"), independent of the distance field.
 //!
 //! Each edge is classified by which part of `zeta` changed (within 1e-9, angles compared
@@ -20,7 +20,7 @@ use super::exact::{check_config_exact, ExactViolation};
 use crate::map::grid::Grid;
 use crate::plan::Plan;
 
-/// Tolerance for "stays" when classifying an edge (ARC-MODEL.md).
+/// Tolerance for "stays" when classifying an edge (docs/model.md).
 pub const STAY_TOLERANCE: f64 = 1e-9;
 
 /// Most sample intervals one edge may need (a 2.5 km translation at 0.1 m).
@@ -79,7 +79,7 @@ pub fn classify_edge(a: &[f64], b: &[f64]) -> EdgeKind {
     }
 }
 
-/// Number of sample intervals ARC-MODEL.md's rule needs for the edge `a -> b` of `kind`
+/// Number of sample intervals docs/model.md's rule needs for the edge `a -> b` of `kind`
 /// at resolution `r_v` (at least 1; 0 for [`EdgeKind::Stay`] and [`EdgeKind::Both`]).
 pub fn edge_intervals(
     kind: EdgeKind,
@@ -399,7 +399,7 @@ pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> Verif
 }
 
 /// Exact check of one edge `a -> b` (`zeta`s) on `grid` for chain `params`, by
-/// ARC-MODEL.md's sampling rule, including both ends. Returns the smallest clearance,
+/// docs/model.md's sampling rule, including both ends. Returns the smallest clearance,
 /// or the first failing sample's fraction and violation (an edge that changes both parts
 /// fails at 0 with [`ExactViolation::BadShape`]).
 pub fn check_edge_exact(

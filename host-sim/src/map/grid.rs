@@ -3,7 +3,7 @@
 //! The lattice: voxel index `i` (per axis, an `i32`, OctoMap's key minus 32768) is the
 //! closed cube of edge `r_v` around the centre `(i + 0.5) * r_v`, i.e. it spans
 //! `[i * r_v, (i + 1) * r_v]`. The grid stores one byte per voxel ([`Cell`]) for the
-//! voxels of the map's bounding box (ARC-MODEL.md validity item 4: the metric bounds of
+//! voxels of the map's bounding box (docs/model.md validity item 4: the metric bounds of
 //! all known leaves, as OctoMap's `getMetricMin`/`getMetricMax` report them). A 100 m x
 //! 20 m x 5 m map at 0.1 m is 10^7 voxels, 10 MB.
 //!

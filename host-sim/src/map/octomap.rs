@@ -1,7 +1,7 @@
 //! OctoMap occupancy trees: reading and writing OctoMap's binary tree files (`.bt`).
 //!
 //! The project's interchange format for maps is the file written by OctoMap's
-//! `OcTree::writeBinary` (see `shared/ARC-MODEL.md`, "Files"). This module reads and writes
+//! `OcTree::writeBinary` (see `docs/model.md`, "Files"). This module reads and writes
 //! it without linking OctoMap, and reports what OctoMap reports for the same file: leaf
 //! counts, `getMetricMin`/`getMetricMax`, and `search` results. The tests in
 //! `host-sim/tests/octomap_reference.rs` check that against values printed by the real

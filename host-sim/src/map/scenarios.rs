@@ -4,7 +4,7 @@
 //! Every scenario is a closed box at 0.1 m whose every voxel is known: walls, floors
 //! and obstacles are OCCUPIED (at least two voxels thick), everything else is explicitly
 //! FREE, so treating unknown space as occupied changes nothing inside the box. The
-//! default chain is ARC-MODEL.md's (`l = 0.5 m`, `r_u = 0.15 m`) with
+//! default chain is docs/model.md's (`l = 0.5 m`, `r_u = 0.15 m`) with
 //! [`Scenario::default_units`] units, and the planner's default clearance 0.05 m.
 //!
 //! Openings are sized for the planner's CONSERVATIVE checks, not only for the exact

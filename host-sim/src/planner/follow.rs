@@ -5,7 +5,7 @@
 //! than the room behind a window cannot line up with it, so it must snake: move the
 //! head a short step, then lay the body back along the head's own track, so every
 //! unit slides along the curve the head drew. Each step is still "change shape, then
-//! translate" (ARC-MODEL.md): the translation moves the body off its track by at most
+//! translate" (docs/model.md): the translation moves the body off its track by at most
 //! one step, the next shape change puts it back.
 
 use arc_core::kinematics::link_direction;

@@ -1,4 +1,4 @@
-//! MotionPlan: a solution as an `arc-plan/1` file (ARC-MODEL.md "Files").
+//! MotionPlan: a solution as an `arc-plan/1` file (docs/model.md "Files").
 //!
 //! Waypoint 0 is the start; each head edge becomes its shape changes (head fixed)
 //! then one translation (shape fixed). Timings go under `stats.timing`, the only

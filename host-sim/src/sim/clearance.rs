@@ -96,7 +96,7 @@ impl Obstacles for MapClearance<'_> {
     }
 
     fn check_spacing(&self) -> f64 {
-        // ARC-MODEL.md's edge sampling rule: no body point moves more than r_v / 4.
+        // docs/model.md's edge sampling rule: no body point moves more than r_v / 4.
         self.grid.resolution() / 4.0
     }
 }

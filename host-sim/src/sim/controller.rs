@@ -142,7 +142,7 @@ fn measure_link(front: &BodyState, back: &BodyState) -> LinkMeasure {
         V3::zeros()
     };
     let omega = d.cross(&ddot);
-    // ARC-MODEL.md's angles of d (as arc_core::control::direction_angles, in f64).
+    // docs/model.md's angles of d (as arc_core::control::direction_angles, in f64).
     let pitch = (-d.z).clamp(-1.0, 1.0).asin();
     let yaw = if d.x.abs() + d.y.abs() > 1e-12 {
         d.y.atan2(d.x)

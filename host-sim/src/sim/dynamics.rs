@@ -22,7 +22,7 @@
 //!   `k`'s front end (local `+x l/2`) on unit `k` and its back end on unit `k + 1`.
 //!   Kept as the reference the lumped model is tested against.
 //!
-//! In both, a link's body x axis is ARC-MODEL.md's link direction `d`. rapier3d works
+//! In both, a link's body x axis is docs/model.md's link direction `d`. rapier3d works
 //! in `f32` with glam types; this module converts at its boundary to the `f64`
 //! nalgebra types the rest of the simulation uses.
 
@@ -124,7 +124,7 @@ pub struct ChainDynamics {
     time: f64,
 }
 
-/// Unit centres of a configuration (`f64` forward kinematics, ARC-MODEL.md Eq. 2).
+/// Unit centres of a configuration (`f64` forward kinematics, docs/model.md Eq. 2).
 pub fn unit_positions(l: f64, head: V3, eta: &[f64]) -> Vec<V3> {
     let links = eta.len().saturating_sub(1) / 2;
     let mut p = Vec::with_capacity(links + 1);
@@ -136,7 +136,7 @@ pub fn unit_positions(l: f64, head: V3, eta: &[f64]) -> Vec<V3> {
     p
 }
 
-/// ARC-MODEL.md's link direction `[cos psi cos theta, sin psi cos theta, -sin theta]`.
+/// docs/model.md's link direction `[cos psi cos theta, sin psi cos theta, -sin theta]`.
 pub fn link_direction(pitch: f64, yaw: f64) -> V3 {
     V3::new(
         yaw.cos() * pitch.cos(),

@@ -3,7 +3,7 @@
 //! acceleration (and the link angles, rates and angular accelerations) are continuous
 //! and the chain is at rest at every waypoint.
 //!
-//! Edges follow ARC-MODEL.md "Motion between two configurations": a translation
+//! Edges follow docs/model.md "Motion between two configurations": a translation
 //! moves the head along the straight segment with the shape fixed; a shape change
 //! moves every angle of `eta` linearly along its shortest signed difference with the
 //! head fixed. An edge that changes both is refused.
@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 
 use super::dynamics::{unit_positions, V3};
 
-/// ARC-MODEL.md: "stays" means equal within this (angles compared after wrapping).
+/// docs/model.md: "stays" means equal within this (angles compared after wrapping).
 pub const STAY_TOLERANCE: f64 = 1e-9;
 
 /// Peak of `ds/dtau` of the quintic time scaling.
@@ -210,7 +210,7 @@ impl Reference {
             let (kind, duration) = match (moves_head, moves_shape) {
                 (true, true) => {
                     return Err(format!(
-                        "edge {i} -> {} changes both the head position and the shape (ARC-MODEL.md allows one kind per edge)",
+                        "edge {i} -> {} changes both the head position and the shape (docs/model.md allows one kind per edge)",
                         i + 1
                     ))
                 }
