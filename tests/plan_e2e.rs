@@ -426,3 +426,51 @@ fn follow_step_zero_is_the_papers_planner() {
         .expect("waypoint_sources");
     assert!(sources.iter().all(|w| w.as_str() != Some("follow")));
 }
+
+/// Refinement (the default) and `--no-smooth` both give plans the exact verifier
+/// accepts; the refined plan asks no more of the chain than the raw one and records
+/// the raw plan's quality beside its own.
+#[test]
+fn refined_plans_verify_and_ask_less_of_the_chain() {
+    let dir = tmp();
+    for (scenario, units) in [("window", "5"), ("maze", "5"), ("corridor", "4")] {
+        let sc = scenarios::build(scenario).expect("built-in scenario");
+        let plan = |name: &str, extra: &[&str]| -> Plan {
+            let out = dir.path().join(name);
+            let mut args = vec!["plan", "--scenario", scenario, "--units", units];
+            args.extend_from_slice(extra);
+            args.extend_from_slice(&["--out", s(&out)]);
+            arc(&args).unwrap_or_else(|e| panic!("{scenario}: {e}"));
+            let plan = Plan::read(&out).expect("plan file reads back");
+            let report = verify_plan(&sc.grid, &plan);
+            assert!(report.ok, "{scenario} {name}: {:?}", report.violation);
+            plan
+        };
+        let raw = plan(&format!("{scenario}-raw.json"), &["--no-smooth"]);
+        let refined = plan(&format!("{scenario}-refined.json"), &[]);
+        let q = |p: &Plan, key: &str| p.stats["quality"][key].as_f64().expect(key);
+        assert!(raw.stats.get("refinement").is_none());
+        for key in ["head_path_m", "shape_motion_rad", "shape_changes"] {
+            assert_eq!(
+                q(&raw, key),
+                refined.stats["refinement"]["before"][key].as_f64().unwrap(),
+                "{scenario}: the refined plan records the raw plan's {key}"
+            );
+        }
+        assert!(q(&refined, "head_path_m") <= q(&raw, "head_path_m") + 1e-9);
+        assert!(q(&refined, "shape_changes") <= q(&raw, "shape_changes"));
+        assert!(
+            refined.waypoints.len() < raw.waypoints.len(),
+            "{scenario}: refinement removed no waypoint"
+        );
+        eprintln!(
+            "{scenario} N={units}: path {:.2} -> {:.2} m, shape motion {:.2} -> {:.2} rad, {} -> {} waypoints",
+            q(&raw, "head_path_m"),
+            q(&refined, "head_path_m"),
+            q(&raw, "shape_motion_rad"),
+            q(&refined, "shape_motion_rad"),
+            raw.waypoints.len(),
+            refined.waypoints.len()
+        );
+    }
+}

@@ -36,6 +36,8 @@ pub mod palette {
     pub const SENSOR: Colour = "#17becf";
     /// Follow-the-leader shapes.
     pub const FOLLOW: Colour = "#8c564b";
+    /// Shape changes made smaller by refinement.
+    pub const SHRUNK: Colour = "#bcbd22";
     /// Axis and text.
     pub const INK: Colour = "#222222";
 }

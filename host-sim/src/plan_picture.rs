@@ -145,6 +145,8 @@ pub fn draw(grid: &Grid, plan: &Plan, title: &str, goal: Option<[f64; 3]>) -> Fi
                 Some(palette::SRS)
             } else if src == "rotation" {
                 Some(palette::SENSOR)
+            } else if src == "shrunk" {
+                Some(palette::SHRUNK)
             } else if follow && follows % every == 0 {
                 Some(palette::FOLLOW)
             } else {
@@ -165,6 +167,7 @@ pub fn draw(grid: &Grid, plan: &Plan, title: &str, goal: Option<[f64; 3]>) -> Fi
     fig.legend(palette::SRS, "random shape (SRS)");
     fig.legend(palette::SENSOR, "yaw rotation");
     fig.legend(palette::FOLLOW, "follow-the-leader (some)");
+    fig.legend(palette::SHRUNK, "shape change made smaller by refinement");
     fig.legend(palette::GOAL, "end");
     fig.legend(
         palette::OBSTACLE,

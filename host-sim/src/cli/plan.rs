@@ -10,6 +10,7 @@ use clap::Args;
 use super::common::{ChainArgs, MapArgs, Query, QueryArgs};
 use super::{CliError, CliResult};
 use crate::collision::{CollisionContext, DEFAULT_CLEARANCE};
+use crate::planner::refine::{Quality, Refinement};
 use crate::planner::{motion, Mode, Planner, Preference, Settings, Termination};
 use crate::tables::{ShapeTables, TableSettings};
 
@@ -74,6 +75,10 @@ pub struct PlanArgs {
     /// Times a failing query may double the head roadmap and try again.
     #[arg(long, default_value_t = 3)]
     max_growth: usize,
+    /// Keep the plan as the search made it: no shortcuts, no merged translations or
+    /// dropped shape changes (see `planner::refine`).
+    #[arg(long)]
+    no_smooth: bool,
     /// Give up after this many seconds.
     #[arg(long)]
     time_limit: Option<f64>,
@@ -220,7 +225,15 @@ pub fn run(a: PlanArgs) -> CliResult {
     let solution = planner
         .solve(start, shape, goal, stop)
         .map_err(|e| CliError::failed(format!("no plan: {e}")))?;
-    let plan = motion::to_plan(&solution, &params, resolution, unknown_occ);
+    let (solution, refinement) = if a.no_smooth {
+        (solution, None)
+    } else {
+        let (refined, r) = planner.refine(&solution);
+        (refined, Some(r))
+    };
+    let quality = Quality::of(&solution.steps);
+    let mut plan = motion::to_plan(&solution, &params, resolution, unknown_occ);
+    motion::annotate_quality(&mut plan, &quality, refinement.as_ref());
     plan.write(&a.out)
         .map_err(|e| CliError::input(e.to_string()))?;
     let s = &solution.stats;
@@ -246,6 +259,7 @@ pub fn run(a: PlanArgs) -> CliResult {
         s.collision_s * 1e3,
         s.collision_checks
     );
+    print_quality(&quality, refinement.as_ref());
     if let Some(pic) = &a.picture {
         let grid = planner.context().field().grid();
         crate::plan_picture::draw(
@@ -259,4 +273,22 @@ pub fn run(a: PlanArgs) -> CliResult {
         println!("  picture: {}", pic.display());
     }
     Ok(())
+}
+
+/// Prints the plan's quality, and what refinement changed.
+fn print_quality(q: &Quality, refinement: Option<&Refinement>) {
+    println!(
+        "  head path {:.2} m, {} shape changes, shape motion {:.2} rad (sum of C_T {:.2})",
+        q.head_path_m, q.shape_changes, q.shape_motion_rad, q.shape_cost
+    );
+    if let Some(r) = refinement {
+        println!(
+            "  refined in {:.1} ms ({} checks) from: head path {:.2} m, {} shape changes, shape motion {:.2} rad",
+            r.time_s * 1e3,
+            r.checks,
+            r.before.head_path_m,
+            r.before.shape_changes,
+            r.before.shape_motion_rad
+        );
+    }
 }

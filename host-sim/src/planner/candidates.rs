@@ -22,6 +22,9 @@ pub enum Source {
     SrsTurned(u16),
     /// The chain laid back along the head's track (follow-the-leader).
     Follow,
+    /// Part of the way to a shape the search chose, where refinement found that
+    /// enough ([`super::refine`]).
+    Shrunk,
 }
 
 /// A shape with its origin.

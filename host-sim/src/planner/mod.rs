@@ -16,6 +16,7 @@
 pub mod candidates;
 pub mod follow;
 pub mod motion;
+pub mod refine;
 pub mod roadmap;
 pub mod srs_connect;
 
@@ -148,6 +149,8 @@ pub struct Stats {
     pub srs_uses: usize,
     /// Follow-the-leader shapes used (one per short step).
     pub follow_uses: usize,
+    /// Shape changes that refinement made smaller ([`refine`]).
+    pub shrunk: usize,
     /// SRSConnect calls.
     pub srs_connects: usize,
     /// Head edges dropped and routes asked again (in the final roadmap).
@@ -390,6 +393,33 @@ fn trail_yaw(params: &arc_core::ChainParams, shape: &Shape) -> f32 {
     c.y.atan2(c.x)
 }
 
+/// Counts a plan's head edges and shape changes by where each shape came from
+/// (replacing earlier counts: backing up and refinement change the steps).
+fn count_sources(steps: &[Step], stats: &mut Stats) {
+    (stats.edges, stats.shape_changes) = (0, 0);
+    (
+        stats.rotations,
+        stats.lsc_uses,
+        stats.srs_uses,
+        stats.follow_uses,
+    ) = (0, 0, 0, 0);
+    for s in &steps[1..] {
+        if !s.shape_change {
+            stats.edges += 1;
+            continue;
+        }
+        stats.shape_changes += 1;
+        match s.source {
+            Source::Rotation => stats.rotations += 1,
+            Source::Lsc(_) => stats.lsc_uses += 1,
+            Source::Srs(_) | Source::SrsTurned(_) => stats.srs_uses += 1,
+            Source::Follow => stats.follow_uses += 1,
+            Source::Shrunk => stats.shrunk += 1,
+            Source::Start => {}
+        }
+    }
+}
+
 /// One leg of a head edge: shape changes where the head is, then a translation.
 struct Leg {
     changes: Vec<Candidate>,
@@ -560,7 +590,7 @@ impl<'p> Construction<'p> {
             };
             i = 0;
         }
-        self.count_steps();
+        count_sources(&self.steps, &mut self.stats);
         self.stats.collision_s = self.checker.time.as_secs_f64();
         Ok((self.steps, self.stats))
     }
@@ -589,24 +619,6 @@ impl<'p> Construction<'p> {
                 source: cur.source,
                 shape_change: false,
             });
-        }
-    }
-
-    /// Counts of the final plan's steps (after any backing up).
-    fn count_steps(&mut self) {
-        for s in &self.steps[1..] {
-            if !s.shape_change {
-                self.stats.edges += 1;
-                continue;
-            }
-            self.stats.shape_changes += 1;
-            match s.source {
-                Source::Rotation => self.stats.rotations += 1,
-                Source::Lsc(_) => self.stats.lsc_uses += 1,
-                Source::Srs(_) | Source::SrsTurned(_) => self.stats.srs_uses += 1,
-                Source::Follow => self.stats.follow_uses += 1,
-                Source::Start => {}
-            }
         }
     }
 

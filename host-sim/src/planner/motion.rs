@@ -8,6 +8,7 @@ use arc_core::ChainParams;
 use serde_json::Value;
 
 use super::candidates::Source;
+use super::refine::{Quality, Refinement};
 use super::Solution;
 use crate::plan::{Plan, Timing};
 
@@ -21,6 +22,7 @@ pub fn source_label(s: &Source, shape_change: bool) -> String {
         (Source::Srs(i), true) => format!("SRS:{i}"),
         (Source::SrsTurned(i), true) => format!("SRS:{i}:turned"),
         (Source::Follow, true) => "follow".into(),
+        (Source::Shrunk, true) => "shrunk".into(),
     }
 }
 
@@ -39,6 +41,7 @@ pub fn to_plan(
         ("lsc_uses", st.lsc_uses as u64),
         ("srs_uses", st.srs_uses as u64),
         ("follow_uses", st.follow_uses as u64),
+        ("shrunk", st.shrunk as u64),
         ("srs_connects", st.srs_connects as u64),
         ("replans", st.replans as u64),
         ("roadmap_growths", st.roadmap_growths as u64),
@@ -68,4 +71,30 @@ pub fn to_plan(
     plan.stats
         .insert("waypoint_sources".into(), Value::Array(labels));
     plan
+}
+
+/// Records a plan's quality (docs/model.md, "Plan statistics") under `stats.quality`,
+/// and, for a refined plan, the raw plan's quality and the refinement's cost under
+/// `stats.refinement` (its time under `stats.timing.refine_s`).
+pub fn annotate_quality(plan: &mut Plan, quality: &Quality, refinement: Option<&Refinement>) {
+    plan.stats.insert("quality".into(), quality_json(quality));
+    let Some(r) = refinement else {
+        return;
+    };
+    let mut m = serde_json::Map::new();
+    m.insert("before".into(), quality_json(&r.before));
+    m.insert("checks".into(), r.checks.into());
+    plan.stats.insert("refinement".into(), Value::Object(m));
+    if let Some(Value::Object(t)) = plan.stats.get_mut("timing") {
+        t.insert("refine_s".into(), r.time_s.into());
+    }
+}
+
+fn quality_json(q: &Quality) -> Value {
+    serde_json::json!({
+        "head_path_m": q.head_path_m,
+        "shape_motion_rad": q.shape_motion_rad,
+        "shape_cost": q.shape_cost,
+        "shape_changes": q.shape_changes,
+    })
 }

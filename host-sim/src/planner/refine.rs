@@ -1,0 +1,350 @@
+//! Plan refinement: after a query is solved, shortcut its waypoints where the chain
+//! can still pass, so that plans fly with fewer and smaller shape changes.
+//!
+//! The planner's plans are sequences of poses (head position, shape) where each
+//! step either changes the shape or translates the head (docs/model.md, "Motion
+//! between two configurations"). Refinement walks the poses and, from the pose it
+//! stands at, looks ahead for the farthest pose it can reach directly, in one of two
+//! ways:
+//! - keep the current shape, translate straight to the later pose's head position,
+//!   then change to its shape there;
+//! - change to the later pose's shape here, then translate there with it.
+//!
+//! Both are checked with the planner's conservative checks (the same clearance
+//! margin as the search), so a refined plan is as admissible as the raw one and
+//! keeps the same clearance from walls. Skipped poses take their shape changes with
+//! them: a detour through another shape and back becomes one direct change or none,
+//! consecutive translations with one shape become one, and a run of short
+//! follow-the-leader steps becomes as few steps as stay admissible.
+//!
+//! The look-ahead gallops (2, 4, 8, ... poses ahead, then bisects back), so a pose
+//! costs a few checks; a budget of checks bounds the whole pass. Refinement counts
+//! checks, not time, so it is deterministic: the same plan gives the same result.
+
+use std::time::Instant;
+
+use arc_core::angle;
+use arc_core::cost::transition_cost;
+use arc_core::Shape;
+
+use super::candidates::Source;
+use super::{Checker, Planner, Solution, Step};
+
+/// Collision checks refinement may spend on one plan. At a few microseconds each
+/// this bounds the pass to tens of milliseconds; what is left unrefined when it
+/// runs out stays as the search made it.
+pub const CHECK_BUDGET: u64 = 20_000;
+
+/// Angles closer than this (rad) are the same shape: no shape change is needed.
+const SAME_SHAPE: f32 = 1e-6;
+
+/// What a plan asks of the chain: the measures the flight time depends on.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Quality {
+    /// Length of the head's path (m).
+    pub head_path_m: f64,
+    /// Total shape motion: over every shape change, the sum of the absolute wrapped
+    /// differences of every angle of the shape (head yaw, link pitches and yaws), rad.
+    pub shape_motion_rad: f64,
+    /// Sum of the cost to transition `C_T` over every shape change (paper Eq. 3).
+    pub shape_cost: f64,
+    /// Number of shape changes.
+    pub shape_changes: usize,
+}
+
+impl Quality {
+    /// The measures of a plan's steps.
+    pub fn of(steps: &[Step]) -> Self {
+        let mut q = Self::default();
+        for w in steps.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            q.head_path_m += super::roadmap::dist(a.xi, b.xi);
+            if differs(&a.shape, &b.shape) {
+                q.shape_changes += 1;
+                q.shape_motion_rad += shape_motion(&a.shape, &b.shape);
+                q.shape_cost += transition_cost(&a.shape, &b.shape) as f64;
+            }
+        }
+        q
+    }
+}
+
+/// What refinement did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Refinement {
+    /// The plan as the search made it.
+    pub before: Quality,
+    /// The refined plan.
+    pub after: Quality,
+    /// Collision checks spent.
+    pub checks: u64,
+    /// Time spent (s).
+    pub time_s: f64,
+}
+
+/// The sum of the absolute wrapped differences of every angle from `a` to `b` (rad).
+pub fn shape_motion(a: &Shape, b: &Shape) -> f64 {
+    a.as_slice()
+        .iter()
+        .zip(b.as_slice())
+        .map(|(&x, &y)| angle::diff(x, y).abs() as f64)
+        .sum()
+}
+
+fn differs(a: &Shape, b: &Shape) -> bool {
+    a.max_angle_diff(b) > SAME_SHAPE
+}
+
+impl Planner {
+    /// Refines a solved query's plan (see the module docs). The result starts and
+    /// ends where the solution does and passes the same checks.
+    pub fn refine(&self, solution: &Solution) -> (Solution, Refinement) {
+        let began = Instant::now();
+        let mut pass = Pass {
+            checker: Checker {
+                ctx: &self.ctx,
+                time: std::time::Duration::ZERO,
+            },
+            poses: &solution.steps,
+            checks: 0,
+        };
+        let steps = pass.run();
+        let steps = pass.shrink_changes(steps);
+        let mut stats = solution.stats.clone();
+        super::count_sources(&steps, &mut stats);
+        let report = Refinement {
+            before: Quality::of(&solution.steps),
+            after: Quality::of(&steps),
+            checks: pass.checks,
+            time_s: began.elapsed().as_secs_f64(),
+        };
+        (Solution { steps, stats }, report)
+    }
+}
+
+/// One refinement pass over a plan's poses.
+struct Pass<'a> {
+    checker: Checker<'a>,
+    poses: &'a [Step],
+    checks: u64,
+}
+
+impl Pass<'_> {
+    fn run(&mut self) -> Vec<Step> {
+        let last = self.poses.len() - 1;
+        let mut out = vec![self.poses[0]];
+        let mut i = 0;
+        while i < last {
+            match self.farthest(i) {
+                Some((j, steps)) => {
+                    out.extend(steps);
+                    i = j;
+                }
+                None => {
+                    out.push(self.poses[i + 1]);
+                    i += 1;
+                }
+            }
+        }
+        out
+    }
+
+    fn exhausted(&self) -> bool {
+        self.checks >= CHECK_BUDGET
+    }
+
+    /// The farthest pose (beyond the next) reachable from pose `i` directly, with
+    /// the steps that reach it: gallop ahead while jumps succeed, then bisect
+    /// between the last success and the first failure.
+    fn farthest(&mut self, i: usize) -> Option<(usize, Vec<Step>)> {
+        let last = self.poses.len() - 1;
+        if i + 2 > last || self.exhausted() {
+            return None;
+        }
+        // A straight run to the end is the best there is; open space often allows it.
+        if let Some(s) = self.jump(i, last) {
+            return Some((last, s));
+        }
+        let mut best: Option<(usize, Vec<Step>)> = None;
+        let mut k = 2;
+        let mut fail = last;
+        while i + k < last {
+            match self.jump(i, i + k) {
+                Some(s) => best = Some((i + k, s)),
+                None => {
+                    fail = i + k;
+                    break;
+                }
+            }
+            k *= 2;
+        }
+        let mut lo = best.as_ref().map_or(i + 1, |b| b.0);
+        let mut hi = fail;
+        while hi - lo > 1 && !self.exhausted() {
+            let mid = lo + (hi - lo) / 2;
+            match self.jump(i, mid) {
+                Some(s) => {
+                    best = Some((mid, s));
+                    lo = mid;
+                }
+                None => hi = mid,
+            }
+        }
+        best
+    }
+
+    /// The steps that take the chain from pose `i` to pose `j` directly, if any.
+    fn jump(&mut self, i: usize, j: usize) -> Option<Vec<Step>> {
+        if self.exhausted() {
+            return None;
+        }
+        let (a, b) = (self.poses[i], self.poses[j]);
+        let moved = super::roadmap::dist(a.xi, b.xi) > 0.0;
+        let change = differs(&a.shape, &b.shape);
+        let translate = |shape: Shape, source: Source| Step {
+            xi: b.xi,
+            shape,
+            source,
+            shape_change: false,
+        };
+        let change_at = |xi: [f64; 3]| Step {
+            xi,
+            shape: b.shape,
+            source: b.source,
+            shape_change: true,
+        };
+        if !moved {
+            return (change && self.shape_change(a.xi, &a.shape, &b.shape))
+                .then(|| vec![change_at(a.xi)]);
+        }
+        // Keep the shape, translate, then change (or not) at the far end.
+        if self.translation(a.xi, b.xi, &a.shape)
+            && (!change || self.shape_change(b.xi, &a.shape, &b.shape))
+        {
+            let mut s = vec![translate(a.shape, a.source)];
+            if change {
+                s.push(change_at(b.xi));
+            }
+            return Some(s);
+        }
+        // Change here, then translate with the new shape.
+        if change
+            && self.shape_change(a.xi, &a.shape, &b.shape)
+            && self.translation(a.xi, b.xi, &b.shape)
+        {
+            return Some(vec![change_at(a.xi), translate(b.shape, b.source)]);
+        }
+        None
+    }
+
+    /// Makes each shape change as small as the run of translations after it allows:
+    /// a change `a -> b` followed by translations with `b` (and then, maybe, a change
+    /// `b -> c`) becomes `a -> b'` with `b'` a quarter, half or three quarters of the
+    /// way from `a` to `b` (the first that flies the whole run), when that moves the
+    /// chain's angles less in total.
+    fn shrink_changes(&mut self, mut steps: Vec<Step>) -> Vec<Step> {
+        let mut k = 1;
+        while k < steps.len() && !self.exhausted() {
+            if steps[k].shape_change && !steps[k - 1].shape_change {
+                let end = run_end(&steps, k);
+                if let Some(shape) = self.smaller_change(&steps, k, end) {
+                    for s in &mut steps[k..=end] {
+                        (s.shape, s.source) = (shape, Source::Shrunk);
+                    }
+                }
+            }
+            k += 1;
+        }
+        steps
+    }
+
+    /// For the change at `k` whose shape is flown up to step `end`, the smallest
+    /// partial change that flies the run and reaches the next shape (if any) with
+    /// less total motion.
+    fn smaller_change(&mut self, steps: &[Step], k: usize, end: usize) -> Option<Shape> {
+        let (a, b) = (steps[k - 1].shape, steps[k].shape);
+        let next = steps.get(end + 1).map(|s| s.shape);
+        let motion = |x: &Shape| shape_motion(&a, x) + next.map_or(0.0, |c| shape_motion(x, &c));
+        let whole = motion(&b);
+        for t in [0.25f32, 0.5, 0.75] {
+            let c = a.lerp(&b, t);
+            if motion(&c) + 1e-6 >= whole || !self.flies_run(steps, k, end, &c) {
+                continue;
+            }
+            return Some(c);
+        }
+        None
+    }
+
+    /// Whether `c` can replace the shape of steps `k..=end` (the change into it at
+    /// step `k`, every translation of the run, and the change out of it after `end`).
+    fn flies_run(&mut self, steps: &[Step], k: usize, end: usize, c: &Shape) -> bool {
+        let prev = steps[k - 1].shape;
+        if !self.shape_change(steps[k].xi, &prev, c) {
+            return false;
+        }
+        for w in k..end {
+            if !self.translation(steps[w].xi, steps[w + 1].xi, c) {
+                return false;
+            }
+        }
+        match steps.get(end + 1) {
+            Some(n) => self.shape_change(steps[end].xi, c, &n.shape),
+            None => true,
+        }
+    }
+
+    fn translation(&mut self, a: [f64; 3], b: [f64; 3], s: &Shape) -> bool {
+        self.checks += 1;
+        self.checker.translation(a, b, s)
+    }
+
+    fn shape_change(&mut self, xi: [f64; 3], s: &Shape, t: &Shape) -> bool {
+        self.checks += 1;
+        self.checker.shape_change(xi, s, t)
+    }
+}
+
+/// The last step of the run that flies the shape changed into at step `k`: the
+/// translations after it, up to the next shape change or the end.
+fn run_end(steps: &[Step], k: usize) -> usize {
+    let mut end = k;
+    while end + 1 < steps.len() && !steps[end + 1].shape_change {
+        end += 1;
+    }
+    end
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn step(xi: [f64; 3], yaw: f32, shape_change: bool) -> Step {
+        Step {
+            xi,
+            shape: Shape::line(4, yaw),
+            source: if shape_change {
+                Source::Rotation
+            } else {
+                Source::Start
+            },
+            shape_change,
+        }
+    }
+
+    #[test]
+    fn quality_sums_path_and_wrapped_shape_motion() {
+        let steps = [
+            step([0.0, 0.0, 1.0], 3.0, false),
+            step([0.0, 0.0, 1.0], -3.0, true),
+            step([3.0, 4.0, 1.0], -3.0, false),
+        ];
+        let q = Quality::of(&steps);
+        assert!((q.head_path_m - 5.0).abs() < 1e-12);
+        assert_eq!(q.shape_changes, 1);
+        // A line turned by 2 pi - 6 rad: head yaw and 3 link yaws, each wrapped.
+        let d = (std::f64::consts::TAU - 6.0) as f32;
+        assert!((q.shape_motion_rad - 4.0 * d as f64).abs() < 1e-4, "{q:?}");
+        assert!(q.shape_cost > 0.0);
+    }
+}
