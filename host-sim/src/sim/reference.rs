@@ -1,7 +1,9 @@
-//! Reference generation from a plan: every edge timed within speed and angular-rate
-//! limits, with a minimum-jerk (quintic) time scaling so that position, velocity and
-//! acceleration (and the link angles, rates and angular accelerations) are continuous
-//! and the chain is at rest at every waypoint.
+//! Reference generation from a plan: every edge timed within speed, acceleration and
+//! angular-rate limits. Each edge accelerates along a smooth ramp (the speed follows
+//! a smoothstep, so acceleration is continuous and zero at both ends of the ramp),
+//! cruises at the limit, and ramps down, so that position, velocity and acceleration
+//! (and the link angles, rates and angular accelerations) are continuous and the
+//! chain is at rest at every waypoint. Short edges never reach the cruise.
 //!
 //! Edges follow docs/model.md "Motion between two configurations": a translation
 //! moves the head along the straight segment with the shape fixed; a shape change
@@ -15,10 +17,9 @@ use super::dynamics::{unit_positions, V3};
 /// docs/model.md: "stays" means equal within this (angles compared after wrapping).
 pub const STAY_TOLERANCE: f64 = 1e-9;
 
-/// Peak of `ds/dtau` of the quintic time scaling.
-const QUINTIC_PEAK_RATE: f64 = 1.875;
-/// Peak of `|d2s/dtau2|` of the quintic time scaling (`10 / sqrt(3)`).
-const QUINTIC_PEAK_ACCEL: f64 = 5.773_502_691_896_258;
+/// Peak acceleration of a smoothstep speed ramp, per unit of cruise rate over ramp
+/// time: `max d/dx (3x^2 - 2x^3) = 1.5`.
+const RAMP_PEAK_ACCEL: f64 = 1.5;
 
 /// Wraps an angle to `(-pi, pi]`.
 pub fn wrap(a: f64) -> f64 {
@@ -102,6 +103,69 @@ pub struct Segment {
     pub delta: Vec<f64>,
     /// Index of the waypoint the segment ends at.
     pub to_waypoint: usize,
+    /// How the segment's progress from 0 to 1 runs in time.
+    pub scaling: Scaling,
+}
+
+/// Progress `s` from 0 to 1 along a segment: a smoothstep speed ramp up to the cruise
+/// rate, the cruise, and the mirror ramp down.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Scaling {
+    /// Cruise rate of `s` (1/s).
+    pub rate: f64,
+    /// Duration of each ramp (s).
+    pub ramp: f64,
+    /// Duration of the whole segment (s).
+    pub duration: f64,
+}
+
+impl Scaling {
+    /// The fastest scaling whose rate stays within `max_rate` and whose acceleration
+    /// stays within `max_accel` (both for `s`, per second).
+    pub fn fastest(max_rate: f64, max_accel: f64) -> Self {
+        // A ramp to rate r takes t_r = 1.5 r / a and covers r t_r / 2; two of them
+        // must fit in the segment (r t_r <= 1), else the rate is what they allow.
+        let full = RAMP_PEAK_ACCEL * max_rate * max_rate / max_accel;
+        let rate = if full <= 1.0 {
+            max_rate
+        } else {
+            (max_accel / RAMP_PEAK_ACCEL).sqrt()
+        };
+        let ramp = RAMP_PEAK_ACCEL * rate / max_accel;
+        Self {
+            rate,
+            ramp,
+            duration: 1.0 / rate + ramp,
+        }
+    }
+
+    /// `(s, ds/dt, d2s/dt2)` at time `t` into the segment.
+    pub fn at(&self, t: f64) -> (f64, f64, f64) {
+        if self.duration <= 0.0 || t >= self.duration {
+            return (1.0, 0.0, 0.0);
+        }
+        if t <= 0.0 {
+            return (0.0, 0.0, 0.0);
+        }
+        if t > self.duration - self.ramp {
+            let (s, ds, dds) = self.ramp_up(self.duration - t);
+            return (1.0 - s, ds, -dds);
+        }
+        if t < self.ramp {
+            return self.ramp_up(t);
+        }
+        let s = self.rate * self.ramp / 2.0 + self.rate * (t - self.ramp);
+        (s, self.rate, 0.0)
+    }
+
+    /// The ramp from rest: speed `rate * (3x^2 - 2x^3)` with `x = t / ramp`.
+    fn ramp_up(&self, t: f64) -> (f64, f64, f64) {
+        let x = t / self.ramp;
+        let s = self.rate * self.ramp * (x * x * x - 0.5 * x * x * x * x);
+        let ds = self.rate * x * x * (3.0 - 2.0 * x);
+        let dds = self.rate / self.ramp * 6.0 * x * (1.0 - x);
+        (s, ds, dds)
+    }
 }
 
 /// The reference of one link at one time.
@@ -147,19 +211,14 @@ pub struct Reference {
     duration: f64,
 }
 
-/// Minimum-jerk time scaling: `(s, ds/dt, d2s/dt2)` at `t` in a segment of length `d`.
-fn quintic(t: f64, d: f64) -> (f64, f64, f64) {
-    if d <= 0.0 || t >= d {
-        return (1.0, 0.0, 0.0);
+impl Segment {
+    /// `(s, ds/dt, d2s/dt2)` at time `t` into the segment; a hold stays at 0.
+    fn progress(&self, t: f64) -> (f64, f64, f64) {
+        match self.kind {
+            SegmentKind::Hold => (0.0, 0.0, 0.0),
+            _ => self.scaling.at(t),
+        }
     }
-    if t <= 0.0 {
-        return (0.0, 0.0, 0.0);
-    }
-    let x = t / d;
-    let s = x * x * x * (10.0 - 15.0 * x + 6.0 * x * x);
-    let ds = 30.0 * x * x * (1.0 - x) * (1.0 - x) / d;
-    let dds = 60.0 * x * (1.0 - 3.0 * x + 2.0 * x * x) / (d * d);
-    (s, ds, dds)
 }
 
 impl Reference {
@@ -191,6 +250,11 @@ impl Reference {
                 from: waypoints[0].clone(),
                 delta: vec![0.0; dim],
                 to_waypoint: 0,
+                scaling: Scaling {
+                    rate: 0.0,
+                    ramp: 0.0,
+                    duration: 0.0,
+                },
             });
             t = limits.start_hold;
         }
@@ -207,7 +271,7 @@ impl Reference {
                 .collect();
             let moves_head = delta[..3].iter().any(|d| d.abs() > STAY_TOLERANCE);
             let moves_shape = delta[3..].iter().any(|d| d.abs() > STAY_TOLERANCE);
-            let (kind, duration) = match (moves_head, moves_shape) {
+            let (kind, scaling) = match (moves_head, moves_shape) {
                 (true, true) => {
                     return Err(format!(
                         "edge {i} -> {} changes both the head position and the shape (docs/model.md allows one kind per edge)",
@@ -216,13 +280,13 @@ impl Reference {
                 }
                 (false, false) => {
                     delta.iter_mut().for_each(|d| *d = 0.0);
-                    (SegmentKind::Hold, 0.0)
+                    (SegmentKind::Hold, Scaling::default())
                 }
                 (true, false) => {
                     let len = V3::new(delta[0], delta[1], delta[2]).norm();
-                    let d = (QUINTIC_PEAK_RATE * len / limits.speed).max((QUINTIC_PEAK_ACCEL * len / limits.accel).sqrt());
+                    let scaling = Scaling::fastest(limits.speed / len, limits.accel / len);
                     delta[3..].iter_mut().for_each(|d| *d = 0.0);
-                    (SegmentKind::Translation, d)
+                    (SegmentKind::Translation, scaling)
                 }
                 (false, true) => {
                     let max_angle = delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()));
@@ -232,23 +296,23 @@ impl Reference {
                         .map(|k| (delta[4 + 2 * k].powi(2) + delta[5 + 2 * k].powi(2)).sqrt())
                         .sum::<f64>()
                         * link_length;
-                    let d = (QUINTIC_PEAK_RATE * max_angle / limits.angular_rate)
-                        .max((QUINTIC_PEAK_ACCEL * max_angle / limits.angular_accel).sqrt())
-                        .max(QUINTIC_PEAK_RATE * sweep / limits.speed);
+                    let rate = (limits.angular_rate / max_angle).min(limits.speed / sweep);
+                    let scaling = Scaling::fastest(rate, limits.angular_accel / max_angle);
                     delta[..3].iter_mut().for_each(|d| *d = 0.0);
-                    (SegmentKind::ShapeChange, d)
+                    (SegmentKind::ShapeChange, scaling)
                 }
             };
-            if duration > 0.0 {
+            if scaling.duration > 0.0 {
                 segments.push(Segment {
                     kind,
                     t0: t,
-                    duration,
+                    duration: scaling.duration,
                     from: a.clone(),
                     delta,
                     to_waypoint: i + 1,
+                    scaling,
                 });
-                t += duration;
+                t += scaling.duration;
             }
         }
         let mut end = waypoints[waypoints.len() - 1].clone();
@@ -293,7 +357,7 @@ impl Reference {
     pub fn zeta(&self, t: f64) -> Vec<f64> {
         match self.segment_at(t) {
             Some(seg) => {
-                let (s, _, _) = quintic(t - seg.t0, seg.duration);
+                let (s, _, _) = seg.progress(t - seg.t0);
                 seg.from
                     .iter()
                     .zip(&seg.delta)
@@ -316,7 +380,7 @@ impl Reference {
     pub fn sample(&self, t: f64) -> RefPoint {
         let (z, dz, ddz) = match self.segment_at(t) {
             Some(seg) => {
-                let (s, ds, dds) = quintic(t - seg.t0, seg.duration);
+                let (s, ds, dds) = seg.progress(t - seg.t0);
                 let z: Vec<f64> = seg
                     .from
                     .iter()
@@ -367,6 +431,35 @@ mod tests {
         let mut z = xi.to_vec();
         z.extend_from_slice(eta);
         z
+    }
+
+    #[test]
+    fn scaling_cruises_at_the_limit_or_ramps_straight_down() {
+        for (rate, accel) in [(0.1, 0.1), (2.0, 0.5), (0.5, 100.0)] {
+            let sc = Scaling::fastest(rate, accel);
+            let (mut vmax, mut amax, mut t, mut prev) = (0.0f64, 0.0f64, 0.0, (0.0, 0.0, 0.0));
+            while t <= sc.duration + 0.01 {
+                let now = sc.at(t);
+                assert!(now.0 >= prev.0 - 1e-12, "progress never goes back");
+                assert!(
+                    (now.1 - prev.1).abs() < 0.02 * rate.max(1.0),
+                    "speed is continuous"
+                );
+                (vmax, amax, prev) = (vmax.max(now.1), amax.max(now.2.abs()), now);
+                t += 1e-4;
+            }
+            assert!(
+                vmax <= rate + 1e-9 && amax <= accel + 1e-9,
+                "{rate} {accel}"
+            );
+            assert_eq!(sc.at(sc.duration), (1.0, 0.0, 0.0));
+            // Where the cruise is reached, the edge takes one ramp longer than at the
+            // cruise rate throughout: the quintic took 1.875 times as long.
+            if 1.5 * rate * rate / accel <= 1.0 {
+                assert!((sc.duration - (1.0 / rate + 1.5 * rate / accel)).abs() < 1e-12);
+                assert!((vmax - rate).abs() < 1e-9);
+            }
+        }
     }
 
     #[test]
