@@ -7,7 +7,7 @@ use std::time::Duration;
 use arc_core::ChainParams;
 use clap::Args;
 
-use super::common::{ChainArgs, MapArgs, Query, QueryArgs};
+use super::common::{ChainArgs, MapArgs, Query, QueryArgs, Report};
 use super::{CliError, CliResult};
 use crate::collision::{CollisionContext, DEFAULT_CLEARANCE};
 use crate::planner::{motion, Mode, Planner, Preference, Settings, Termination};
@@ -77,7 +77,7 @@ pub struct PlanArgs {
     /// Give up after this many seconds.
     #[arg(long)]
     time_limit: Option<f64>,
-    /// Output plan (JSON, arc-plan/1).
+    /// Output plan (JSON, arc-plan/1); `-` writes it to standard output.
     #[arg(long)]
     out: PathBuf,
     /// Picture of the plan (.svg or .png).
@@ -195,6 +195,7 @@ pub fn run(a: PlanArgs) -> CliResult {
     } = a.query.resolve(&a.chain, loaded.scenario.as_ref())?;
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
     let (resolution, unknown_occ) = (loaded.grid.resolution(), loaded.grid.unknown_is_occupied());
+    let source = loaded.source.clone();
     let (field, _) = loaded.into_field();
     let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;
     let settings = Settings {
@@ -220,13 +221,16 @@ pub fn run(a: PlanArgs) -> CliResult {
     let solution = planner
         .solve(start, shape, goal, stop)
         .map_err(|e| CliError::failed(format!("no plan: {e}")))?;
-    let plan = motion::to_plan(&solution, &params, resolution, unknown_occ);
+    let mut plan = motion::to_plan(&solution, &params, resolution, unknown_occ);
+    plan.map.source = source;
     plan.write(&a.out)
         .map_err(|e| CliError::input(e.to_string()))?;
     let s = &solution.stats;
-    println!(
+    // With `--out -` the plan is standard output; the report goes to standard error.
+    let report = Report::new(&a.out);
+    report.line(format_args!(
         "{}: solved on {} with N = {}: {} waypoints, {} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations, {} follow), {} replans",
-        a.out.display(),
+        crate::fsutil::display_name(&a.out),
         a.map.name(),
         params.units,
         plan.waypoints.len(),
@@ -237,15 +241,15 @@ pub fn run(a: PlanArgs) -> CliResult {
         s.rotations,
         s.follow_uses,
         s.replans
-    );
-    println!(
+    ));
+    report.line(format_args!(
         "  roadmap {:.1} ms ({} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
         s.roadmap_s * 1e3,
         s.roadmap_vertices,
         s.planning_s * 1e3,
         s.collision_s * 1e3,
         s.collision_checks
-    );
+    ));
     if let Some(pic) = &a.picture {
         let grid = planner.context().field().grid();
         crate::plan_picture::draw(
@@ -256,7 +260,7 @@ pub fn run(a: PlanArgs) -> CliResult {
         )
         .save(pic)
         .map_err(CliError::input)?;
-        println!("  picture: {}", pic.display());
+        report.line(format_args!("  picture: {}", pic.display()));
     }
     Ok(())
 }
