@@ -407,7 +407,7 @@ mod tests {
             0.15f32,
             0.01,
             0.5,
-            1.047_197_6,
+            std::f32::consts::FRAC_PI_3,
             -std::f32::consts::PI,
             1e-8,
             0.0,
