@@ -30,10 +30,19 @@ pub fn is_stdio(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
 
-/// How messages name `path`: `standard input/output` for `-`, else the path.
-pub fn display_name(path: &Path) -> String {
+/// How messages name an input `path`: `standard input` for `-`, else the path.
+pub fn input_name(path: &Path) -> String {
     if is_stdio(path) {
-        "- (standard input/output)".into()
+        "standard input".into()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// How messages name an output `path`: `standard output` for `-`, else the path.
+pub fn output_name(path: &Path) -> String {
+    if is_stdio(path) {
+        "standard output".into()
     } else {
         path.display().to_string()
     }

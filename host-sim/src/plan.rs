@@ -284,7 +284,7 @@ impl Plan {
     /// Reads and checks a plan file (`-`: standard input): format tag, chain
     /// parameters, every waypoint's length and finiteness.
     pub fn read(path: &Path) -> Result<Self, PlanError> {
-        let name = crate::fsutil::display_name(path);
+        let name = crate::fsutil::input_name(path);
         let mut text = String::new();
         let read = if crate::fsutil::is_stdio(path) {
             std::io::stdin().read_to_string(&mut text)
@@ -340,7 +340,7 @@ impl Plan {
         let mut text = serde_json::to_string_pretty(self).expect("a plan always serialises");
         text.push('\n');
         crate::fsutil::write_output(path, text.as_bytes()).map_err(|source| PlanError::Io {
-            path: crate::fsutil::display_name(path),
+            path: crate::fsutil::output_name(path),
             source,
         })
     }

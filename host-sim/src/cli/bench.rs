@@ -405,7 +405,7 @@ fn run_prm(a: PrmArgs) -> CliResult {
     let lines = Report::new(&a.out);
     lines.line(format_args!(
         "{}: full-state PRM solved {} with N = {}: {} waypoints, {} roadmap edges, {} shape changes",
-        crate::fsutil::display_name(&a.out),
+        crate::fsutil::output_name(&a.out),
         a.map.name(),
         params.units,
         plan.waypoints.len(),

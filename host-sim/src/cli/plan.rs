@@ -230,7 +230,7 @@ pub fn run(a: PlanArgs) -> CliResult {
     let report = Report::new(&a.out);
     report.line(format_args!(
         "{}: solved on {} with N = {}: {} waypoints, {} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations, {} follow), {} replans",
-        crate::fsutil::display_name(&a.out),
+        crate::fsutil::output_name(&a.out),
         a.map.name(),
         params.units,
         plan.waypoints.len(),

@@ -128,7 +128,7 @@ fn with_progress<T>(job: impl FnOnce(&Progress) -> T) -> T {
 /// the map or itself.
 pub fn run(a: SimArgs) -> CliResult {
     let plan = Plan::read(&a.plan).map_err(|e| CliError::input(e.to_string()))?;
-    let plan_name = crate::fsutil::display_name(&a.plan);
+    let plan_name = crate::fsutil::input_name(&a.plan);
     let params = plan
         .check()
         .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;

@@ -46,7 +46,7 @@ pub fn run(a: VerifyArgs) -> CliResult {
     let report = verify_plan(&loaded.grid, &plan);
     println!(
         "{}: {} waypoints, {} edges ({} translations, {} shape changes), {} configurations checked exactly (unknown space {})",
-        crate::fsutil::display_name(&a.plan),
+        crate::fsutil::input_name(&a.plan),
         plan.waypoints.len(),
         report.edges.len(),
         report.edges.iter().filter(|e| **e == crate::collision::EdgeKind::Translation).count(),
