@@ -1,9 +1,10 @@
 //! `arc-core` must build for the units' autopilots: thumbv7em-none-eabihf
 //! (Cortex-M4F/M7F), no_std, no alloc, with and without its `defmt` feature.
 
-use arc_tests::cargo;
+use arc_tests::{cargo, require_thumbv7em_target};
 
 fn build_core(features: &[&str]) {
+    require_thumbv7em_target();
     let mut c = cargo("cross");
     c.args([
         "build",

@@ -1,6 +1,6 @@
 //! The unit firmware (`firmware-sketch/`) built for thumbv7em-none-eabihf and run
-//! in QEMU (netduinoplus2, an STM32F405), its defmt output decoded by
-//! `defmt-print`:
+//! in QEMU (netduinoplus2, an STM32F405), its defmt output decoded in-process with
+//! the `defmt-decoder` crate (the ELF's defmt table, the semihosting byte stream):
 //!
 //! - with the table its build script generates (the same bytes as the host's
 //!   `arc tables build`, checked by CRC): the table is valid, every
@@ -12,10 +12,11 @@
 //!   writes them): accepted when it is for this chain, refused as a chain
 //!   mismatch when it is for another.
 //!
-//! When `qemu-system-arm` or `defmt-print` is missing the tests say so on stderr
-//! and pass without running (`.ci/run` installs both, so CI runs them for real).
+//! Without `qemu-system-arm` the tests fail and name the package to install:
+//! a run in which the firmware never ran must not look green (`./test`
+//! installs QEMU).
 
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::sync::atomic::AtomicUsize;
@@ -27,7 +28,8 @@ use arc_core::srs::{Srs, SrsSettings};
 use arc_core::table::{encode_into, TableView};
 use arc_core::ChainParams;
 use arc_host_sim::tables::{ShapeTables, TableSettings};
-use arc_tests::{cargo, workspace_root};
+use arc_tests::{cargo, require_thumbv7em_target, require_tool, workspace_root};
+use defmt_decoder::{DecodeError, Table};
 
 /// Builds share one target folder and one output path: one at a time.
 static BUILD: Mutex<()> = Mutex::new(());
@@ -39,60 +41,15 @@ const STACK_BUDGET: u64 = 8 * 1024;
 /// Settle tolerance the firmware uses (degrees).
 const TOLERANCE_DEG: f64 = 0.5;
 
-/// The `defmt-print` to use: on PATH, else in cargo's bin folder.
-fn defmt_print() -> Option<PathBuf> {
-    let mut candidates = vec![PathBuf::from("defmt-print")];
-    if let Some(home) = std::env::var_os("CARGO_HOME") {
-        candidates.push(Path::new(&home).join("bin/defmt-print"));
-    }
-    if let Some(home) = std::env::var_os("HOME") {
-        candidates.push(Path::new(&home).join(".cargo/bin/defmt-print"));
-    }
-    candidates.into_iter().find(|c| {
-        let mut probe = Command::new(c);
-        probe.arg("-V");
-        runs(probe)
-    })
-}
-
-/// Whether a command starts and exits with success (its output discarded).
-fn runs(mut c: Command) -> bool {
-    c.stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
-}
-
-/// Says on the real stderr (not the test harness's captured one, so the message
-/// shows even when the test passes) that `test` is skipped and why.
-fn skip(test: &str, why: &str) {
-    let _ = writeln!(
-        std::io::stderr(),
-        "SKIPPED {test}: {why}; the firmware was not run in QEMU"
-    );
-}
-
-/// The tools, or None after saying on stderr why the test is skipped.
-fn tools(test: &str) -> Option<PathBuf> {
-    let mut probe = Command::new("qemu-system-arm");
-    probe.arg("--version");
-    if !runs(probe) {
-        skip(
-            test,
-            "qemu-system-arm not found (apt-get install qemu-system-arm)",
-        );
-        return None;
-    }
-    let Some(dp) = defmt_print() else {
-        skip(test, "defmt-print not found (cargo install defmt-print)");
-        return None;
-    };
-    Some(dp)
+/// Fails the test, naming the package, when QEMU is not installed.
+fn require_qemu() {
+    require_tool("qemu-system-arm", &["--version"], "qemu-system-arm");
 }
 
 /// Builds the firmware with `features` and build environment `env`, and copies
 /// the ELF to `target/firmware/qemu-tests/<name>.elf`.
 fn build(name: &str, features: &[&str], env: &[(&str, &str)]) -> PathBuf {
+    require_thumbv7em_target();
     let _guard = BUILD.lock().unwrap_or_else(|e| e.into_inner());
     let dir = workspace_root().join("firmware-sketch");
     let mut c = cargo("firmware");
@@ -135,7 +92,7 @@ fn build(name: &str, features: &[&str], env: &[(&str, &str)]) -> PathBuf {
 struct Run {
     /// QEMU's exit status (the firmware's semihosting exit code).
     status: ExitStatus,
-    /// defmt-print's output, then anything QEMU wrote on stderr.
+    /// The decoded defmt frames, then anything QEMU wrote on stderr.
     log: String,
 }
 
@@ -156,13 +113,14 @@ impl Run {
     }
 }
 
-/// Boots `elf` in QEMU and decodes its defmt frames with `defmt-print`.
-fn run(elf: &Path, defmt_print: &Path) -> Run {
-    run_with(elf, defmt_print, &[])
+/// Boots `elf` in QEMU and decodes its defmt frames.
+fn run(elf: &Path) -> Run {
+    run_with(elf, &[])
 }
 
 /// [`run`] with extra QEMU arguments.
-fn run_with(elf: &Path, defmt_print: &Path, qemu_args: &[&str]) -> Run {
+fn run_with(elf: &Path, qemu_args: &[&str]) -> Run {
+    require_qemu();
     let mut qemu = Command::new("qemu-system-arm")
         .args(["-cpu", "cortex-m4", "-machine", "netduinoplus2"])
         .args([
@@ -178,20 +136,11 @@ fn run_with(elf: &Path, defmt_print: &Path, qemu_args: &[&str]) -> Run {
         .stderr(Stdio::piped())
         .spawn()
         .expect("qemu-system-arm starts");
-    let frames = qemu.stdout.take().expect("piped");
-    let mut decoder = Command::new(defmt_print)
-        .arg("-e")
-        .arg(elf)
-        .stdin(Stdio::from(frames))
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("defmt-print starts");
-    let mut decoded = decoder.stdout.take().expect("piped");
+    let mut frames = qemu.stdout.take().expect("piped");
     let reader = std::thread::spawn(move || {
-        let mut s = String::new();
-        let _ = decoded.read_to_string(&mut s);
-        s
+        let mut bytes = Vec::new();
+        let _ = frames.read_to_end(&mut bytes);
+        bytes
     });
     let start = Instant::now();
     let status = loop {
@@ -200,8 +149,8 @@ fn run_with(elf: &Path, defmt_print: &Path, qemu_args: &[&str]) -> Run {
         }
         if start.elapsed() > QEMU_TIMEOUT {
             let _ = qemu.kill();
-            let _ = decoder.kill();
-            let log = reader.join().unwrap_or_default();
+            let _ = qemu.wait();
+            let log = decode(elf, &reader.join().unwrap_or_default());
             panic!(
                 "firmware {} still running after {QEMU_TIMEOUT:?}; log so far:\n{log}",
                 elf.display()
@@ -209,8 +158,7 @@ fn run_with(elf: &Path, defmt_print: &Path, qemu_args: &[&str]) -> Run {
         }
         std::thread::sleep(Duration::from_millis(20));
     };
-    let _ = decoder.wait();
-    let mut log = reader.join().expect("reader thread");
+    let mut log = decode(elf, &reader.join().expect("reader thread"));
     let mut err = String::new();
     if let Some(mut e) = qemu.stderr.take() {
         let _ = e.read_to_string(&mut err);
@@ -220,6 +168,40 @@ fn run_with(elf: &Path, defmt_print: &Path, qemu_args: &[&str]) -> Run {
         log.push_str(&err);
     }
     Run { status, log }
+}
+
+/// Decodes the defmt frames in `bytes` with the table in `elf`: one line per frame,
+/// `LEVEL message` (or the message alone for `println!`). A frame that cannot be
+/// decoded becomes a `[malformed defmt frame]` line, which no check accepts.
+fn decode(elf: &Path, bytes: &[u8]) -> String {
+    let image = std::fs::read(elf).unwrap_or_else(|e| panic!("{}: {e}", elf.display()));
+    let table = Table::parse(&image)
+        .unwrap_or_else(|e| panic!("{}: defmt table unreadable: {e}", elf.display()))
+        .unwrap_or_else(|| panic!("{}: no .defmt section", elf.display()));
+    let mut stream = table.new_stream_decoder();
+    stream.received(bytes);
+    let mut log = String::new();
+    loop {
+        match stream.decode() {
+            Ok(frame) => {
+                if let Some(level) = frame.level() {
+                    log.push_str(&level.as_str().to_ascii_uppercase());
+                    log.push(' ');
+                }
+                log.push_str(&frame.display_message().to_string());
+                log.push('\n');
+            }
+            Err(DecodeError::UnexpectedEof) => break,
+            Err(DecodeError::Malformed) if table.encoding().can_recover() => {
+                log.push_str("[malformed defmt frame]\n");
+            }
+            Err(DecodeError::Malformed) => {
+                log.push_str("[malformed defmt frame: the rest of the stream is lost]\n");
+                break;
+            }
+        }
+    }
+    log
 }
 
 /// The number after `key` in `line` (e.g. `key = "in "` in "settled ... in 2.1 s").
@@ -394,11 +376,9 @@ fn assert_safe_mode(r: &Run, reason: &str) {
 
 #[test]
 fn firmware_reaches_every_commanded_shape() {
-    let Some(dp) = tools("firmware_reaches_every_commanded_shape") else {
-        return;
-    };
+    require_qemu();
     let elf = build("valid", &[], &[("ARC_N_SRS", "100")]);
-    let r = run(&elf, &dp);
+    let r = run(&elf);
     assert_mission_success(&r, 100);
     // The table the firmware's build script generated is the very table the
     // host makes (`arc tables build --units 6 --srs 100 --seed 1`): same CRC.
@@ -427,11 +407,9 @@ fn firmware_reaches_every_commanded_shape() {
 
 #[test]
 fn corrupted_table_puts_the_unit_in_safe_mode() {
-    let Some(dp) = tools("corrupted_table_puts_the_unit_in_safe_mode") else {
-        return;
-    };
+    require_qemu();
     let elf = build("corrupt", &["corrupt-table"], &[("ARC_N_SRS", "100")]);
-    let r = run(&elf, &dp);
+    let r = run(&elf);
     assert_safe_mode(&r, "CrcMismatch");
 }
 
@@ -451,9 +429,7 @@ fn host_table(units: u8, count: usize, name: &str) -> PathBuf {
 
 #[test]
 fn host_written_tables_are_checked_against_the_unit_chain() {
-    let Some(dp) = tools("host_written_tables_are_checked_against_the_unit_chain") else {
-        return;
-    };
+    require_qemu();
     // For this chain (N = 6), with 64 SRS shapes: the script's SRS shape 105 is
     // not there, so that command is refused and the run fails, but the table is
     // accepted and every shape it has is reached.
@@ -463,7 +439,7 @@ fn host_written_tables_are_checked_against_the_unit_chain() {
         &[],
         &[("ARC_TABLE", own.to_str().expect("utf-8 path"))],
     );
-    let r = run(&elf, &dp);
+    let r = run(&elf);
     assert_clean(&r);
     assert!(
         r.has("table valid: format v1, chain N=6"),
@@ -491,18 +467,16 @@ fn host_written_tables_are_checked_against_the_unit_chain() {
         &[],
         &[("ARC_TABLE", other.to_str().expect("utf-8 path"))],
     );
-    let r = run(&elf, &dp);
+    let r = run(&elf);
     assert_safe_mode(&r, "ChainMismatch");
 }
 
 #[test]
 fn table_flashed_apart_from_the_program() {
-    let Some(dp) = tools("table_flashed_apart_from_the_program") else {
-        return;
-    };
+    require_qemu();
     // A program that links no table (its ELF leaves the table slot alone)...
     let elf = build("external", &["external-table"], &[]);
-    let r = run(&elf, &dp);
+    let r = run(&elf);
     assert_safe_mode(&r, "Slot(Empty)");
     // ...and a table image flashed on its own at the slot's address, as
     // `probe-rs download --binary-format bin --base-address 0x080C0000` would:
@@ -513,21 +487,19 @@ fn table_flashed_apart_from_the_program() {
     let slot = workspace_root().join("target/firmware/qemu-tests/slot-n6-100.bin");
     std::fs::write(&slot, &image).expect("write slot image");
     let loader = format!("loader,file={},addr=0x080C0000", slot.display());
-    let r = run_with(&elf, &dp, &["-device", &loader]);
+    let r = run_with(&elf, &["-device", &loader]);
     assert!(r.has("table external"), "{}", r.context());
     assert_mission_success(&r, 100);
 }
 
 #[test]
 fn head_and_tail_units_steer_their_links() {
-    let Some(dp) = tools("head_and_tail_units_steer_their_links") else {
-        return;
-    };
+    require_qemu();
     // Unit 1 (the head) steers link 1; unit 6, the tail, leads no link and
     // steers link 5, the one it trails.
     for (unit, link) in [("1", "1"), ("6", "5")] {
         let elf = build(&format!("unit{unit}"), &[], &[("ARC_UNIT", unit)]);
-        let r = run(&elf, &dp);
+        let r = run(&elf);
         let up = format!("ARC unit {unit} of 6 up: steers link {link},");
         assert!(r.has(&up), "expected {up:?}; {}", r.context());
         assert_mission_success(&r, 100);

@@ -161,10 +161,7 @@ fn a_plan_into_a_wall_fails_with_exit_1() {
     let plan = arc_host_sim::plan::Plan {
         format: arc_host_sim::plan::FORMAT.into(),
         chain: arc_host_sim::plan::ChainSection::from_params(&params),
-        map: arc_host_sim::plan::MapSection {
-            resolution: sc.grid.resolution(),
-            unknown_is_occupied: true,
-        },
+        map: arc_host_sim::plan::MapSection::new(sc.grid.resolution(), true),
         waypoints: vec![
             arc_host_sim::plan::Waypoint::new(start, &shape),
             arc_host_sim::plan::Waypoint::new(goal, &shape),

@@ -1,5 +1,6 @@
 //! File output that is never lost or half-written: write to a temporary file in the
-//! destination's directory, then rename it over the destination.
+//! destination's directory, then rename it over the destination. The path `-` names
+//! standard output (and standard input where a command reads a file).
 
 use std::io::Write;
 use std::path::Path;
@@ -22,6 +23,39 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+/// Whether `path` is `-`: standard input or output rather than a file.
+pub fn is_stdio(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// How messages name an input `path`: `standard input` for `-`, else the path.
+pub fn input_name(path: &Path) -> String {
+    if is_stdio(path) {
+        "standard input".into()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// How messages name an output `path`: `standard output` for `-`, else the path.
+pub fn output_name(path: &Path) -> String {
+    if is_stdio(path) {
+        "standard output".into()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// Writes `bytes` to standard output when `path` is `-`, else atomically to the file.
+pub fn write_output(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    if is_stdio(path) {
+        let mut out = std::io::stdout().lock();
+        out.write_all(bytes)?;
+        return out.flush();
+    }
+    write_atomic(path, bytes)
 }
 
 #[cfg(test)]

@@ -1,9 +1,12 @@
-//! Plan files: JSON, `"format": "arc-plan/1"` (docs/model.md, "Files").
+//! Plan files: JSON, `"format": "arc-plan/1"` (docs/model.md, "Plans").
 //!
-//! Values are `f64` in the file; shapes come from the `f32` core and are widened
-//! exactly, head positions are kept in `f64` so a start given on the command line
-//! is reproduced to the last digit.
+//! Values are `f64` in the file. Numbers that come from the `f32` core (shape angles,
+//! chain parameters) are written as the shortest decimal that reads back as the same
+//! `f32` (`0.15`, not `0.15000000596046448`); head positions are kept in `f64` so a
+//! start given on the command line is reproduced to the last digit. A plan records
+//! which map it was made for (file name and SHA-256, or the scenario).
 
+use std::io::Read;
 use std::path::Path;
 
 use arc_core::{ChainParams, Shape};
@@ -29,13 +32,97 @@ pub struct ChainSection {
     pub beta_max: f64,
 }
 
-/// The map assumptions of a plan.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// The map assumptions of a plan, and which map it was made for.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MapSection {
     /// Voxel edge r_v (m).
     pub resolution: f64,
     /// Whether unknown space was treated as occupied.
     pub unknown_is_occupied: bool,
+    /// Which map: optional fields, absent in plans written before they existed.
+    #[serde(flatten)]
+    pub source: MapSource,
+}
+
+/// Which map a plan was made for: a file (its name and the SHA-256 of its bytes) or a
+/// built-in scenario. Informative: a checker tests a plan against the map it is given,
+/// and says so when that map is not the one recorded here.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MapSource {
+    /// The map file's name, without its directory.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// SHA-256 of the map file's bytes, 64 lowercase hex digits.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sha256: Option<String>,
+    /// The built-in scenario's name (as given to `--scenario`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scenario: Option<String>,
+}
+
+impl MapSection {
+    /// A section with no record of the map's source.
+    pub fn new(resolution: f64, unknown_is_occupied: bool) -> Self {
+        Self {
+            resolution,
+            unknown_is_occupied,
+            source: MapSource::default(),
+        }
+    }
+}
+
+impl MapSource {
+    /// The source of a map read from `path`, whose content is `bytes`.
+    pub fn file(path: &Path, bytes: &[u8]) -> Self {
+        use sha2::{Digest, Sha256};
+        let digest = Sha256::digest(bytes);
+        Self {
+            file: path.file_name().map(|n| n.to_string_lossy().into_owned()),
+            sha256: Some(digest.iter().map(|b| format!("{b:02x}")).collect()),
+            scenario: None,
+        }
+    }
+
+    /// The source of a built-in scenario.
+    pub fn scenario(name: &str) -> Self {
+        Self {
+            scenario: Some(name.to_string()),
+            ..Self::default()
+        }
+    }
+
+    /// Whether both name a map and the maps differ: different file contents, different
+    /// scenarios, or a file against a scenario. Unrecorded sources differ from nothing.
+    pub fn differs_from(&self, other: &MapSource) -> bool {
+        let recorded = |s: &MapSource| s.sha256.is_some() || s.scenario.is_some();
+        recorded(self)
+            && recorded(other)
+            && (self.sha256 != other.sha256 || self.scenario != other.scenario)
+    }
+}
+
+impl std::fmt::Display for MapSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match (&self.scenario, &self.file, &self.sha256) {
+            (Some(s), _, _) => write!(f, "scenario {s}"),
+            (None, file, Some(h)) => write!(
+                f,
+                "{} (sha256 {})",
+                file.as_deref().unwrap_or("a map file"),
+                &h[..h.len().min(12)]
+            ),
+            (None, Some(file), None) => f.write_str(file),
+            (None, None, None) => f.write_str("an unrecorded map"),
+        }
+    }
+}
+
+/// `x` as the shortest decimal that reads back as the same `f32`, in an `f64`: what a
+/// plan file stores for values that come from the `f32` core, so that `0.15f32` is
+/// written `0.15` (its exact widening would be `0.15000000596046448`).
+pub fn f32_decimal(x: f32) -> f64 {
+    // Display prints the shortest round-trip representation; it always parses.
+    x.to_string().parse().unwrap_or(f64::from(x))
 }
 
 /// One waypoint: a full configuration zeta (2N + 2 numbers).
@@ -121,11 +208,11 @@ impl ChainSection {
     pub fn from_params(p: &ChainParams) -> Self {
         Self {
             units: p.units as u32,
-            link_length: p.link_length as f64,
-            unit_radius: p.unit_radius as f64,
-            link_radius: p.link_radius as f64,
-            theta_max: p.theta_max as f64,
-            beta_max: p.beta_max as f64,
+            link_length: f32_decimal(p.link_length),
+            unit_radius: f32_decimal(p.unit_radius),
+            link_radius: f32_decimal(p.link_radius),
+            theta_max: f32_decimal(p.theta_max),
+            beta_max: f32_decimal(p.beta_max),
         }
     }
 
@@ -151,7 +238,7 @@ impl Waypoint {
     /// A waypoint from a head position and a shape.
     pub fn new(xi: [f64; 3], shape: &Shape) -> Self {
         let mut zeta = xi.to_vec();
-        zeta.extend(shape.as_slice().iter().map(|&a| a as f64));
+        zeta.extend(shape.as_slice().iter().map(|&a| f32_decimal(a)));
         Self { zeta }
     }
 
@@ -185,10 +272,7 @@ impl Plan {
         Plan {
             format: FORMAT.into(),
             chain: ChainSection::from_params(params),
-            map: MapSection {
-                resolution,
-                unknown_is_occupied,
-            },
+            map: MapSection::new(resolution, unknown_is_occupied),
             waypoints: steps
                 .into_iter()
                 .map(|(xi, shape)| Waypoint::new(xi, shape))
@@ -197,11 +281,17 @@ impl Plan {
         }
     }
 
-    /// Reads and checks a plan file: format tag, chain parameters, every waypoint's
-    /// length and finiteness.
+    /// Reads and checks a plan file (`-`: standard input): format tag, chain
+    /// parameters, every waypoint's length and finiteness.
     pub fn read(path: &Path) -> Result<Self, PlanError> {
-        let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| PlanError::Io {
+        let name = crate::fsutil::input_name(path);
+        let mut text = String::new();
+        let read = if crate::fsutil::is_stdio(path) {
+            std::io::stdin().read_to_string(&mut text)
+        } else {
+            std::fs::File::open(path).and_then(|mut f| f.read_to_string(&mut text))
+        };
+        read.map_err(|source| PlanError::Io {
             path: name.clone(),
             source,
         })?;
@@ -245,11 +335,12 @@ impl Plan {
         Ok(params)
     }
 
-    /// Writes the plan as pretty JSON, atomically.
+    /// Writes the plan as pretty JSON, atomically (`-`: to standard output).
     pub fn write(&self, path: &Path) -> Result<(), PlanError> {
-        let text = serde_json::to_string_pretty(self).expect("a plan always serialises");
-        crate::fsutil::write_atomic(path, text.as_bytes()).map_err(|source| PlanError::Io {
-            path: path.display().to_string(),
+        let mut text = serde_json::to_string_pretty(self).expect("a plan always serialises");
+        text.push('\n');
+        crate::fsutil::write_output(path, text.as_bytes()).map_err(|source| PlanError::Io {
+            path: crate::fsutil::output_name(path),
             source,
         })
     }
@@ -264,10 +355,7 @@ mod tests {
         Plan {
             format: FORMAT.into(),
             chain: ChainSection::from_params(&p),
-            map: MapSection {
-                resolution: 0.1,
-                unknown_is_occupied: true,
-            },
+            map: MapSection::new(0.1, true),
             waypoints: vec![Waypoint::new([1.0, 2.0, 3.0], &Shape::line(3, 0.0))],
             stats: Default::default(),
         }
@@ -280,6 +368,85 @@ mod tests {
         let plan = sample();
         plan.write(&path).unwrap();
         assert_eq!(Plan::read(&path).unwrap(), plan);
+    }
+
+    #[test]
+    fn numbers_from_f32_carry_no_noise() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.json");
+        let mut plan = sample();
+        let shape = Shape::line(3, 0.1);
+        plan.waypoints.push(Waypoint::new([1.0, 2.0, 3.0], &shape));
+        plan.write(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("\"unit_radius\": 0.15,"), "{text}");
+        assert!(text.contains("\"link_length\": 0.5,"), "{text}");
+        // Every shape angle is the shortest decimal of its f32: at most 9 digits.
+        for w in &plan.waypoints {
+            for &v in w.eta() {
+                assert_eq!(f32_decimal(v as f32), v);
+                assert_eq!(v as f32, v as f32 as f64 as f32);
+            }
+        }
+        assert!(text.contains("0.1,"), "{text}");
+        assert!(!text.contains("0.100000001"), "{text}");
+    }
+
+    #[test]
+    fn f32_decimals_read_back_as_the_same_f32() {
+        // Readers narrow plan values to f32 (`as f32`): that must give the core's value.
+        let mut s: u32 = 1;
+        for _ in 0..1_000_000 {
+            s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            let x = f32::from_bits(s);
+            if x.is_finite() {
+                assert_eq!(f32_decimal(x) as f32, x, "{x:e}");
+            }
+        }
+        for x in [
+            0.15f32,
+            0.01,
+            0.5,
+            std::f32::consts::FRAC_PI_3,
+            -std::f32::consts::PI,
+            1e-8,
+            0.0,
+        ] {
+            assert_eq!(f32_decimal(x) as f32, x);
+        }
+    }
+
+    #[test]
+    fn the_map_source_is_recorded_and_optional() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.json");
+        let mut plan = sample();
+        plan.map.source = MapSource::file(Path::new("maps/abc.bt"), b"abc");
+        plan.write(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("\"file\": \"abc.bt\""), "{text}");
+        // SHA-256("abc"), FIPS 180-2's first example.
+        assert!(text.contains(
+            "\"sha256\": \"ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad\""
+        ));
+        assert_eq!(Plan::read(&path).unwrap(), plan);
+        // A plan without the fields (written before they existed) still reads.
+        let old = text
+            .lines()
+            .filter(|l| !l.contains("\"file\"") && !l.contains("\"sha256\""))
+            .collect::<Vec<_>>()
+            .join("\n")
+            .replace(
+                "\"unknown_is_occupied\": true,",
+                "\"unknown_is_occupied\": true",
+            );
+        std::fs::write(&path, old).unwrap();
+        assert_eq!(Plan::read(&path).unwrap().map.source, MapSource::default());
+        let window = MapSource::scenario("window");
+        assert!(window.differs_from(&MapSource::scenario("maze")));
+        assert!(window.differs_from(&plan.map.source));
+        assert!(!window.differs_from(&MapSource::default()));
+        assert!(!plan.map.source.differs_from(&plan.map.source.clone()));
     }
 
     #[test]

@@ -147,7 +147,7 @@ pub fn draw(grid: &Grid, plan: &Plan, title: &str, goal: Option<[f64; 3]>) -> Fi
                 Some(palette::SENSOR)
             } else if src == "shrunk" {
                 Some(palette::SHRUNK)
-            } else if follow && follows % every == 0 {
+            } else if follow && follows.is_multiple_of(every) {
                 Some(palette::FOLLOW)
             } else {
                 None

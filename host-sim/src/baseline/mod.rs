@@ -303,7 +303,7 @@ impl FullStatePrm {
         let mut tries = 0u64;
         let mut capped = false;
         let out_of_time =
-            |tries: u64| tries % 256 == 0 && limit.is_some_and(|l| began.elapsed() > l);
+            |tries: u64| tries.is_multiple_of(256) && limit.is_some_and(|l| began.elapsed() > l);
         // Goal samples first: the head uniform in the goal ball, any shape.
         let tol = s.goal_tol;
         while xi.len() < want_goal && tries < max_tries {

@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 
 use clap::{Args, Subcommand};
 
-use super::common::{ChainArgs, MapArgs, Query, QueryArgs};
+use super::common::{ChainArgs, MapArgs, Query, QueryArgs, Report};
 use super::{CliError, CliResult};
 use crate::baseline::{self, FullStatePrm, PrmError, PrmSettings};
 use crate::bench::{self, paper, scale};
@@ -17,11 +17,16 @@ use crate::planner::Termination;
 pub enum BenchCommand {
     /// The paper's Tables 1-3 (window, maze; LSC / SRS / both; full-state PRM), paper
     /// numbers beside ours; markdown on stdout, CSV and markdown in --out-dir.
+    #[command(after_help = "Example:\n  arc bench paper --quick --out-dir out/paper")]
     Paper(PaperArgs),
     /// Planning time and success against N (window, N = 3..16) and map size
     /// (corridor:10..100), with a plot (SVG and PNG).
+    #[command(after_help = "Example:\n  arc bench scale --quick --out-dir out/scale")]
     Scale(ScaleArgs),
     /// One plan by the full-state lazy PRM baseline (arc-plan/1, verified exactly).
+    #[command(
+        after_help = "Example:\n  arc bench prm --scenario window --units 4 --vertices 15000 --out prm.json"
+    )]
     Prm(Box<PrmArgs>),
 }
 
@@ -118,7 +123,7 @@ pub struct PrmArgs {
     /// Give up after this many seconds (roadmap build and query each).
     #[arg(long)]
     time_limit: Option<f64>,
-    /// Output plan (JSON, arc-plan/1).
+    /// Output plan (JSON, arc-plan/1); `-` writes it to standard output.
     #[arg(long)]
     out: PathBuf,
 }
@@ -358,6 +363,7 @@ fn run_prm(a: PrmArgs) -> CliResult {
         goal,
     } = a.query.resolve(&a.chain, loaded.scenario.as_ref())?;
     let grid = loaded.grid.clone();
+    let source = loaded.source.clone();
     let (field, _) = loaded.into_field();
     let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;
     let settings = PrmSettings {
@@ -390,21 +396,23 @@ fn run_prm(a: PrmArgs) -> CliResult {
             ))
         }
     })?;
-    let plan = baseline::to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
+    let mut plan = baseline::to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
+    plan.map.source = source;
     let report = verify_plan(&grid, &plan);
     plan.write(&a.out)
         .map_err(|e| CliError::input(e.to_string()))?;
     let s = &sol.stats;
-    println!(
+    let lines = Report::new(&a.out);
+    lines.line(format_args!(
         "{}: full-state PRM solved {} with N = {}: {} waypoints, {} roadmap edges, {} shape changes",
-        a.out.display(),
+        crate::fsutil::output_name(&a.out),
         a.map.name(),
         params.units,
         plan.waypoints.len(),
         s.path_edges,
         s.shape_changes
-    );
-    println!(
+    ));
+    lines.line(format_args!(
         "  roadmap {:.1} ms ({} vertices, k = {}, {} edges), planning {:.1} ms ({} lazy searches, {} edges checked, {} blocked; {:.1} ms in checks)",
         s.roadmap_s * 1e3,
         s.vertices,
@@ -415,9 +423,9 @@ fn run_prm(a: PrmArgs) -> CliResult {
         s.edges_checked,
         s.edges_blocked,
         s.collision_s * 1e3
-    );
+    ));
     if report.ok {
-        println!("  exact verification: ok");
+        lines.line(format_args!("  exact verification: ok"));
         Ok(())
     } else {
         Err(CliError::failed(format!(

@@ -12,6 +12,7 @@ use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 use crate::map::octomap::OcTree;
 use crate::map::scenarios::{self, Scenario};
+use crate::plan::MapSource;
 
 /// Chain geometry options shared by every command that makes a chain.
 #[derive(Args, Debug, Clone)]
@@ -77,6 +78,8 @@ pub struct LoadedMap {
     pub grid: Grid,
     /// The scenario, when the map is a built-in one.
     pub scenario: Option<Scenario>,
+    /// Which map this is, as plans record it (file name and hash, or scenario).
+    pub source: MapSource,
 }
 
 impl MapArgs {
@@ -90,18 +93,25 @@ impl MapArgs {
             return Ok(LoadedMap {
                 grid,
                 scenario: Some(sc),
+                source: MapSource::scenario(name),
             });
         }
         let path = self
             .map
             .as_ref()
             .ok_or_else(|| CliError::input("give --map FILE.bt or --scenario NAME"))?;
-        let tree = OcTree::read_bt(path).map_err(|e| CliError::input(e.to_string()))?;
+        // Read once: the bytes give both the tree and the hash a plan records.
+        let bytes = std::fs::read(path).map_err(|e| {
+            CliError::input(format!("{}: cannot read the file: {e}", path.display()))
+        })?;
+        let tree = OcTree::from_bt_bytes(&bytes, &path.display().to_string())
+            .map_err(|e| CliError::input(e.to_string()))?;
         let grid = Grid::from_octree(&tree, !self.unknown_free)
             .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
         Ok(LoadedMap {
             grid,
             scenario: None,
+            source: MapSource::file(path, &bytes),
         })
     }
 
@@ -119,6 +129,30 @@ impl LoadedMap {
     /// The distance field over the grid (which it keeps), and the scenario.
     pub fn into_field(self) -> (Arc<DistanceField>, Option<Scenario>) {
         (Arc::new(DistanceField::new(self.grid)), self.scenario)
+    }
+}
+
+/// Where a command's report lines go: standard output, unless that carries the
+/// command's data (`--out -`); then standard error, so the data stays clean.
+pub struct Report {
+    to_stderr: bool,
+}
+
+impl Report {
+    /// The report of a command that writes its data to `out`.
+    pub fn new(out: &std::path::Path) -> Self {
+        Self {
+            to_stderr: crate::fsutil::is_stdio(out),
+        }
+    }
+
+    /// Prints one line.
+    pub fn line(&self, args: std::fmt::Arguments<'_>) {
+        if self.to_stderr {
+            eprintln!("{args}");
+        } else {
+            println!("{args}");
+        }
     }
 }
 

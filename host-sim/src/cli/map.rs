@@ -15,11 +15,14 @@ use crate::map::scenarios::{self, Scenario};
 /// `arc map ...`
 #[derive(Subcommand, Debug)]
 pub enum MapCommand {
-    /// Write a built-in scenario's map as an OctoMap binary file (.bt).
+    /// Write a built-in scenario's map as an OctoMap file: binary (.bt) or full (.ot).
+    #[command(after_help = "Example:\n  arc map export --scenario window --out window.bt")]
     Export(ExportArgs),
     /// Print a map file's resolution, bounds and voxel counts.
+    #[command(after_help = "Example:\n  arc map info maps/geb079.bt")]
     Info(InfoArgs),
     /// Draw a map (file or scenario): a top view and horizontal slices, SVG or PNG.
+    #[command(after_help = "Example:\n  arc map picture maps/geb079.bt --out geb079.png")]
     Picture(PictureArgs),
 }
 
@@ -29,7 +32,7 @@ pub struct ExportArgs {
     /// Scenario: window, maze, silos, corridor, or corridor:LENGTH (10 to 100 m).
     #[arg(long)]
     pub scenario: String,
-    /// Output file (.bt).
+    /// Output file: .bt (OctoMap binary, max-likelihood) or .ot (full, log-odds).
     #[arg(long)]
     pub out: PathBuf,
 }
@@ -37,14 +40,14 @@ pub struct ExportArgs {
 /// `arc map info`
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// The map (.bt).
+    /// The map (.bt or .ot).
     pub file: PathBuf,
 }
 
 /// `arc map picture`
 #[derive(Args, Debug)]
 pub struct PictureArgs {
-    /// The map (.bt); or give --scenario.
+    /// The map (.bt or .ot); or give --scenario.
     #[arg(required_unless_present = "scenario", conflicts_with = "scenario")]
     pub file: Option<PathBuf>,
     /// A built-in scenario instead of a file (window, maze, silos, corridor[:LENGTH]).
@@ -85,11 +88,40 @@ fn grid_of(tree: &OcTree, path: &Path) -> Result<Grid, CliError> {
     Grid::from_octree(tree, true).map_err(|e| CliError::input(format!("{}: {e}", path.display())))
 }
 
+/// The OctoMap file kinds `arc map export` writes.
+enum MapFormat {
+    /// `.bt`: OctoMap's binary, max-likelihood format.
+    Binary,
+    /// `.ot`: OctoMap's full format, a log-odds value per node.
+    Full,
+}
+
+/// The format `path`'s extension names, or a bad-input error naming the path.
+fn map_format(path: &Path) -> Result<MapFormat, CliError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("bt") => Ok(MapFormat::Binary),
+        Some("ot") => Ok(MapFormat::Full),
+        _ => Err(CliError::input(format!(
+            "--out {}: a map file must end in .bt or .ot",
+            path.display()
+        ))),
+    }
+}
+
 fn export(a: ExportArgs) -> CliResult {
+    // Refuse a wrong name before the work, not after.
+    let format = map_format(&a.out)?;
     let s = scenario(&a.scenario)?;
     let tree = s.octree().map_err(|e| CliError::input(e.to_string()))?;
-    tree.write_bt(&a.out)
-        .map_err(|e| CliError::input(e.to_string()))?;
+    match format {
+        MapFormat::Binary => tree.write_bt(&a.out),
+        MapFormat::Full => tree.write_ot(&a.out),
+    }
+    .map_err(|e| CliError::input(e.to_string()))?;
     let c = s.grid.counts();
     println!(
         "{}: wrote {} ({} x {} x {} voxels at {} m: {} occupied, {} free; {} tree nodes)",
@@ -240,6 +272,26 @@ mod tests {
         ])
         .unwrap();
         arc(["arc", "map", "info", bt_s]).unwrap();
+        // A full .ot holds the same map.
+        let ot = dir.path().join("w.ot");
+        arc([
+            "arc",
+            "map",
+            "export",
+            "--scenario",
+            "window",
+            "--out",
+            ot.to_str().unwrap(),
+        ])
+        .unwrap();
+        let (from_ot, from_bt) = (
+            crate::map::octomap::OcTree::read_bt(&ot).unwrap(),
+            crate::map::octomap::OcTree::read_bt(&bt).unwrap(),
+        );
+        assert!(std::fs::read(&ot)
+            .unwrap()
+            .starts_with(b"# Octomap OcTree file\n"));
+        assert_eq!(from_ot, from_bt);
         let svg = dir.path().join("w.svg");
         arc([
             "arc",
@@ -290,6 +342,20 @@ mod tests {
             2
         );
         assert_eq!(code(&["arc", "map", "info", "/nonexistent/map.bt"]), 2);
+        let txt = dir.path().join("x.txt");
+        let e = arc([
+            "arc",
+            "map",
+            "export",
+            "--scenario",
+            "window",
+            "--out",
+            txt.to_str().unwrap(),
+        ])
+        .unwrap_err();
+        assert_eq!(e.code, 2);
+        assert!(e.message.contains(".bt or .ot"), "{}", e.message);
+        assert!(!txt.exists(), "nothing written under a wrong name");
         let junk = dir.path().join("junk.bt");
         std::fs::write(&junk, b"not an octomap").unwrap();
         let e = arc(["arc", "map", "info", junk.to_str().unwrap()]).unwrap_err();

@@ -64,21 +64,32 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Build or inspect shape tables (LSC + SRS + G_SRS, postcard, CRC-checked).
-    #[command(subcommand)]
+    #[command(
+        subcommand,
+        after_help = "Example:\n  arc tables build --units 6 --out n6.arct"
+    )]
     Tables(tables::TablesCommand),
     /// Draw the shape library (LSC) in top and side view.
+    #[command(after_help = "Example:\n  arc shapes --units 6 --out lsc.svg")]
     Shapes(tables::ShapesArgs),
     /// Plan a collision-free motion with shape changes (the ARCplanner).
+    #[command(
+        after_help = "Example:\n  arc plan --scenario window --units 5 --out window.json --picture window.svg"
+    )]
     Plan(Box<plan::PlanArgs>),
     /// Check a plan exactly against a map (docs/model.md), independent of the planner.
+    #[command(after_help = "Example:\n  arc verify --scenario window --plan window.json")]
     Verify(verify::VerifyArgs),
     /// Maps: export built-in scenarios as OctoMap files, inspect and draw maps.
-    #[command(subcommand)]
+    #[command(subcommand, after_help = "Example:\n  arc map info maps/geb079.bt")]
     Map(map::MapCommand),
     /// Benchmarks: the paper's Tables 1-3, scaling studies, full-state PRM plans.
-    #[command(subcommand)]
+    #[command(subcommand, after_help = "Example:\n  arc bench paper --quick")]
     Bench(bench::BenchCommand),
     /// Fly a plan: chain dynamics, head MPC, link SO(3) controllers, unit attitude loops.
+    #[command(
+        after_help = "Example:\n  arc sim --scenario window --plan window.json --picture flight.svg"
+    )]
     Sim(sim::SimArgs),
 }
 

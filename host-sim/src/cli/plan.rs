@@ -7,7 +7,7 @@ use std::time::Duration;
 use arc_core::ChainParams;
 use clap::Args;
 
-use super::common::{ChainArgs, MapArgs, Query, QueryArgs};
+use super::common::{ChainArgs, MapArgs, Query, QueryArgs, Report};
 use super::{CliError, CliResult};
 use crate::collision::{CollisionContext, DEFAULT_CLEARANCE};
 use crate::planner::refine::{Quality, Refinement};
@@ -82,7 +82,7 @@ pub struct PlanArgs {
     /// Give up after this many seconds.
     #[arg(long)]
     time_limit: Option<f64>,
-    /// Output plan (JSON, arc-plan/1).
+    /// Output plan (JSON, arc-plan/1); `-` writes it to standard output.
     #[arg(long)]
     out: PathBuf,
     /// Picture of the plan (.svg or .png).
@@ -200,6 +200,7 @@ pub fn run(a: PlanArgs) -> CliResult {
     } = a.query.resolve(&a.chain, loaded.scenario.as_ref())?;
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
     let (resolution, unknown_occ) = (loaded.grid.resolution(), loaded.grid.unknown_is_occupied());
+    let source = loaded.source.clone();
     let (field, _) = loaded.into_field();
     let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;
     let settings = Settings {
@@ -234,12 +235,15 @@ pub fn run(a: PlanArgs) -> CliResult {
     let quality = Quality::of(&solution.steps);
     let mut plan = motion::to_plan(&solution, &params, resolution, unknown_occ);
     motion::annotate_quality(&mut plan, &quality, refinement.as_ref());
+    plan.map.source = source;
     plan.write(&a.out)
         .map_err(|e| CliError::input(e.to_string()))?;
     let s = &solution.stats;
-    println!(
+    // With `--out -` the plan is standard output; the report goes to standard error.
+    let report = Report::new(&a.out);
+    report.line(format_args!(
         "{}: solved on {} with N = {}: {} waypoints, {} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations, {} follow), {} replans",
-        a.out.display(),
+        crate::fsutil::output_name(&a.out),
         a.map.name(),
         params.units,
         plan.waypoints.len(),
@@ -250,16 +254,16 @@ pub fn run(a: PlanArgs) -> CliResult {
         s.rotations,
         s.follow_uses,
         s.replans
-    );
-    println!(
+    ));
+    report.line(format_args!(
         "  roadmap {:.1} ms ({} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
         s.roadmap_s * 1e3,
         s.roadmap_vertices,
         s.planning_s * 1e3,
         s.collision_s * 1e3,
         s.collision_checks
-    );
-    print_quality(&quality, refinement.as_ref());
+    ));
+    print_quality(&report, &quality, refinement.as_ref());
     if let Some(pic) = &a.picture {
         let grid = planner.context().field().grid();
         crate::plan_picture::draw(
@@ -270,25 +274,25 @@ pub fn run(a: PlanArgs) -> CliResult {
         )
         .save(pic)
         .map_err(CliError::input)?;
-        println!("  picture: {}", pic.display());
+        report.line(format_args!("  picture: {}", pic.display()));
     }
     Ok(())
 }
 
 /// Prints the plan's quality, and what refinement changed.
-fn print_quality(q: &Quality, refinement: Option<&Refinement>) {
-    println!(
+fn print_quality(report: &Report, q: &Quality, refinement: Option<&Refinement>) {
+    report.line(format_args!(
         "  head path {:.2} m, {} shape changes, shape motion {:.2} rad (sum of C_T {:.2})",
         q.head_path_m, q.shape_changes, q.shape_motion_rad, q.shape_cost
-    );
+    ));
     if let Some(r) = refinement {
-        println!(
+        report.line(format_args!(
             "  refined in {:.1} ms ({} checks) from: head path {:.2} m, {} shape changes, shape motion {:.2} rad",
             r.time_s * 1e3,
             r.checks,
             r.before.head_path_m,
             r.before.shape_changes,
             r.before.shape_motion_rad
-        );
+        ));
     }
 }

@@ -1,15 +1,18 @@
 //! `arc sim`: fly a plan with the chain's dynamics and control stack, on a map.
 
-use std::path::PathBuf;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
 
 use clap::Args;
 use serde::Serialize;
 
-use super::common::MapArgs;
+use super::common::{MapArgs, Report};
 use super::{CliError, CliResult};
 use crate::plan::Plan;
 use crate::sim::clearance::{footprint, MapClearance};
-use crate::sim::flight::{simulate, FlightReport, Gust, Sample, SimConfig};
+use crate::sim::flight::{simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig};
 use crate::sim::plot::flight_svg;
 use crate::sim::V3;
 
@@ -18,10 +21,11 @@ use crate::sim::V3;
 pub struct SimArgs {
     #[command(flatten)]
     map: MapArgs,
-    /// The plan to fly (JSON, arc-plan/1).
+    /// The plan to fly (JSON, arc-plan/1); `-` reads it from standard input.
     #[arg(long)]
     plan: PathBuf,
-    /// Write the flight (report and recorded states) as JSON.
+    /// Write the flight (report and recorded states) as JSON; `-` writes it to
+    /// standard output.
     #[arg(long)]
     out: Option<PathBuf>,
     /// Write plots of the flight: SVG, or PNG when the name ends in .png.
@@ -83,13 +87,51 @@ fn parse_gust(s: &str) -> Result<Gust, CliError> {
     })
 }
 
+/// Runs `job` with a progress bar on standard error while it flies, when standard
+/// error is a terminal (a log file gets no bar).
+fn with_progress<T>(job: impl FnOnce(&Progress) -> T) -> T {
+    let progress = Progress::default();
+    if !std::io::stderr().is_terminal() {
+        return job(&progress);
+    }
+    /// Stops the bar however the job ends (a panic included), so the scope can join it.
+    struct Finish<'a>(&'a AtomicBool);
+    impl Drop for Finish<'_> {
+        fn drop(&mut self) {
+            self.0.store(true, Ordering::Relaxed);
+        }
+    }
+    let finished = AtomicBool::new(false);
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            let bar = indicatif::ProgressBar::new(0);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "flying [{bar:40}] {percent}% of the longest flight ({eta})",
+                )
+                .expect("static template")
+                .progress_chars("=> "),
+            );
+            while !finished.load(Ordering::Relaxed) {
+                bar.set_length(progress.total.load(Ordering::Relaxed));
+                bar.set_position(progress.done.load(Ordering::Relaxed));
+                std::thread::sleep(Duration::from_millis(100));
+            }
+            bar.finish_and_clear();
+        });
+        let _finish = Finish(&finished);
+        job(&progress)
+    })
+}
+
 /// Runs `arc sim`: exit 0 only when the chain reaches the plan's goal without touching
 /// the map or itself.
 pub fn run(a: SimArgs) -> CliResult {
     let plan = Plan::read(&a.plan).map_err(|e| CliError::input(e.to_string()))?;
+    let plan_name = crate::fsutil::input_name(&a.plan);
     let params = plan
         .check()
-        .map_err(|e| CliError::input(format!("{}: {e}", a.plan.display())))?;
+        .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
     let mut map = a.map.clone();
     // Check the flight under what the plan assumed of unknown space.
     map.unknown_free |= !plan.map.unknown_is_occupied;
@@ -116,12 +158,17 @@ pub fn run(a: SimArgs) -> CliResult {
         .map_err(|e| CliError::input(format!("simulation settings: {e}")))?;
     let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
     let obstacles = MapClearance::new(&loaded.grid, &params);
-    let flight = simulate(&params, &waypoints, &cfg, Some(&obstacles))
-        .map_err(|e| CliError::input(format!("{}: {e}", a.plan.display())))?;
+    let flight = with_progress(|progress| {
+        simulate_with_progress(&params, &waypoints, &cfg, Some(&obstacles), progress)
+    })
+    .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
     let r = &flight.report;
-    println!(
+    // With `--out -` the flight is standard output; the report goes to standard error.
+    let report = Report::new(a.out.as_deref().unwrap_or(Path::new("")));
+    let say = |args: std::fmt::Arguments<'_>| report.line(args);
+    say(format_args!(
         "{}: N = {}, {} waypoints, plan {:.2} s, flown {:.2} s at {} Hz ({:.1}x real time, MPC {} solves, {} fallbacks)",
-        a.plan.display(),
+        plan_name,
         r.units,
         plan.waypoints.len(),
         r.planned_duration,
@@ -130,34 +177,37 @@ pub fn run(a: SimArgs) -> CliResult {
         r.realtime_factor,
         r.mpc_solves,
         r.mpc_failures
-    );
+    ));
     match r.time_to_complete {
-        Some(t) => println!("  reached the goal at {t:.2} s"),
-        None => println!("  did not reach the goal"),
+        Some(t) => say(format_args!("  reached the goal at {t:.2} s")),
+        None => say(format_args!("  did not reach the goal")),
     }
-    println!(
+    say(format_args!(
         "  head tracking error: RMS {:.4} m, max {:.4} m",
         r.head_rms, r.head_max
-    );
-    println!(
+    ));
+    say(format_args!(
         "  link angle error:    RMS {:.3} deg, max {:.3} deg",
         r.link_rms_deg, r.link_max_deg
-    );
+    ));
     match (r.min_clearance, &r.min_clearance_at, r.min_clearance_time) {
-        (Some(c), Some(at), Some(t)) => {
-            println!("  minimum clearance to the map: {c:.4} m at {t:.2} s ({at})")
-        }
-        _ => println!("  minimum clearance to the map: not measured"),
+        (Some(c), Some(at), Some(t)) => say(format_args!(
+            "  minimum clearance to the map: {c:.4} m at {t:.2} s ({at})"
+        )),
+        _ => say(format_args!("  minimum clearance to the map: not measured")),
     }
-    println!("  smallest gap inside the chain: {:.4} m", r.min_self_gap);
-    println!(
+    say(format_args!(
+        "  smallest gap inside the chain: {:.4} m",
+        r.min_self_gap
+    ));
+    say(format_args!(
         "  joint-limit excursions: pitch {:.3} deg, bend {:.3} deg, {:.3} s beyond",
         r.limits.max_pitch_excess_deg, r.limits.max_bend_excess_deg, r.limits.time_beyond
-    );
+    ));
     if let Some(path) = &a.out {
         let file = SimFile {
             format: "arc-sim/1",
-            plan: a.plan.display().to_string(),
+            plan: plan_name.clone(),
             map: a.map.name(),
             report: r,
             record_every: a.record_every,
@@ -165,9 +215,11 @@ pub fn run(a: SimArgs) -> CliResult {
         };
         let text = serde_json::to_string(&file)
             .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
-        crate::fsutil::write_atomic(path, text.as_bytes())
+        crate::fsutil::write_output(path, text.as_bytes())
             .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
-        println!("  wrote {}", path.display());
+        if !crate::fsutil::is_stdio(path) {
+            say(format_args!("  wrote {}", path.display()));
+        }
     }
     if let Some(path) = &a.picture {
         let zs = flight
@@ -179,7 +231,7 @@ pub fn run(a: SimArgs) -> CliResult {
         });
         let band = params.unit_radius as f64;
         let obs = footprint(&loaded.grid, lo - band, hi + band);
-        let title = format!("arc sim: {} on {}", a.plan.display(), a.map.name());
+        let title = format!("arc sim: {plan_name} on {}", a.map.name());
         let svg = flight_svg(&flight, &obs, &title).map_err(CliError::failed)?;
         let bytes = match path
             .extension()
@@ -192,7 +244,7 @@ pub fn run(a: SimArgs) -> CliResult {
         };
         crate::fsutil::write_atomic(path, &bytes)
             .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
-        println!("  wrote {}", path.display());
+        say(format_args!("  wrote {}", path.display()));
     }
     if r.success() {
         return Ok(());
@@ -212,5 +264,5 @@ pub fn run(a: SimArgs) -> CliResult {
             cfg.settle_time
         )
     };
-    Err(CliError::failed(format!("{}: {why}", a.plan.display())))
+    Err(CliError::failed(format!("{plan_name}: {why}")))
 }

@@ -18,8 +18,12 @@ use crate::tables::{ShapeTables, TableSettings};
 #[derive(Subcommand, Debug)]
 pub enum TablesCommand {
     /// Build the shape table of a chain (LSC, SRS, G_SRS) and write it atomically.
+    #[command(
+        after_help = "Example:\n  arc tables build --units 6 --srs 500 --seed 1 --out n6.arct"
+    )]
     Build(BuildArgs),
     /// Check a table file and print its header, counts, LSC names and CRC verdict.
+    #[command(after_help = "Example:\n  arc tables inspect n6.arct")]
     Inspect {
         /// The table file.
         file: PathBuf,

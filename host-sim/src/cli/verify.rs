@@ -14,7 +14,7 @@ use crate::plan::Plan;
 pub struct VerifyArgs {
     #[command(flatten)]
     map: MapArgs,
-    /// The plan (JSON, arc-plan/1).
+    /// The plan (JSON, arc-plan/1); `-` reads it from standard input.
     #[arg(long)]
     plan: PathBuf,
     /// Where the plan must start (head x,y,z); a scenario has its own.
@@ -46,7 +46,7 @@ pub fn run(a: VerifyArgs) -> CliResult {
     let report = verify_plan(&loaded.grid, &plan);
     println!(
         "{}: {} waypoints, {} edges ({} translations, {} shape changes), {} configurations checked exactly (unknown space {})",
-        a.plan.display(),
+        crate::fsutil::input_name(&a.plan),
         plan.waypoints.len(),
         report.edges.len(),
         report.edges.iter().filter(|e| **e == crate::collision::EdgeKind::Translation).count(),
@@ -54,6 +54,12 @@ pub fn run(a: VerifyArgs) -> CliResult {
         report.samples,
         if loaded.grid.unknown_is_occupied() { "occupied" } else { "free" }
     );
+    if plan.map.source.differs_from(&loaded.source) {
+        println!(
+            "  note: the plan was made for {}; checked here against {}",
+            plan.map.source, loaded.source
+        );
+    }
     for n in &report.notes {
         println!("  note: {n}");
     }

@@ -447,10 +447,7 @@ mod tests {
         Plan {
             format: FORMAT.into(),
             chain: ChainSection::from_params(&ChainParams::new(3)),
-            map: MapSection {
-                resolution: 0.1,
-                unknown_is_occupied: true,
-            },
+            map: MapSection::new(0.1, true),
             waypoints: points.iter().map(|(h, s)| Waypoint::new(*h, s)).collect(),
             stats: Default::default(),
         }

@@ -87,6 +87,13 @@ const CHILD_FREE: u16 = 1;
 const CHILD_OCCUPIED: u16 = 2;
 const CHILD_INNER: u16 = 3;
 
+/// Log-odds of an occupied leaf in the `.ot` files we write: OctoMap's default upper
+/// clamping bound (probability 0.971), what a voxel seen occupied many times holds.
+pub const OT_OCCUPIED_LOG_ODDS: f32 = 3.5;
+/// Log-odds of a free leaf in the `.ot` files we write: OctoMap's default lower clamping
+/// bound (probability 0.1192).
+pub const OT_FREE_LOG_ODDS: f32 = -2.0;
+
 /// The name used in errors from [`OcTree::from_voxels`], which has no file.
 const VOXELS_NAME: &str = "<from_voxels>";
 
@@ -349,6 +356,105 @@ impl OcTree {
     /// Writes the tree as a `.bt` file, atomically (a reader never sees half a file).
     pub fn write_bt(&self, path: &Path) -> Result<(), MapFileError> {
         crate::fsutil::write_atomic(path, &self.to_bt_bytes()).map_err(|source| MapFileError::Io {
+            file: path.display().to_string(),
+            action: "write",
+            source,
+        })
+    }
+
+    /// The tree as a full `.ot` file (OctoMap's `AbstractOcTree::write`): per node, in
+    /// depth-first order, its log-odds occupancy (`f32`, little-endian) and a byte of
+    /// child-exists bits. The tree keeps only max-likelihood states, so a leaf is written
+    /// with OctoMap's default clamping bound for its state ([`OT_OCCUPIED_LOG_ODDS`],
+    /// [`OT_FREE_LOG_ODDS`]) and an inner node with the largest value below it, as
+    /// OctoMap's `updateInnerOccupancy` sets it. Reading the file gives this tree back.
+    pub fn to_ot_bytes(&self) -> Vec<u8> {
+        let header = format!(
+            "# Octomap OcTree file\n\
+             # (feel free to add / change comments, but leave the first line as it is!)\n\
+             #\n\
+             id OcTree\n\
+             size {}\n\
+             res {}\n\
+             data\n",
+            self.stats.nodes, self.resolution
+        );
+        let mut out = Vec::with_capacity(header.len() + 5 * self.stats.nodes as usize);
+        out.extend_from_slice(header.as_bytes());
+        if self.codes.is_empty() {
+            return out;
+        }
+        let mut occupied = vec![None; self.codes.len()];
+        let root_value = self.inner_log_odds(0, &mut occupied);
+        self.write_ot_node(0, root_value, &mut occupied, &mut out);
+        out
+    }
+
+    /// The log-odds of the inner node in `slot`: occupied when any leaf below it is
+    /// (memoised in `memo`, one entry per inner node).
+    fn inner_log_odds(&self, slot: usize, memo: &mut [Option<bool>]) -> f32 {
+        if let Some(known) = memo[slot] {
+            return if known {
+                OT_OCCUPIED_LOG_ODDS
+            } else {
+                OT_FREE_LOG_ODDS
+            };
+        }
+        let code = self.codes[slot];
+        let mut any = false;
+        for child in 0..8u32 {
+            any |= match (code >> (2 * child)) & 3 {
+                CHILD_OCCUPIED => true,
+                CHILD_INNER => self
+                    .inner_child_slot(slot, code, child)
+                    .is_some_and(|s| self.inner_log_odds(s, memo) >= 0.0),
+                _ => false,
+            };
+        }
+        memo[slot] = Some(any);
+        if any {
+            OT_OCCUPIED_LOG_ODDS
+        } else {
+            OT_FREE_LOG_ODDS
+        }
+    }
+
+    /// Appends the inner node in `slot` (log-odds `value`) and its subtree to `out`.
+    fn write_ot_node(&self, slot: usize, value: f32, memo: &mut [Option<bool>], out: &mut Vec<u8>) {
+        let code = self.codes[slot];
+        let exists = (0..8u32).fold(0u8, |m, c| {
+            if (code >> (2 * c)) & 3 != CHILD_NONE {
+                m | (1 << c)
+            } else {
+                m
+            }
+        });
+        out.extend_from_slice(&value.to_le_bytes());
+        out.push(exists);
+        for child in 0..8u32 {
+            match (code >> (2 * child)) & 3 {
+                CHILD_OCCUPIED => {
+                    out.extend_from_slice(&OT_OCCUPIED_LOG_ODDS.to_le_bytes());
+                    out.push(0);
+                }
+                CHILD_FREE => {
+                    out.extend_from_slice(&OT_FREE_LOG_ODDS.to_le_bytes());
+                    out.push(0);
+                }
+                CHILD_INNER => {
+                    if let Some(s) = self.inner_child_slot(slot, code, child) {
+                        let v = self.inner_log_odds(s, memo);
+                        self.write_ot_node(s, v, memo, out);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// Writes the tree as a full `.ot` file ([`OcTree::to_ot_bytes`]), atomically.
+    pub fn write_ot(&self, path: &Path) -> Result<(), MapFileError> {
+        crate::fsutil::write_atomic(path, &self.to_ot_bytes()).map_err(|source| MapFileError::Io {
             file: path.display().to_string(),
             action: "write",
             source,
@@ -1603,6 +1709,23 @@ mod tests {
             assert_eq!(t.query([bad, 0.0, 0.0]), None);
             assert_eq!(t.query([0.0, 0.0, bad]), None);
         }
+    }
+
+    #[test]
+    fn ot_files_we_write_read_back_as_the_same_tree() {
+        let t = OcTree::from_bt_bytes(&tiny_bt(), "tiny.bt").unwrap();
+        let ot = t.to_ot_bytes();
+        assert!(ot.starts_with(b"# Octomap OcTree file\n"));
+        assert_eq!(OcTree::from_bt_bytes(&ot, "tiny.ot").unwrap(), t);
+        let empty = OcTree::empty(0.1);
+        assert_eq!(
+            OcTree::from_bt_bytes(&empty.to_ot_bytes(), "e.ot").unwrap(),
+            empty
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.ot");
+        t.write_ot(&path).unwrap();
+        assert_eq!(OcTree::read_bt(&path).unwrap(), t);
     }
 
     #[test]

@@ -29,7 +29,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use arc_core::{ChainParams, Shape};
 
 use super::grid::{Cell, Grid};
-use crate::plan::{ChainSection, MapSection, Plan, Waypoint};
+use crate::plan::{ChainSection, MapSection, MapSource, Plan, Waypoint};
 
 /// Resolution of every built-in scenario (m).
 pub const RESOLUTION: f64 = 0.1;
@@ -364,8 +364,8 @@ impl Scenario {
             format: crate::plan::FORMAT.into(),
             chain: ChainSection::from_params(&params),
             map: MapSection {
-                resolution: self.grid.resolution(),
-                unknown_is_occupied: self.grid.unknown_is_occupied(),
+                source: MapSource::scenario(&self.name),
+                ..MapSection::new(self.grid.resolution(), self.grid.unknown_is_occupied())
             },
             waypoints: vec![Waypoint::new(self.start, &shape)],
             stats: Default::default(),

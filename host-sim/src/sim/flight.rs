@@ -8,6 +8,7 @@
 //! after the reference has ended, or [`SimConfig::settle_time`] after the reference
 //! has ended, or when it diverges.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use arc_core::control::{desired_attitude, Vec3};
@@ -280,12 +281,49 @@ pub fn simulate(
     simulate_model(ChainModel::new(*params), waypoints, cfg, obstacles)
 }
 
+/// How far a running simulation is, read by another thread for a progress display.
+#[derive(Debug, Default)]
+pub struct Progress {
+    /// Steps simulated so far.
+    pub done: AtomicU64,
+    /// Most steps the run can take; 0 until the run has timed its reference.
+    pub total: AtomicU64,
+}
+
+/// [`simulate`], reporting its progress in `progress` as it goes.
+pub fn simulate_with_progress(
+    params: &ChainParams,
+    waypoints: &[Vec<f64>],
+    cfg: &SimConfig,
+    obstacles: Option<&dyn Obstacles>,
+    progress: &Progress,
+) -> Result<Flight, SimError> {
+    fly(
+        ChainModel::new(*params),
+        waypoints,
+        cfg,
+        obstacles,
+        progress,
+    )
+}
+
 /// [`simulate`] with explicit bodies.
 pub fn simulate_model(
     model: ChainModel,
     waypoints: &[Vec<f64>],
     cfg: &SimConfig,
     obstacles: Option<&dyn Obstacles>,
+) -> Result<Flight, SimError> {
+    fly(model, waypoints, cfg, obstacles, &Progress::default())
+}
+
+/// The simulation loop behind [`simulate_model`] and [`simulate_with_progress`].
+fn fly(
+    model: ChainModel,
+    waypoints: &[Vec<f64>],
+    cfg: &SimConfig,
+    obstacles: Option<&dyn Obstacles>,
+    progress: &Progress,
 ) -> Result<Flight, SimError> {
     cfg.validate().map_err(SimError::Config)?;
     model.validate().map_err(SimError::Config)?;
@@ -333,6 +371,9 @@ pub fn simulate_model(
         .collect();
     let t_ref = reference.duration();
     let t_max = t_ref.max(cfg.min_time) + cfg.settle_time;
+    progress
+        .total
+        .store((t_max * cfg.rate).ceil() as u64 + 1, Ordering::Relaxed);
     let theta_max = params.theta_max as f64;
     let beta_max = params.beta_max as f64;
 
@@ -350,6 +391,7 @@ pub fn simulate_model(
     let mut step = 0usize;
     loop {
         let t = step as f64 * dt;
+        progress.done.store(step as u64, Ordering::Relaxed);
         let units = dynamics.unit_states();
         let links = dynamics.link_states();
         let out = controller.step(t, &units, &reference);

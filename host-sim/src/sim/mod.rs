@@ -3,7 +3,7 @@
 //!
 //! - [`model`]: bodies, actuators and their default numbers;
 //! - [`dynamics`]: the multibody (rapier3d, spherical joints at the unit centres);
-//! - [`reference`]: the plan's edges timed within speed and angular-rate limits;
+//! - [`reference`](mod@reference): the plan's edges timed within speed and angular-rate limits;
 //! - [`mpc`]: the head's position MPC (a second-order-cone QP solved by clarabel);
 //! - [`controller`]: link controllers, mixer and unit attitude loops (paper Fig. 3);
 //! - [`flight`]: [`simulate`], the recorded flight and its report;

@@ -197,3 +197,34 @@ fn unflyable_plans_are_errors_not_panics() {
     };
     assert!(simulate(&p, &[zeta([0.0; 3], &line(3))], &bad, None).is_err());
 }
+
+#[test]
+fn progress_counts_the_steps_flown() {
+    use super::flight::{simulate_with_progress, Progress};
+    use std::sync::atomic::Ordering;
+    let p = ChainParams::new(3);
+    let cfg = SimConfig {
+        min_time: 1.0,
+        ..Default::default()
+    };
+    let progress = Progress::default();
+    let f = simulate_with_progress(
+        &p,
+        &[zeta([0.0, 0.0, 2.0], &line(3))],
+        &cfg,
+        None,
+        &progress,
+    )
+    .unwrap();
+    let (done, total) = (
+        progress.done.load(Ordering::Relaxed),
+        progress.total.load(Ordering::Relaxed),
+    );
+    // One sample per step: the last step's index is the count less one.
+    assert_eq!(done + 1, f.samples.len() as u64);
+    let longest = (cfg.min_time + cfg.settle_time) * cfg.rate;
+    assert!(
+        total as f64 >= longest && done <= total,
+        "{done} of {total}"
+    );
+}
