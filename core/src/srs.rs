@@ -16,7 +16,7 @@ use core::f32::consts::PI;
 use rand_core::{RngCore, SeedableRng};
 use rand_pcg::Pcg32;
 
-use crate::cost::transition_cost_sq;
+use crate::cost::transition_cost_sq_within;
 use crate::lsc::LIMIT_MARGIN;
 use crate::params::ChainParams;
 use crate::shape::Shape;
@@ -165,10 +165,15 @@ pub fn build_roadmap<const DEG: usize>(
         // The DEG nearest candidates of i among later shapes, nearest first.
         let mut near: heapless::Vec<(f32, u16), DEG> = heapless::Vec::new();
         for j in i + 1..shapes.len() {
-            let d = transition_cost_sq(&shapes[i], &shapes[j]);
-            if d > r2 {
+            // Only a shape nearer than the farthest kept one can enter: stop summing
+            // its cost as soon as it cannot (the same costs, far fewer terms).
+            let bound = match near.last() {
+                Some(&(last, _)) if near.is_full() => last.min(r2),
+                _ => r2,
+            };
+            let Some(d) = transition_cost_sq_within(&shapes[i], &shapes[j], bound) else {
                 continue;
-            }
+            };
             if near.is_full() {
                 if d >= near[DEG - 1].0 {
                     continue;

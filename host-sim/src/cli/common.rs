@@ -71,6 +71,18 @@ pub struct MapArgs {
     pub unknown_free: bool,
 }
 
+/// Why a plan cannot be trusted under the user's assumptions: it was made with
+/// unknown space free, and the user did not say `--unknown-free`. The checker's
+/// assumptions come from the person running it, never from the file under test.
+pub fn looser_assumption(plan: &crate::plan::Plan, map: &MapArgs) -> Option<String> {
+    (!plan.map.unknown_is_occupied && !map.unknown_free).then(|| {
+        "the plan was made with unknown space free (map.unknown_is_occupied: false), \
+         but it is checked with unknown space occupied; give --unknown-free to check it \
+         under the plan's assumption"
+            .to_string()
+    })
+}
+
 /// A loaded map, and the scenario it came from if any.
 pub struct LoadedMap {
     /// The occupancy grid (with the user's unknown-space choice applied).
