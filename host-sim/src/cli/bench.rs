@@ -372,8 +372,8 @@ fn run_scale(a: ScaleArgs) -> CliResult {
 
 /// Checks every option of `arc bench prm` before any work (docs/promises.md).
 fn check_prm(a: &PrmArgs) -> Result<Option<Duration>, CliError> {
-    checks::non_negative("--clearance", a.clearance)?;
-    checks::non_negative("--goal-tol", a.goal_tol)?;
+    checks::length("--clearance", a.clearance, false)?;
+    checks::length("--goal-tol", a.goal_tol, false)?;
     checks::count(
         "--vertices",
         a.vertices,

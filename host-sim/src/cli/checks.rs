@@ -27,6 +27,28 @@ pub const MAX_PRM_VERTICES: usize = 1_000_000;
 /// Most head edges the planner may drop without progress (`--max-replans`).
 pub const MAX_REPLANS: usize = 1_000_000;
 
+/// Longest length a flag may give in metres (`--goal-tol`, `--clearance`, `--r-t`):
+/// 10 km, far beyond any map, so that sums and samplers stay finite.
+pub const MAX_LENGTH_M: f64 = 1e4;
+
+/// Longest link (`--link-length`, m).
+pub const MAX_LINK_LENGTH_M: f32 = 100.0;
+
+/// A length in metres: `>= 0` (or `> 0` when `positive`) and at most [`MAX_LENGTH_M`].
+pub fn length(flag: &str, v: f64, positive: bool) -> Result<(), CliError> {
+    let low_ok = if positive { v > 0.0 } else { v >= 0.0 };
+    if low_ok && v <= MAX_LENGTH_M {
+        Ok(())
+    } else {
+        let low = if positive { "positive" } else { ">= 0" };
+        Err(bad(
+            flag,
+            v,
+            &format!("a length {low} and at most {MAX_LENGTH_M:e} m"),
+        ))
+    }
+}
+
 /// The error for a flag whose value breaks its limit: `--flag VALUE: must be WANT`.
 pub fn bad(flag: &str, value: impl std::fmt::Display, want: &str) -> CliError {
     CliError::input(format!("{flag} {value}: must be {want}"))

@@ -4,10 +4,11 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use arc_core::lsc::{library, LscKind};
+use arc_core::params::ParamError;
 use arc_core::{ChainParams, Shape};
 use clap::Args;
 
-use super::CliError;
+use super::{checks, CliError};
 use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 use crate::map::octomap::OcTree;
@@ -40,6 +41,17 @@ impl ChainArgs {
     /// Validated chain parameters, with `default_units` when `--units` is absent.
     pub fn params(&self, default_units: u8) -> Result<arc_core::ChainParams, CliError> {
         let units = self.units.unwrap_or(default_units);
+        if !(self.link_length <= checks::MAX_LINK_LENGTH_M) {
+            return Err(checks::bad(
+                "--link-length",
+                self.link_length,
+                &format!(
+                    "a positive length up to {} m (the core's f32 geometry keeps \
+                     sub-millimetre precision up to there)",
+                    checks::MAX_LINK_LENGTH_M
+                ),
+            ));
+        }
         arc_core::ChainParams {
             units,
             link_length: self.link_length,
@@ -49,7 +61,39 @@ impl ChainArgs {
             beta_max: arc_core::angle::deg(self.beta_max_deg),
         }
         .validate()
-        .map_err(|e| CliError::input(format!("chain parameters (--units {units}, ...): {e}")))
+        .map_err(|e| self.param_error(units, e))
+    }
+
+    /// The flag behind a chain parameter the core refused, its value and its limit.
+    fn param_error(&self, units: u8, e: ParamError) -> CliError {
+        match e {
+            ParamError::UnitsOutOfRange => checks::bad("--units", units, "between 2 and 16"),
+            ParamError::LinkLength => {
+                checks::bad("--link-length", self.link_length, "a positive length (m)")
+            }
+            ParamError::UnitRadius => {
+                checks::bad("--unit-radius", self.unit_radius, "a positive length (m)")
+            }
+            ParamError::LinkRadius => checks::bad(
+                "--link-radius",
+                self.link_radius,
+                &format!("positive and below --unit-radius {}", self.unit_radius),
+            ),
+            ParamError::UnitsOverlap => checks::bad(
+                "--unit-radius",
+                self.unit_radius,
+                &format!(
+                    "below half of --link-length {} (neighbouring units would overlap)",
+                    self.link_length
+                ),
+            ),
+            ParamError::ThetaMax => {
+                checks::bad("--theta-max-deg", self.theta_max_deg, "in (0, 90) degrees")
+            }
+            ParamError::BetaMax => {
+                checks::bad("--beta-max-deg", self.beta_max_deg, "in (0, 180] degrees")
+            }
+        }
     }
 }
 
@@ -179,6 +223,16 @@ impl QueryArgs {
             .goal
             .or(sc.map(|s| s.goal))
             .ok_or_else(|| CliError::input("--goal is required with --map"))?;
+        if let Some(d) = self.start_yaw_deg {
+            // The shape holds angles as f32.
+            if !(d.to_radians() as f32).is_finite() {
+                return Err(checks::bad(
+                    "--start-yaw-deg",
+                    d,
+                    "a finite angle (degrees)",
+                ));
+            }
+        }
         let yaw = self
             .start_yaw_deg
             .map(f64::to_radians)

@@ -6,7 +6,7 @@ use std::ffi::OsString;
 use std::fmt;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod bench;
 pub mod checks;
@@ -96,35 +96,55 @@ enum Command {
     Sim(sim::SimArgs),
 }
 
+/// The command line, where every option that takes a value takes a negative number
+/// too: `--seed -1` is then refused by its own check, which names the flag, instead
+/// of being read as an unknown option `-1`.
+fn command() -> clap::Command {
+    fn negatives(c: clap::Command) -> clap::Command {
+        c.mut_args(|a| {
+            if a.get_action().takes_values() {
+                a.allow_negative_numbers(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
+}
+
 /// Parses `args` (including the program name) and runs the command.
 pub fn run<I, T>(args: I) -> CliResult
 where
     I: IntoIterator<Item = T>,
     T: Into<OsString> + Clone,
 {
-    let cli = Cli::try_parse_from(args).map_err(|e| {
-        // --help and --version are not errors.
-        if matches!(
-            e.kind(),
-            clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion
-        ) {
-            let _ = e.print();
-            return CliError {
-                code: exit::DONE,
-                message: String::new(),
-            };
-        }
-        // One line: clap's first paragraph ("error: invalid value '-1' for '--seed
-        // <SEED>': ..."), joined, without the usage and help after it.
-        let text = e.render().to_string();
-        let first: Vec<&str> = text
-            .lines()
-            .map(str::trim)
-            .skip_while(|l| l.is_empty())
-            .take_while(|l| !l.is_empty())
-            .collect();
-        CliError::input(first.join(" ").trim_start_matches("error: ").to_string())
-    });
+    let cli = command()
+        .try_get_matches_from(args)
+        .and_then(|m| Cli::from_arg_matches(&m))
+        .map_err(|e| {
+            // --help and --version are not errors.
+            if matches!(
+                e.kind(),
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion
+            ) {
+                let _ = e.print();
+                return CliError {
+                    code: exit::DONE,
+                    message: String::new(),
+                };
+            }
+            // One line: clap's first paragraph ("error: invalid value '-1' for '--seed
+            // <SEED>': ..."), joined, without the usage and help after it.
+            let text = e.render().to_string();
+            let first: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .skip_while(|l| l.is_empty())
+                .take_while(|l| !l.is_empty())
+                .collect();
+            CliError::input(first.join(" ").trim_start_matches("error: ").to_string())
+        });
     let cli = match cli {
         Ok(c) => c,
         Err(e) if e.code == exit::DONE => return Ok(()),

@@ -113,7 +113,7 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
             checks::MAX_HEAD_VERTICES
         ),
     )?;
-    checks::positive("--r-t", a.r_t)?;
+    checks::length("--r-t", a.r_t, true)?;
     checks::count("--n-psi", a.n_psi, 1, 360, "headings per shape")?;
     if let Some(d) = a.d_c {
         checks::positive("--d-c", d as f64)?;
@@ -126,8 +126,8 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
             &format!("0 (off) or between {MIN_FOLLOW_STEP} and 1 m"),
         ));
     }
-    checks::non_negative("--goal-tol", a.goal_tol)?;
-    checks::non_negative("--clearance", a.clearance)?;
+    checks::length("--goal-tol", a.goal_tol, false)?;
+    checks::length("--clearance", a.clearance, false)?;
     checks::count(
         "--max-replans",
         a.max_replans,

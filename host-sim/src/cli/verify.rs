@@ -41,7 +41,7 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// Runs `arc verify`: exit 0 only when every waypoint and every sampled point of
 /// every edge is valid, and the plan starts and ends where asked.
 pub fn run(a: VerifyArgs) -> CliResult {
-    checks::non_negative("--goal-tol", a.goal_tol)?;
+    checks::length("--goal-tol", a.goal_tol, false)?;
     let plan = Plan::read(&a.plan).map_err(|e| CliError::input(e.to_string()))?;
     // What unknown space is comes from the command line only, never from the plan
     // under test (docs/model.md, Interpretations).

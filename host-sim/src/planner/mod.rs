@@ -184,6 +184,11 @@ pub struct Solution {
     pub stats: Stats,
 }
 
+/// A point for messages: `(x, y, z)` to the millimetre.
+fn point(p: &[f64; 3]) -> String {
+    format!("({:.3}, {:.3}, {:.3})", p[0], p[1], p[2])
+}
+
 /// Why a query has no solution, or cannot be asked.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum PlanError {
@@ -208,7 +213,11 @@ pub enum PlanError {
         tol: f64,
     },
     /// The head could be routed, but the chain found no shape for some edge.
-    #[error("no shape fits head edge {from:?} -> {to:?} after {replans} replans")]
+    #[error(
+        "no shape fits head edge {} -> {} after {replans} replans",
+        point(from),
+        point(to)
+    )]
     NoShape {
         /// The last edge tried.
         from: [f64; 3],
@@ -372,9 +381,12 @@ impl Planner {
             .map_err(|c| PlanError::StartInvalid(c.to_string()))?;
         if !self.ctx.is_head_free(goal) {
             let why = if self.ctx.field().grid().in_bounds(goal) {
-                format!("the head's sphere (radius + clearance) collides at {goal:?}")
+                format!(
+                    "the head's sphere (radius + clearance) collides at {}",
+                    point(&goal)
+                )
             } else {
-                format!("{goal:?} is outside the map's bounds")
+                format!("{} is outside the map's bounds", point(&goal))
             };
             return Err(PlanError::GoalInvalid(why));
         }

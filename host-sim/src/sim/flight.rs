@@ -177,14 +177,18 @@ fn sample_bytes(n: usize) -> f64 {
 }
 
 /// Checks that recording a flight of up to `t_max` s fits [`MAX_RECORDED_BYTES`].
-fn check_budget(n: usize, t_max: f64, rate: f64) -> Result<usize, SimError> {
-    let steps = (t_max * rate).ceil() + 1.0;
+fn check_budget(n: usize, t_ref: f64, cfg: &SimConfig) -> Result<usize, SimError> {
+    let t_max = t_ref.max(cfg.min_time) + cfg.settle_time;
+    let steps = (t_max * cfg.rate).ceil() + 1.0;
     let bytes = steps * sample_bytes(n);
     if !(bytes <= MAX_RECORDED_BYTES) {
         return Err(SimError::Budget(format!(
-            "the flight may last {t_max:.3e} s, {steps:.3e} steps at {rate} Hz; recording \
-             them needs {:.3e} GiB, over the budget of 1 GiB (raise --speed, --accel or \
-             --angular-rate-deg, or lower --settle-time or --rate)",
+            "the flight may last {t_max:.3e} s (the plan {t_ref:.3e} s at --speed {} m/s, \
+             then --settle-time {} s), {steps:.3e} steps at --rate {} Hz; recording them \
+             needs {:.3e} GiB, over the budget of 1 GiB",
+            cfg.limits.speed,
+            cfg.settle_time,
+            cfg.rate,
             bytes / MAX_RECORDED_BYTES
         )));
     }
@@ -408,7 +412,7 @@ pub fn simulate_model(
         .collect();
     let t_ref = reference.duration();
     let t_max = t_ref.max(cfg.min_time) + cfg.settle_time;
-    let steps = check_budget(n, t_max, cfg.rate)?;
+    let steps = check_budget(n, t_ref, cfg)?;
     let theta_max = params.theta_max as f64;
     let beta_max = params.beta_max as f64;
 
