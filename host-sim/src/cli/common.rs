@@ -41,7 +41,7 @@ impl ChainArgs {
     /// Validated chain parameters, with `default_units` when `--units` is absent.
     pub fn params(&self, default_units: u8) -> Result<arc_core::ChainParams, CliError> {
         let units = self.units.unwrap_or(default_units);
-        if !(self.link_length <= checks::MAX_LINK_LENGTH_M) {
+        if self.link_length.is_nan() || self.link_length > checks::MAX_LINK_LENGTH_M {
             return Err(checks::bad(
                 "--link-length",
                 self.link_length,

@@ -218,6 +218,7 @@ pub fn run(a: PlanArgs) -> CliResult {
     let stop = Termination {
         time_limit: checks::time_limit(a.time_limit)?,
     };
+    let began = Instant::now();
     let solution = planner
         .solve(start, shape, goal, stop)
         .map_err(|e| match e {
@@ -225,7 +226,11 @@ pub fn run(a: PlanArgs) -> CliResult {
             PlanError::TablesMismatch { .. }
             | PlanError::StartInvalid(_)
             | PlanError::GoalInvalid(_) => CliError::input(e.to_string()),
-            _ => CliError::failed(format!("no plan: {e}")),
+            _ => CliError::failed(format!(
+                "no plan: {e} (after {:.1} ms of planning; setup {:.1} ms)",
+                began.elapsed().as_secs_f64() * 1e3,
+                setup_s * 1e3
+            )),
         })?;
     let plan = motion::to_plan(&solution, &params, resolution, unknown_occ);
     plan.write(&a.out)

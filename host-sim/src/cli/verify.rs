@@ -90,8 +90,8 @@ pub fn run(a: VerifyArgs) -> CliResult {
     let last = plan.waypoints[plan.waypoints.len() - 1].xi();
     if let Some(g) = goal {
         let d = dist(last, g);
-        // Written so that a NaN distance fails too.
-        if !(d <= a.goal_tol) {
+        // A NaN distance fails too.
+        if d.is_nan() || d > a.goal_tol {
             return Err(CliError::failed(format!(
                 "INVALID: last head {} is {d:.3} m from the goal {} (tolerance {} m)",
                 point(last),

@@ -181,7 +181,7 @@ fn check_budget(n: usize, t_ref: f64, cfg: &SimConfig) -> Result<usize, SimError
     let t_max = t_ref.max(cfg.min_time) + cfg.settle_time;
     let steps = (t_max * cfg.rate).ceil() + 1.0;
     let bytes = steps * sample_bytes(n);
-    if !(bytes <= MAX_RECORDED_BYTES) {
+    if bytes.is_nan() || bytes > MAX_RECORDED_BYTES {
         return Err(SimError::Budget(format!(
             "the flight may last {t_max:.3e} s (the plan {t_ref:.3e} s at --speed {} m/s, \
              then --settle-time {} s), {steps:.3e} steps at --rate {} Hz; recording them \
