@@ -155,7 +155,7 @@ fn check_study(a: &StudyArgs) -> Result<(), CliError> {
             v,
             1,
             checks::MAX_HEAD_VERTICES >> 3,
-            "the roadmap may grow 8 times",
+            "a run's roadmap may grow to 8 times this",
         )?;
     }
     if let Some(s) = a.srs {

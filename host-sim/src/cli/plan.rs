@@ -108,7 +108,9 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
         1,
         most,
         &format!(
-            "the roadmap may grow {} times, to at most {} vertices",
+            "--max-growth {} lets the roadmap grow to {} times this, and the budget is {} \
+             vertices",
+            a.max_growth,
             1usize << a.max_growth,
             checks::MAX_HEAD_VERTICES
         ),
