@@ -204,7 +204,8 @@ fn start_in_collision_names_the_body() {
         s(&out),
     ])
     .unwrap_err();
-    assert_eq!(e.code, 1, "{e}");
+    // A start in collision is bad input (2), in `arc plan` as in `arc bench prm`.
+    assert_eq!(e.code, 2, "{e}");
     assert!(
         e.message.contains("start is invalid") && e.message.contains("unit"),
         "{e}"

@@ -14,16 +14,28 @@ pub fn transition_cost(a: &Shape, b: &Shape) -> f32 {
 
 /// `C_T^2`, for comparisons without the square root.
 pub fn transition_cost_sq(a: &Shape, b: &Shape) -> f32 {
+    transition_cost_sq_within(a, b, f32::INFINITY).unwrap_or(f32::INFINITY)
+}
+
+/// `C_T^2` when it is at most `bound`, else `None`, found without summing every
+/// term: the terms are never negative, so once a partial sum exceeds `bound` the
+/// whole does. The terms are added in the same order as [`transition_cost_sq`], so a
+/// value returned is bit for bit the same. Heaviest terms come first (head, then
+/// links from the head), which is what makes nearest-neighbour searches fast.
+pub fn transition_cost_sq_within(a: &Shape, b: &Shape, bound: f32) -> Option<f32> {
     let n = a.units() as f32;
     let dh = diff(a.head_yaw(), b.head_yaw());
     let mut sum = n * dh * dh;
     for k in 0..a.links() {
+        if sum > bound {
+            return None;
+        }
         let w = n - (k as f32 + 1.0); // link i = k + 1 weighs N - i
         let dp = diff(a.pitch(k), b.pitch(k));
         let dy = diff(a.yaw(k), b.yaw(k));
         sum += w * (dp * dp + dy * dy);
     }
-    sum
+    (sum <= bound).then_some(sum)
 }
 
 #[cfg(test)]
@@ -42,6 +54,15 @@ mod tests {
     }
 
     proptest! {
+        #[test]
+        fn the_bounded_cost_is_the_cost_or_none(v in proptest::array::uniform7(-3.0f32..3.0), w in proptest::array::uniform7(-3.0f32..3.0), bound in 0.0f32..40.0) {
+            let a = Shape::from_slice(4, &v).unwrap();
+            let b = Shape::from_slice(4, &w).unwrap();
+            let full = transition_cost_sq(&a, &b);
+            let within = transition_cost_sq_within(&a, &b, bound);
+            prop_assert_eq!(within, (full <= bound).then_some(full));
+        }
+
         #[test]
         fn symmetric_and_invariant_to_full_turns(v in proptest::array::uniform7(-3.0f32..3.0), w in proptest::array::uniform7(-3.0f32..3.0)) {
             let a = Shape::from_slice(4, &v).unwrap();

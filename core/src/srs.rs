@@ -16,7 +16,7 @@ use core::f32::consts::PI;
 use rand_core::{RngCore, SeedableRng};
 use rand_pcg::Pcg32;
 
-use crate::cost::transition_cost_sq;
+use crate::cost::transition_cost_sq_within;
 use crate::lsc::LIMIT_MARGIN;
 use crate::params::ChainParams;
 use crate::shape::Shape;
@@ -150,43 +150,76 @@ impl Sampler {
 /// Fills `adjacency[i]` with the roadmap neighbours of `shapes[i]`: up to `DEG`
 /// nearest shapes within `r_s` (in `C_T`) whose straight transition is valid, with
 /// [`LIMIT_MARGIN`] of slack. Edges are symmetric; a vertex whose list is full
-/// takes no more. Quadratic in the number of shapes, which is fine offline.
+/// takes no more. Quadratic in the number of shapes; the host finds the same
+/// candidates faster with an index ([`nearest_later`] on fewer shapes, then
+/// [`connect`]).
 pub fn build_roadmap<const DEG: usize>(
     params: &ChainParams,
     shapes: &[Shape],
     r_s: f32,
     adjacency: &mut [Neighbours<DEG>],
 ) {
-    let r2 = r_s * r_s;
     for a in adjacency.iter_mut() {
         a.clear();
     }
     for i in 0..shapes.len() {
-        // The DEG nearest candidates of i among later shapes, nearest first.
-        let mut near: heapless::Vec<(f32, u16), DEG> = heapless::Vec::new();
-        for j in i + 1..shapes.len() {
-            let d = transition_cost_sq(&shapes[i], &shapes[j]);
-            if d > r2 {
+        let near = nearest_later::<DEG>(shapes, i, r_s, i + 1..shapes.len());
+        connect(params, shapes, i, &near, adjacency);
+    }
+}
+
+/// Roadmap candidates of `shapes[i]`: the `DEG` nearest of `later` (indices above
+/// `i`, ascending) within `r_s` in `C_T`, nearest first, as `(C_T^2, index)`; of
+/// equally near shapes the lower index. `later` may skip shapes that are provably
+/// farther than `r_s`: the result is the same.
+pub fn nearest_later<const DEG: usize>(
+    shapes: &[Shape],
+    i: usize,
+    r_s: f32,
+    later: impl Iterator<Item = usize>,
+) -> heapless::Vec<(f32, u16), DEG> {
+    let r2 = r_s * r_s;
+    let mut near: heapless::Vec<(f32, u16), DEG> = heapless::Vec::new();
+    for j in later {
+        // Only a shape nearer than the farthest kept one can enter: stop summing
+        // its cost as soon as it cannot (the same costs, far fewer terms).
+        let bound = match near.last() {
+            Some(&(last, _)) if near.is_full() => last.min(r2),
+            _ => r2,
+        };
+        let Some(d) = transition_cost_sq_within(&shapes[i], &shapes[j], bound) else {
+            continue;
+        };
+        if near.is_full() {
+            if d >= near[DEG - 1].0 {
                 continue;
             }
-            if near.is_full() {
-                if d >= near[DEG - 1].0 {
-                    continue;
-                }
-                near.pop();
-            }
-            let at = near.iter().position(|&(e, _)| e > d).unwrap_or(near.len());
-            let _ = near.insert(at, (d, j as u16));
+            near.pop();
         }
-        for &(_, j) in near.iter() {
-            let j = j as usize;
-            if adjacency[i].is_full() || adjacency[j].is_full() {
-                continue;
-            }
-            if check_transition(params, &shapes[i], &shapes[j], LIMIT_MARGIN).is_ok() {
-                let _ = adjacency[i].push(j as u16);
-                let _ = adjacency[j].push(i as u16);
-            }
+        let at = near.iter().position(|&(e, _)| e > d).unwrap_or(near.len());
+        let _ = near.insert(at, (d, j as u16));
+    }
+    near
+}
+
+/// Joins `shapes[i]` to its candidates `near` (from [`nearest_later`]), nearest
+/// first, where both lists have room and the straight transition is valid. Called
+/// for `i` in ascending order, it builds the roadmap of [`build_roadmap`].
+pub fn connect<const DEG: usize>(
+    params: &ChainParams,
+    shapes: &[Shape],
+    i: usize,
+    near: &[(f32, u16)],
+    adjacency: &mut [Neighbours<DEG>],
+) {
+    for &(_, j) in near.iter() {
+        let j = j as usize;
+        if adjacency[i].is_full() || adjacency[j].is_full() {
+            continue;
+        }
+        if check_transition(params, &shapes[i], &shapes[j], LIMIT_MARGIN).is_ok() {
+            let _ = adjacency[i].push(j as u16);
+            let _ = adjacency[j].push(i as u16);
         }
     }
 }

@@ -46,7 +46,15 @@ pub enum Violation {
     Bend(u8),
     /// Two bodies that share no joint touch or intersect.
     SelfCollision(Body, Body),
+    /// A transition needs steps too small to make progress, or more than
+    /// [`MAX_TRANSITION_STEPS`] of them: it is rejected (conservatively) rather than
+    /// checked for ever.
+    TooManySteps,
 }
+
+/// Most samples [`check_transition`] takes before it gives up and rejects the
+/// transition: every loop of the core must end, on the autopilot too.
+pub const MAX_TRANSITION_STEPS: u32 = 1 << 20;
 
 impl core::fmt::Display for Violation {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -59,6 +67,10 @@ impl core::fmt::Display for Violation {
                 k + 2
             ),
             Violation::SelfCollision(a, b) => write!(f, "{a} touches {b}"),
+            Violation::TooManySteps => write!(
+                f,
+                "the transition needs more than {MAX_TRANSITION_STEPS} checked steps"
+            ),
         }
     }
 }
@@ -224,14 +236,22 @@ pub fn check_transition(
     }
     let margin = margin.max(1e-5);
     let mut t = 0.0f32;
-    loop {
+    for _ in 0..MAX_TRANSITION_STEPS {
         let s = if t >= 1.0 { *b } else { a.lerp(b, t) };
         let dt = safe_step(params, &s, &rate, &prefix, margin)?;
         if t >= 1.0 {
             return Ok(());
         }
-        t = (t + dt).min(1.0);
+        t = advance(t, dt).ok_or(Violation::TooManySteps)?;
     }
+    Err(Violation::TooManySteps)
+}
+
+/// `t + dt` capped at 1, or `None` when the step is lost in the rounding of `t` (a
+/// loop on it would never end).
+fn advance(t: f32, dt: f32) -> Option<f32> {
+    let next = (t + dt).min(1.0);
+    (next > t).then_some(next)
 }
 
 /// At shape `s`, the largest parameter step that provably keeps every gap and bend
@@ -346,6 +366,31 @@ mod tests {
             check_shape(&p, &s),
             Err(Violation::SelfCollision(_, _))
         ));
+    }
+
+    #[test]
+    fn a_step_lost_in_rounding_ends_the_walk() {
+        assert_eq!(advance(0.5, 0.25), Some(0.75));
+        assert_eq!(advance(0.9, 0.5), Some(1.0));
+        // Below half an ulp of 0.5: t + dt == t.
+        assert_eq!(advance(0.5, 1e-9), None);
+    }
+
+    #[test]
+    fn a_transition_of_a_huge_chain_ends() {
+        // l = 1e4 m: the safe step falls below the rounding of t; it used to loop for
+        // ever, now it ends (valid or conservatively rejected).
+        let p = ChainParams {
+            link_length: 1e4,
+            ..ChainParams::new(5)
+        };
+        let a = Shape::line(5, 0.0);
+        let mut b = a;
+        for k in 0..4 {
+            b.set_link(k, 0.0, deg(30.0) * (k % 2) as f32);
+        }
+        let r = check_transition(&p, &a, &b, 0.0);
+        assert!(matches!(r, Ok(()) | Err(Violation::TooManySteps)), "{r:?}");
     }
 
     #[test]

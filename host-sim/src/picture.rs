@@ -436,24 +436,51 @@ impl Figure {
 
     /// Writes the figure atomically: SVG, or PNG when the path ends in `.png`.
     pub fn save(&self, path: &Path) -> Result<(), String> {
-        let svg = self.to_svg();
-        let bytes = match path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .as_deref()
-        {
-            Some("svg") => svg.into_bytes(),
-            Some("png") => rasterise(&svg)?,
-            _ => {
-                return Err(format!(
-                    "{}: picture must end in .svg or .png",
-                    path.display()
-                ))
-            }
-        };
-        crate::fsutil::write_atomic(path, &bytes).map_err(|e| format!("{}: {e}", path.display()))
+        save_svg(&self.to_svg(), path)
     }
+}
+
+/// The formats a picture can be written in, by the output's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PictureFormat {
+    /// Scalable vector graphics.
+    Svg,
+    /// A raster image, rendered from the SVG.
+    Png,
+}
+
+impl PictureFormat {
+    /// Every supported format and its extension; a new format is one more row.
+    const ALL: [(&'static str, PictureFormat); 2] =
+        [("svg", PictureFormat::Svg), ("png", PictureFormat::Png)];
+
+    /// The format of `path` by its extension (any case).
+    pub fn of(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Self::ALL.iter().find(|(e, _)| *e == ext).map(|&(_, f)| f)
+    }
+
+    /// The supported extensions, for messages: `.svg or .png`.
+    pub fn extensions() -> String {
+        let names: Vec<String> = Self::ALL.iter().map(|(e, _)| format!(".{e}")).collect();
+        names.join(" or ")
+    }
+}
+
+/// Writes `svg` to `path` in the format its extension names, atomically.
+pub fn save_svg(svg: &str, path: &Path) -> Result<(), String> {
+    let bytes = match PictureFormat::of(path) {
+        Some(PictureFormat::Svg) => svg.as_bytes().to_vec(),
+        Some(PictureFormat::Png) => rasterise(svg)?,
+        None => {
+            return Err(format!(
+                "{}: a picture must end in {}",
+                path.display(),
+                PictureFormat::extensions()
+            ))
+        }
+    };
+    crate::fsutil::write_atomic(path, &bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// SVG text to PNG bytes.

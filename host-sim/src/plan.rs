@@ -295,12 +295,19 @@ impl Plan {
             path: name.clone(),
             source,
         })?;
-        let plan: Plan = serde_json::from_str(&text).map_err(|source| PlanError::Json {
-            path: name.clone(),
+        Self::parse(&text, &name)
+    }
+
+    /// Parses and checks a plan's text (as [`Self::read`]); `name` names it in errors.
+    pub fn parse(text: &str, name: &str) -> Result<Self, PlanError> {
+        let plan: Plan = serde_json::from_str(text).map_err(|source| PlanError::Json {
+            path: name.to_string(),
             source,
         })?;
-        plan.check()
-            .map_err(|what| PlanError::Invalid { path: name, what })?;
+        plan.check().map_err(|what| PlanError::Invalid {
+            path: name.to_string(),
+            what,
+        })?;
         Ok(plan)
     }
 

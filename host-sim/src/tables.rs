@@ -5,11 +5,13 @@
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use arc_core::lsc::LIMIT_MARGIN;
 use arc_core::lsc::{library, LscEntry, LscKind};
-use arc_core::srs::{build_roadmap, Neighbours, Sampler, SrsError, SrsSettings};
+use arc_core::srs::{nearest_later, Neighbours, Sampler, SrsError, SrsSettings};
 use arc_core::table::{encode_into, TableError, TableView};
-use arc_core::validity::Violation;
+use arc_core::validity::{check_transition, Violation};
 use arc_core::{ChainParams, Shape};
+use rayon::prelude::*;
 
 /// Roadmap degree the host builds `G_SRS` with.
 pub const DEGREE: usize = 12;
@@ -74,6 +76,76 @@ pub enum TablesError {
     },
 }
 
+/// `G_SRS` as the core's `build_roadmap` makes it, bit for bit, without comparing
+/// every pair: `C_T^2 >= N dpsi1_r^2`, so only shapes whose head yaw lies within
+/// `r_s / sqrt(N)` of a shape's can be its neighbours. Shapes are sorted by head yaw,
+/// each one's candidates are found in its window (in parallel: they are independent),
+/// then joined in order as the core's `connect` does.
+fn indexed_roadmap(params: &ChainParams, shapes: &[Shape], r_s: f32) -> Vec<Neighbours<DEGREE>> {
+    let n = params.units as f32;
+    // A little wider than the bound, for rounding in the core's angle differences.
+    let w = (r_s * r_s / n).sqrt() * (1.0 + 1e-4) + 1e-5;
+    let mut by_yaw: Vec<(f32, usize)> = shapes
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (arc_core::angle::wrap(s.head_yaw()), i))
+        .collect();
+    by_yaw.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let yaws: Vec<f32> = by_yaw.iter().map(|p| p.0).collect();
+    let window = |y: f32| -> Vec<(f32, f32)> {
+        use std::f32::consts::{PI, TAU};
+        if w >= PI {
+            return vec![(f32::NEG_INFINITY, f32::INFINITY)];
+        }
+        let mut v = vec![(y - w, y + w)];
+        if y - w < -PI {
+            v.push((y - w + TAU, f32::INFINITY));
+        }
+        if y + w > PI {
+            v.push((f32::NEG_INFINITY, y + w - TAU));
+        }
+        v
+    };
+    let near: Vec<_> = (0..shapes.len())
+        .into_par_iter()
+        .map(|i| {
+            let mut later: Vec<usize> = Vec::new();
+            for (lo, hi) in window(arc_core::angle::wrap(shapes[i].head_yaw())) {
+                let a = yaws.partition_point(|&y| y < lo);
+                let b = yaws.partition_point(|&y| y <= hi);
+                later.extend(by_yaw[a..b].iter().map(|p| p.1).filter(|&j| j > i));
+            }
+            later.sort_unstable();
+            later.dedup();
+            nearest_later::<DEGREE>(shapes, i, r_s, later.into_iter())
+        })
+        .collect();
+    // The transition checks dominate and do not depend on the order: run them in
+    // parallel, then join in order exactly as the core's `connect` does.
+    let valid: Vec<Vec<bool>> = near
+        .par_iter()
+        .enumerate()
+        .map(|(i, near)| {
+            near.iter()
+                .map(|&(_, j)| {
+                    check_transition(params, &shapes[i], &shapes[j as usize], LIMIT_MARGIN).is_ok()
+                })
+                .collect()
+        })
+        .collect();
+    let mut adj = vec![Neighbours::<DEGREE>::new(); shapes.len()];
+    for (i, (near, valid)) in near.iter().zip(&valid).enumerate() {
+        for (&(_, j), &ok) in near.iter().zip(valid) {
+            let j = j as usize;
+            if ok && !adj[i].is_full() && !adj[j].is_full() {
+                let _ = adj[i].push(j as u16);
+                let _ = adj[j].push(i as u16);
+            }
+        }
+    }
+    adj
+}
+
 impl ShapeTables {
     /// Builds the library and an SRS with its roadmap. `progress` is told how many
     /// random shapes have been sampled so far (it may be read from another thread).
@@ -93,13 +165,7 @@ impl ShapeTables {
             srs.push(sampler.next_shape().map_err(TablesError::Srs)?);
             progress.store(i + 1, Ordering::Relaxed);
         }
-        let mut adj = vec![Neighbours::<DEGREE>::new(); srs.len()];
-        build_roadmap(
-            &params,
-            &srs,
-            settings.r_s.unwrap_or(defaults.r_s),
-            &mut adj,
-        );
+        let adj = indexed_roadmap(&params, &srs, settings.r_s.unwrap_or(defaults.r_s));
         Ok(Self {
             params,
             lsc: lib.entries.to_vec(),
@@ -200,6 +266,23 @@ impl ShapeTables {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_indexed_roadmap_is_the_cores_bit_for_bit() {
+        // Small N (narrow yaw windows, with wrap-around) and a larger one (windows
+        // covering the circle), default and wide radii.
+        for (units, count, r_s) in [(3u8, 900, None), (3, 400, Some(1.2)), (6, 300, None)] {
+            let p = ChainParams::new(units);
+            let mut sampler = Sampler::new(p, 7, 100_000);
+            let shapes: Vec<Shape> = (0..count).map(|_| sampler.next_shape().unwrap()).collect();
+            let r_s = r_s.unwrap_or(SrsSettings::new(units, count, 7).r_s);
+            let mut core = vec![Neighbours::<DEGREE>::new(); count];
+            arc_core::srs::build_roadmap(&p, &shapes, r_s, &mut core);
+            let host = indexed_roadmap(&p, &shapes, r_s);
+            assert_eq!(host, core, "N = {units}");
+            assert!(core.iter().map(|a| a.len()).sum::<usize>() > count);
+        }
+    }
 
     #[test]
     fn build_encode_decode_round_trip() {

@@ -358,6 +358,10 @@ impl FullStatePrm {
         let k = s.k.unwrap_or_else(|| prm_star_k(n, params.shape_dim() + 3));
         let mut pairs: Vec<Vec<(u32, f64)>> = vec![Vec::new(); n];
         for i in 0..n {
+            if out_of_time(i as u64) {
+                capped = true;
+                break; // later vertices keep only the edges found so far
+            }
             for (j, d) in index.nearest(index.point(i), k + 1) {
                 if j as usize != i {
                     pairs[i].push((j, d));
@@ -417,6 +421,8 @@ impl FullStatePrm {
                 "the head's sphere (radius + clearance) does not fit at {goal:?}"
             )));
         }
+        // One time limit for the roadmap and the query together (docs/promises.md).
+        let solve_began = Instant::now();
         self.setup(goal, stop.time_limit);
         let began = Instant::now();
         let before = self.ctx.stats();
@@ -426,7 +432,7 @@ impl FullStatePrm {
         let result = Query {
             ctx: &self.ctx,
             graph: &mut graph,
-            began,
+            began: solve_began,
             stop,
             collision: Duration::ZERO,
             stats: PrmStats::default(),

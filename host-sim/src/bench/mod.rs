@@ -453,7 +453,10 @@ pub fn run_one(envs: &Envs, spec: &RunSpec) -> RunResult {
         },
     };
     let stop = Termination {
-        time_limit: spec.time_limit.map(Duration::from_secs_f64),
+        // Checked by the command line; a limit no Duration holds is no limit.
+        time_limit: spec
+            .time_limit
+            .and_then(|t| Duration::try_from_secs_f64(t).ok()),
     };
     match spec.method {
         Method::Arc(mode) => run_arc(env, ctx, spec, mode, query, stop),

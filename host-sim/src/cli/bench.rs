@@ -5,6 +5,7 @@ use std::time::{Duration, Instant};
 
 use clap::{Args, Subcommand};
 
+use super::checks;
 use super::common::{ChainArgs, MapArgs, Query, QueryArgs, Report};
 use super::{CliError, CliResult};
 use crate::baseline::{self, FullStatePrm, PrmError, PrmSettings};
@@ -128,25 +129,48 @@ pub struct PrmArgs {
     out: PathBuf,
 }
 
+/// Most seeds per configuration of a study: every run is held in memory.
+const MAX_SEEDS: u64 = 100_000;
+
+/// Most worker threads of a study.
+const MAX_THREADS: usize = 1024;
+
 fn check_study(a: &StudyArgs) -> Result<(), CliError> {
-    if a.seeds == Some(0) {
-        return Err(CliError::input("--seeds 0: must be at least 1"));
-    }
-    if let Some(t) = a.time_limit {
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(CliError::input(format!(
-                "--time-limit {t}: must be a number of seconds >= 0"
-            )));
+    if let Some(s) = a.seeds {
+        if !(1..=MAX_SEEDS).contains(&s) {
+            return Err(checks::bad(
+                "--seeds",
+                s,
+                &format!("between 1 and {MAX_SEEDS} (every run is kept in memory)"),
+            ));
         }
     }
-    if a.threads == Some(0) {
-        return Err(CliError::input("--threads 0: must be at least 1"));
+    if let Some(t) = a.time_limit {
+        // 0 means none here.
+        if t != 0.0 {
+            checks::time_limit(Some(t))?;
+        }
     }
-    if a.vertices == Some(0) {
-        return Err(CliError::input("--vertices 0: must be at least 1"));
+    if let Some(t) = a.threads {
+        checks::count("--threads", t, 1, MAX_THREADS, "worker threads")?;
     }
-    if a.srs.is_some_and(|s| s > u16::MAX as usize) {
-        return Err(CliError::input("--srs: must be at most 65535"));
+    if let Some(v) = a.vertices {
+        checks::count(
+            "--vertices",
+            v,
+            1,
+            checks::MAX_HEAD_VERTICES >> 3,
+            "a run's roadmap may grow to 8 times this",
+        )?;
+    }
+    if let Some(s) = a.srs {
+        checks::count(
+            "--srs",
+            s,
+            0,
+            u16::MAX as usize,
+            "the table's index is 16 bits",
+        )?;
     }
     Ok(())
 }
@@ -229,10 +253,14 @@ fn run_paper(a: PaperArgs) -> CliResult {
             "--tables {t}: tables are 1, 2 and 3"
         )));
     }
-    if o.prm_vertices.contains(&0) {
-        return Err(CliError::input(
-            "--prm-vertices: every budget must be at least 1",
-        ));
+    for &v in &o.prm_vertices {
+        checks::count(
+            "--prm-vertices",
+            v,
+            1,
+            checks::MAX_PRM_VERTICES,
+            "each holds a full configuration and its edges",
+        )?;
     }
     if let Some(n) = o.prm_units.iter().find(|n| !(2..=16).contains(*n)) {
         return Err(CliError::input(format!(
@@ -298,10 +326,16 @@ fn run_scale(a: ScaleArgs) -> CliResult {
         )));
     }
     if let Some(d) = o.corridor_vertices_per_m {
-        if !(d.is_finite() && d > 0.0) {
-            return Err(CliError::input(format!(
-                "--corridor-density {d}: must be a positive number (or 0 for --vertices)"
-            )));
+        // The longest corridor is 100 m.
+        let most = (checks::MAX_HEAD_VERTICES >> 3) as f64 / 100.0;
+        if !(d.is_finite() && d > 0.0 && d <= most) {
+            return Err(checks::bad(
+                "--corridor-density",
+                d,
+                &format!(
+                    "a positive number of vertices per metre up to {most} (or 0 for --vertices)"
+                ),
+            ));
         }
     }
     let (specs, starts) = scale::specs(&o).map_err(CliError::input)?;
@@ -341,20 +375,34 @@ fn run_scale(a: ScaleArgs) -> CliResult {
     Ok(())
 }
 
+/// Checks every option of `arc bench prm` before any work (docs/promises.md).
+fn check_prm(a: &PrmArgs) -> Result<Option<Duration>, CliError> {
+    checks::length("--clearance", a.clearance, false)?;
+    checks::length("--goal-tol", a.goal_tol, false)?;
+    checks::count(
+        "--vertices",
+        a.vertices,
+        1,
+        checks::MAX_PRM_VERTICES,
+        "each holds a full configuration and its edges",
+    )?;
+    if let Some(k) = a.k {
+        checks::count("--k", k, 1, checks::MAX_NEIGHBOURS, "edges per vertex")?;
+    }
+    if let Some(g) = a.goal_samples {
+        checks::count(
+            "--goal-samples",
+            g,
+            1,
+            a.vertices,
+            "part of the --vertices budget",
+        )?;
+    }
+    checks::time_limit(a.time_limit)
+}
+
 fn run_prm(a: PrmArgs) -> CliResult {
-    if let Some(t) = a.time_limit {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(CliError::input(format!(
-                "--time-limit {t}: must be a positive number of seconds"
-            )));
-        }
-    }
-    if !(a.clearance.is_finite() && a.clearance >= 0.0) {
-        return Err(CliError::input(format!(
-            "--clearance {}: must be a number >= 0",
-            a.clearance
-        )));
-    }
+    let time_limit = check_prm(&a)?;
     let loaded = a.map.load()?;
     let Query {
         params,
@@ -374,9 +422,7 @@ fn run_prm(a: PrmArgs) -> CliResult {
         goal_tol: a.goal_tol,
     };
     let mut prm = FullStatePrm::new(ctx, settings).map_err(|e| CliError::input(e.to_string()))?;
-    let stop = Termination {
-        time_limit: a.time_limit.map(Duration::from_secs_f64),
-    };
+    let stop = Termination { time_limit };
     let sol = prm.solve(start, shape, goal, stop).map_err(|e| match e {
         PrmError::BadSettings(_) | PrmError::StartInvalid(_) | PrmError::GoalInvalid(_) => {
             CliError::input(e.to_string())
@@ -428,9 +474,12 @@ fn run_prm(a: PrmArgs) -> CliResult {
         lines.line(format_args!("  exact verification: ok"));
         Ok(())
     } else {
+        let why = report
+            .violation
+            .as_ref()
+            .map_or_else(|| "a problem".to_string(), |v| v.to_string());
         Err(CliError::failed(format!(
-            "the plan fails exact verification: {:?}",
-            report.violation
+            "the plan fails exact verification: {why}"
         )))
     }
 }

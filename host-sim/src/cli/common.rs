@@ -4,10 +4,11 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use arc_core::lsc::{library, LscKind};
+use arc_core::params::ParamError;
 use arc_core::{ChainParams, Shape};
 use clap::Args;
 
-use super::CliError;
+use super::{checks, CliError};
 use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 use crate::map::octomap::OcTree;
@@ -41,6 +42,17 @@ impl ChainArgs {
     /// Validated chain parameters, with `default_units` when `--units` is absent.
     pub fn params(&self, default_units: u8) -> Result<arc_core::ChainParams, CliError> {
         let units = self.units.unwrap_or(default_units);
+        if self.link_length.is_nan() || self.link_length > checks::MAX_LINK_LENGTH_M {
+            return Err(checks::bad(
+                "--link-length",
+                self.link_length,
+                &format!(
+                    "a positive length up to {} m (the core's f32 geometry keeps \
+                     sub-millimetre precision up to there)",
+                    checks::MAX_LINK_LENGTH_M
+                ),
+            ));
+        }
         arc_core::ChainParams {
             units,
             link_length: self.link_length,
@@ -50,7 +62,39 @@ impl ChainArgs {
             beta_max: arc_core::angle::deg(self.beta_max_deg),
         }
         .validate()
-        .map_err(|e| CliError::input(format!("chain parameters (--units {units}, ...): {e}")))
+        .map_err(|e| self.param_error(units, e))
+    }
+
+    /// The flag behind a chain parameter the core refused, its value and its limit.
+    fn param_error(&self, units: u8, e: ParamError) -> CliError {
+        match e {
+            ParamError::UnitsOutOfRange => checks::bad("--units", units, "between 2 and 16"),
+            ParamError::LinkLength => {
+                checks::bad("--link-length", self.link_length, "a positive length (m)")
+            }
+            ParamError::UnitRadius => {
+                checks::bad("--unit-radius", self.unit_radius, "a positive length (m)")
+            }
+            ParamError::LinkRadius => checks::bad(
+                "--link-radius",
+                self.link_radius,
+                &format!("positive and below --unit-radius {}", self.unit_radius),
+            ),
+            ParamError::UnitsOverlap => checks::bad(
+                "--unit-radius",
+                self.unit_radius,
+                &format!(
+                    "below half of --link-length {} (neighbouring units would overlap)",
+                    self.link_length
+                ),
+            ),
+            ParamError::ThetaMax => {
+                checks::bad("--theta-max-deg", self.theta_max_deg, "in (0, 90) degrees")
+            }
+            ParamError::BetaMax => {
+                checks::bad("--beta-max-deg", self.beta_max_deg, "in (0, 180] degrees")
+            }
+        }
     }
 }
 
@@ -70,6 +114,18 @@ pub struct MapArgs {
     /// Treat unknown space as free (the default treats it as occupied).
     #[arg(long)]
     pub unknown_free: bool,
+}
+
+/// Why a plan cannot be trusted under the user's assumptions: it was made with
+/// unknown space free, and the user did not say `--unknown-free`. The checker's
+/// assumptions come from the person running it, never from the file under test.
+pub fn looser_assumption(plan: &crate::plan::Plan, map: &MapArgs) -> Option<String> {
+    (!plan.map.unknown_is_occupied && !map.unknown_free).then(|| {
+        "the plan was made with unknown space free (map.unknown_is_occupied: false), \
+         but it is checked with unknown space occupied; give --unknown-free to check it \
+         under the plan's assumption"
+            .to_string()
+    })
 }
 
 /// A loaded map, and the scenario it came from if any.
@@ -201,6 +257,16 @@ impl QueryArgs {
             .goal
             .or(sc.map(|s| s.goal))
             .ok_or_else(|| CliError::input("--goal is required with --map"))?;
+        if let Some(d) = self.start_yaw_deg {
+            // The shape holds angles as f32.
+            if !(d.to_radians() as f32).is_finite() {
+                return Err(checks::bad(
+                    "--start-yaw-deg",
+                    d,
+                    "a finite angle (degrees)",
+                ));
+            }
+        }
         let yaw = self
             .start_yaw_deg
             .map(f64::to_radians)

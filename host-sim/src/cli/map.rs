@@ -196,17 +196,7 @@ fn info(a: InfoArgs) -> CliResult {
 }
 
 fn picture(a: PictureArgs) -> CliResult {
-    let ext = a
-        .out
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    if !matches!(ext.as_deref(), Some("svg") | Some("png")) {
-        return Err(CliError::input(format!(
-            "--out {}: a picture must end in .svg or .png",
-            a.out.display()
-        )));
-    }
+    super::checks::picture("--out", &a.out)?;
     let (grid, sc, title) = match (&a.file, &a.scenario) {
         (Some(f), None) => {
             let tree = read_tree(f)?;
@@ -230,16 +220,23 @@ fn picture(a: PictureArgs) -> CliResult {
             let h = hi[2] - lo[2];
             let b0 = b0.unwrap_or(lo[2] + 0.25 * h);
             let b1 = b1.unwrap_or(hi[2] - 0.25 * h);
-            if !(b0.is_finite() && b1.is_finite() && b0 <= b1) {
-                return Err(CliError::input(format!(
-                    "--band-min {b0} must not be above --band-max {b1}"
-                )));
+            for (flag, v) in [("--band-min", b0), ("--band-max", b1)] {
+                if !v.is_finite() {
+                    return Err(super::checks::bad(flag, v, "a finite height (m)"));
+                }
+            }
+            if b0 > b1 {
+                return Err(super::checks::bad(
+                    "--band-min",
+                    b0,
+                    &format!("at most --band-max {b1}"),
+                ));
             }
             Some((b0, b1))
         }
     };
     if let Some(z) = a.slices.iter().find(|z| !z.is_finite()) {
-        return Err(CliError::input(format!("--slices: {z} is not a height")));
+        return Err(super::checks::bad("--slices", z, "finite heights (m)"));
     }
     let opts = MapPictureOptions {
         band,

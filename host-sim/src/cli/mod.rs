@@ -1,14 +1,15 @@
 //! The `arc` command line: one module per subcommand, each with its clap `Args` and a
-//! `run` function. Exit codes: 0 success, 1 the job found no solution (no plan, a
-//! failed verification or flight), 2 bad input (arguments, files).
+//! `run` function. Every subcommand ends with a code of [`exit`], the one exit-code
+//! table (docs/promises.md).
 
 use std::ffi::OsString;
 use std::fmt;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod bench;
+pub mod checks;
 pub mod common;
 mod map;
 mod plan;
@@ -16,10 +17,23 @@ mod sim;
 mod tables;
 mod verify;
 
+/// The exit-code table of every subcommand, the one place that defines it
+/// (docs/promises.md repeats it for users).
+pub mod exit {
+    /// The job is done: a plan written, a plan verified, a flight that arrived.
+    pub const DONE: u8 = 0;
+    /// The job ran and the answer is no: no plan found, an invalid plan, a flight
+    /// with contact or that did not arrive, a failed exact check.
+    pub const FAILED: u8 = 1;
+    /// Bad input: an argument out of its limits, an unreadable or malformed file, a
+    /// start or goal that cannot be used, an output that cannot be written.
+    pub const BAD_INPUT: u8 = 2;
+}
+
 /// What went wrong, and which exit code it earns.
 #[derive(Debug)]
 pub struct CliError {
-    /// 1: no solution; 2: bad input.
+    /// A code of [`exit`]: [`exit::FAILED`] or [`exit::BAD_INPUT`].
     pub code: u8,
     /// One line naming the problem (file, field, value).
     pub message: String,
@@ -29,14 +43,14 @@ impl CliError {
     /// Bad input: exit code 2.
     pub fn input(message: impl Into<String>) -> Self {
         Self {
-            code: 2,
+            code: exit::BAD_INPUT,
             message: message.into(),
         }
     }
     /// The job ran but found no solution: exit code 1.
     pub fn failed(message: impl Into<String>) -> Self {
         Self {
-            code: 1,
+            code: exit::FAILED,
             message: message.into(),
         }
     }
@@ -93,29 +107,58 @@ enum Command {
     Sim(sim::SimArgs),
 }
 
+/// The command line, where every option that takes a value takes a negative number
+/// too: `--seed -1` is then refused by its own check, which names the flag, instead
+/// of being read as an unknown option `-1`.
+fn command() -> clap::Command {
+    fn negatives(c: clap::Command) -> clap::Command {
+        c.mut_args(|a| {
+            if a.get_action().takes_values() {
+                a.allow_negative_numbers(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
+}
+
 /// Parses `args` (including the program name) and runs the command.
 pub fn run<I, T>(args: I) -> CliResult
 where
     I: IntoIterator<Item = T>,
     T: Into<OsString> + Clone,
 {
-    let cli = Cli::try_parse_from(args).map_err(|e| {
-        // --help and --version are not errors.
-        if matches!(
-            e.kind(),
-            clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion
-        ) {
-            let _ = e.print();
-            return CliError {
-                code: 0,
-                message: String::new(),
-            };
-        }
-        CliError::input(e.render().to_string().trim_end().to_string())
-    });
+    let cli = command()
+        .try_get_matches_from(args)
+        .and_then(|m| Cli::from_arg_matches(&m))
+        .map_err(|e| {
+            // --help and --version are not errors.
+            if matches!(
+                e.kind(),
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion
+            ) {
+                let _ = e.print();
+                return CliError {
+                    code: exit::DONE,
+                    message: String::new(),
+                };
+            }
+            // One line: clap's first paragraph ("error: invalid value '-1' for '--seed
+            // <SEED>': ..."), joined, without the usage and help after it.
+            let text = e.render().to_string();
+            let first: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .skip_while(|l| l.is_empty())
+                .take_while(|l| !l.is_empty())
+                .collect();
+            CliError::input(first.join(" ").trim_start_matches("error: ").to_string())
+        });
     let cli = match cli {
         Ok(c) => c,
-        Err(e) if e.code == 0 => return Ok(()),
+        Err(e) if e.code == exit::DONE => return Ok(()),
         Err(e) => return Err(e),
     };
     match cli.command {
@@ -129,8 +172,21 @@ where
     }
 }
 
+/// Restores the default action of SIGPIPE, which Rust's runtime ignores: with it
+/// ignored, a write to a closed pipe (`arc tables inspect T | head -1`) fails and
+/// `println!` panics. With the default, `arc` ends quietly, as `cat` does.
+fn quiet_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to SIG_DFL has no preconditions, and no
+    // other thread exists yet.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 /// Entry point of the `arc` binary.
 pub fn main() -> ExitCode {
+    quiet_on_closed_pipe();
     match run(std::env::args_os()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -2,16 +2,17 @@
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicUsize;
-use std::time::Duration;
+use std::time::Instant;
 
 use arc_core::ChainParams;
 use clap::Args;
 
+use super::checks;
 use super::common::{ChainArgs, MapArgs, Query, QueryArgs, Report};
 use super::{CliError, CliResult};
 use crate::collision::{CollisionContext, DEFAULT_CLEARANCE};
 use crate::planner::refine::{Quality, Refinement};
-use crate::planner::{motion, Mode, Planner, Preference, Settings, Termination};
+use crate::planner::{motion, Mode, PlanError, Planner, Preference, Settings, Termination};
 use crate::tables::{ShapeTables, TableSettings};
 
 /// `arc plan`
@@ -90,68 +91,66 @@ pub struct PlanArgs {
     picture: Option<PathBuf>,
 }
 
-/// Checks the numeric options.
+/// Smallest follow-the-leader step (m) other than 0 (off).
+const MIN_FOLLOW_STEP: f64 = 1e-3;
+
+/// Checks every option before any work: numbers within their limits, sizes within
+/// their budgets (docs/promises.md), the picture's format.
 fn check(a: &PlanArgs) -> Result<(), CliError> {
-    let bad = |flag: &str, v: String, want: &str| {
-        Err(CliError::input(format!("{flag} {v}: must be {want}")))
-    };
-    if a.max_growth > 8 {
-        return bad(
-            "--max-growth",
-            a.max_growth.to_string(),
-            "at most 8 (256 times the vertices)",
-        );
+    checks::count("--max-growth", a.max_growth, 0, 8, "256 times the vertices")?;
+    checks::non_negative("--clearance-weight", a.clearance_weight)?;
+    checks::count(
+        "--max-neighbours",
+        a.max_neighbours,
+        1,
+        checks::MAX_NEIGHBOURS,
+        "edges per vertex",
+    )?;
+    let most = checks::MAX_HEAD_VERTICES >> a.max_growth;
+    checks::count(
+        "--vertices",
+        a.vertices,
+        1,
+        most,
+        &format!(
+            "--max-growth {} lets the roadmap grow to {} times this, and the budget is {} \
+             vertices",
+            a.max_growth,
+            1usize << a.max_growth,
+            checks::MAX_HEAD_VERTICES
+        ),
+    )?;
+    checks::length("--r-t", a.r_t, true)?;
+    checks::count("--n-psi", a.n_psi, 1, 360, "headings per shape")?;
+    if let Some(d) = a.d_c {
+        checks::positive("--d-c", d as f64)?;
     }
-    if !(a.clearance_weight.is_finite() && a.clearance_weight >= 0.0) {
-        return bad(
-            "--clearance-weight",
-            a.clearance_weight.to_string(),
-            "a number >= 0",
-        );
-    }
-    if a.max_neighbours == 0 {
-        return bad(
-            "--max-neighbours",
-            a.max_neighbours.to_string(),
-            "at least 1",
-        );
-    }
-    if a.vertices == 0 {
-        return bad("--vertices", a.vertices.to_string(), "at least 1");
-    }
-    if !(a.r_t.is_finite() && a.r_t > 0.0) {
-        return bad("--r-t", a.r_t.to_string(), "a positive number");
-    }
-    if a.n_psi == 0 || a.n_psi > 360 {
-        return bad("--n-psi", a.n_psi.to_string(), "between 1 and 360");
-    }
-    if a.d_c.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
-        return bad("--d-c", format!("{:?}", a.d_c), "a positive number");
-    }
-    if !(a.follow_step.is_finite() && (0.0..=1.0).contains(&a.follow_step)) {
-        return bad(
+    // A floor on the step bounds the steps of an edge (and the memory they take).
+    if !(a.follow_step == 0.0 || (MIN_FOLLOW_STEP..=1.0).contains(&a.follow_step)) {
+        return Err(checks::bad(
             "--follow-step",
-            a.follow_step.to_string(),
-            "between 0 (off) and 1 m",
-        );
+            a.follow_step,
+            &format!("0 (off) or between {MIN_FOLLOW_STEP} and 1 m"),
+        ));
     }
-    if !(a.goal_tol.is_finite() && a.goal_tol >= 0.0) {
-        return bad("--goal-tol", a.goal_tol.to_string(), "a number >= 0");
-    }
-    if !(a.clearance.is_finite() && a.clearance >= 0.0) {
-        return bad("--clearance", a.clearance.to_string(), "a number >= 0");
-    }
-    if a.time_limit.is_some_and(|t| !(t.is_finite() && t > 0.0)) {
-        return bad(
-            "--time-limit",
-            format!("{:?}", a.time_limit),
-            "a positive number of seconds",
-        );
-    }
-    if a.srs > u16::MAX as usize {
-        return bad("--srs", a.srs.to_string(), "at most 65535");
-    }
-    Ok(())
+    checks::length("--goal-tol", a.goal_tol, false)?;
+    checks::length("--clearance", a.clearance, false)?;
+    checks::count(
+        "--max-replans",
+        a.max_replans,
+        0,
+        checks::MAX_REPLANS,
+        "dropped edges per query",
+    )?;
+    checks::time_limit(a.time_limit)?;
+    checks::count(
+        "--srs",
+        a.srs,
+        0,
+        u16::MAX as usize,
+        "the table's index is 16 bits",
+    )?;
+    checks::optional_picture("--picture", a.picture.as_ref())
 }
 
 /// The tables: read from `--tables` (and checked against the chain) or generated.
@@ -191,6 +190,9 @@ pub fn load_tables(
 /// Runs `arc plan`.
 pub fn run(a: PlanArgs) -> CliResult {
     check(&a)?;
+    // Setup (map, distance field, shape tables) is timed apart: the time limit
+    // covers what follows it (docs/promises.md).
+    let setup = Instant::now();
     let loaded = a.map.load()?;
     let Query {
         params,
@@ -220,16 +222,28 @@ pub fn run(a: PlanArgs) -> CliResult {
     };
     let mut planner =
         Planner::new(ctx, tables, settings).map_err(|e| CliError::input(e.to_string()))?;
+    let setup_s = setup.elapsed().as_secs_f64();
     let stop = Termination {
-        time_limit: a.time_limit.map(Duration::from_secs_f64),
+        time_limit: checks::time_limit(a.time_limit)?,
     };
+    let began = Instant::now();
     let solution = planner
         .solve(start, shape, goal, stop)
-        .map_err(|e| CliError::failed(format!("no plan: {e}")))?;
+        .map_err(|e| match e {
+            // The query itself is unusable: bad input, as in `arc bench prm`.
+            PlanError::TablesMismatch { .. }
+            | PlanError::StartInvalid(_)
+            | PlanError::GoalInvalid(_) => CliError::input(e.to_string()),
+            _ => CliError::failed(format!(
+                "no plan: {e} (after {:.1} ms of planning; setup {:.1} ms)",
+                began.elapsed().as_secs_f64() * 1e3,
+                setup_s * 1e3
+            )),
+        })?;
     let (solution, refinement) = if a.no_smooth {
         (solution, None)
     } else {
-        let (refined, r) = planner.refine(&solution);
+        let (refined, r) = planner.refine(&solution, stop.deadline(began));
         (refined, Some(r))
     };
     let quality = Quality::of(&solution.steps);
@@ -256,7 +270,8 @@ pub fn run(a: PlanArgs) -> CliResult {
         s.replans
     ));
     report.line(format_args!(
-        "  roadmap {:.1} ms ({} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
+        "  setup {:.1} ms, roadmap {:.1} ms ({} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
+        setup_s * 1e3,
         s.roadmap_s * 1e3,
         s.roadmap_vertices,
         s.planning_s * 1e3,

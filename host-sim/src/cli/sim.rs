@@ -8,7 +8,8 @@ use std::time::Duration;
 use clap::Args;
 use serde::Serialize;
 
-use super::common::{MapArgs, Report};
+use super::checks;
+use super::common::{looser_assumption, MapArgs, Report};
 use super::{CliError, CliResult};
 use crate::plan::Plan;
 use crate::sim::clearance::{footprint, MapClearance};
@@ -28,7 +29,7 @@ pub struct SimArgs {
     /// standard output.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Write plots of the flight: SVG, or PNG when the name ends in .png.
+    /// Write plots of the flight (.svg or .png).
     #[arg(long)]
     picture: Option<PathBuf>,
     /// Physics and control rate (Hz, at least 500).
@@ -124,26 +125,41 @@ fn with_progress<T>(job: impl FnOnce(&Progress) -> T) -> T {
     })
 }
 
+/// Checks every option before any work (docs/promises.md); the flight's length
+/// against the memory budget is checked once the plan is timed.
+fn check(a: &SimArgs) -> Result<(), CliError> {
+    if !(a.rate.is_finite() && (500.0..=20_000.0).contains(&a.rate)) {
+        return Err(checks::bad("--rate", a.rate, "between 500 and 20000 Hz"));
+    }
+    checks::positive("--speed", a.speed)?;
+    checks::positive("--accel", a.accel)?;
+    checks::positive("--angular-rate-deg", a.angular_rate_deg)?;
+    checks::positive("--goal-tol", a.goal_tol)?;
+    checks::positive("--settle-time", a.settle_time)?;
+    if a.record_every == 0 {
+        return Err(checks::bad("--record-every", 0, "at least 1"));
+    }
+    checks::optional_picture("--picture", a.picture.as_ref())
+}
+
 /// Runs `arc sim`: exit 0 only when the chain reaches the plan's goal without touching
 /// the map or itself.
 pub fn run(a: SimArgs) -> CliResult {
+    check(&a)?;
     let plan = Plan::read(&a.plan).map_err(|e| CliError::input(e.to_string()))?;
     let plan_name = crate::fsutil::input_name(&a.plan);
     let params = plan
         .check()
         .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
-    let mut map = a.map.clone();
-    // Check the flight under what the plan assumed of unknown space.
-    map.unknown_free |= !plan.map.unknown_is_occupied;
-    let loaded = map.load()?;
+    // The flight is judged under the user's assumption about unknown space, never the
+    // plan's: a plan made with looser assumptions fails (docs/model.md).
+    let looser = looser_assumption(&plan, &a.map);
+    let loaded = a.map.load()?;
     let gusts = a
         .gust
         .iter()
         .map(|g| parse_gust(g))
         .collect::<Result<Vec<_>, _>>()?;
-    if a.record_every == 0 {
-        return Err(CliError::input("--record-every must be at least 1"));
-    }
     let mut cfg = SimConfig {
         rate: a.rate,
         goal_tolerance: a.goal_tol,
@@ -233,18 +249,11 @@ pub fn run(a: SimArgs) -> CliResult {
         let obs = footprint(&loaded.grid, lo - band, hi + band);
         let title = format!("arc sim: {plan_name} on {}", a.map.name());
         let svg = flight_svg(&flight, &obs, &title).map_err(CliError::failed)?;
-        let bytes = match path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .as_deref()
-        {
-            Some("png") => crate::picture::rasterise(&svg).map_err(CliError::failed)?,
-            _ => svg.into_bytes(),
-        };
-        crate::fsutil::write_atomic(path, &bytes)
-            .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+        crate::picture::save_svg(&svg, path).map_err(CliError::input)?;
         say(format_args!("  wrote {}", path.display()));
+    }
+    if let Some(why) = looser {
+        return Err(CliError::failed(format!("{plan_name}: {why}")));
     }
     if r.success() {
         return Ok(());

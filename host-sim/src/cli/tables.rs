@@ -9,6 +9,7 @@ use arc_core::lsc::library;
 use arc_core::table::TableView;
 use clap::{Args, Subcommand};
 
+use super::checks;
 use super::common::ChainArgs;
 use super::{CliError, CliResult};
 use crate::picture::{palette, Figure, Panel};
@@ -73,18 +74,15 @@ fn build(a: BuildArgs) -> CliResult {
             .units
             .ok_or_else(|| CliError::input("--units is required"))?,
     )?;
-    if a.srs > u16::MAX as usize {
-        return Err(CliError::input(format!(
-            "--srs {} exceeds the table limit of {}",
-            a.srs,
-            u16::MAX
-        )));
-    }
-    if a.r_s.is_some_and(|r| !(r.is_finite() && r > 0.0)) {
-        return Err(CliError::input(format!(
-            "--r-s {:?} must be a positive number",
-            a.r_s
-        )));
+    checks::count(
+        "--srs",
+        a.srs,
+        0,
+        u16::MAX as usize,
+        "the table's index is 16 bits",
+    )?;
+    if let Some(r) = a.r_s {
+        checks::positive("--r-s", r as f64)?;
     }
     let settings = TableSettings {
         srs: a.srs,
@@ -196,6 +194,7 @@ fn inspect(file: &std::path::Path) -> CliResult {
 
 /// Runs `arc shapes`: every LSC shape in top view (x-y) and side view (x-z).
 pub fn run_shapes(a: ShapesArgs) -> CliResult {
+    checks::picture("--out", &a.out)?;
     let params = a.chain.params(
         a.chain
             .units

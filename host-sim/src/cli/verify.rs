@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::common::{parse_point, MapArgs};
+use super::checks;
+use super::common::{looser_assumption, parse_point, MapArgs};
 use super::{CliError, CliResult};
 use crate::collision::verify_plan;
 use crate::plan::Plan;
@@ -28,6 +29,11 @@ pub struct VerifyArgs {
     goal_tol: f64,
 }
 
+/// A point for messages: `(x, y, z)`.
+fn point(p: [f64; 3]) -> String {
+    format!("({}, {}, {})", p[0], p[1], p[2])
+}
+
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
@@ -35,11 +41,12 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// Runs `arc verify`: exit 0 only when every waypoint and every sampled point of
 /// every edge is valid, and the plan starts and ends where asked.
 pub fn run(a: VerifyArgs) -> CliResult {
+    checks::length("--goal-tol", a.goal_tol, false)?;
     let plan = Plan::read(&a.plan).map_err(|e| CliError::input(e.to_string()))?;
-    let mut map = a.map.clone();
-    // The plan records what it assumed of unknown space; check it under that assumption.
-    map.unknown_free |= !plan.map.unknown_is_occupied;
-    let loaded = map.load()?;
+    // What unknown space is comes from the command line only, never from the plan
+    // under test (docs/model.md, Interpretations).
+    let looser = looser_assumption(&plan, &a.map);
+    let loaded = a.map.load()?;
     let sc = loaded.scenario.as_ref();
     let start = a.start.or(sc.map(|s| s.start));
     let goal = a.goal.or(sc.map(|s| s.goal));
@@ -73,20 +80,28 @@ pub fn run(a: VerifyArgs) -> CliResult {
     if let Some(v) = &report.violation {
         return Err(CliError::failed(format!("INVALID: {v}")));
     }
+    if let Some(why) = looser {
+        return Err(CliError::failed(format!("INVALID: {why}")));
+    }
     let first = plan.waypoints[0].xi();
     if let Some(s) = start {
         if dist(first, s) > 1e-6 {
             return Err(CliError::failed(format!(
-                "INVALID: waypoint 0 head {first:?} is not the start {s:?}"
+                "INVALID: waypoint 0 head {} is not the start {}",
+                point(first),
+                point(s)
             )));
         }
     }
     let last = plan.waypoints[plan.waypoints.len() - 1].xi();
     if let Some(g) = goal {
         let d = dist(last, g);
-        if d > a.goal_tol {
+        // A NaN distance fails too.
+        if d.is_nan() || d > a.goal_tol {
             return Err(CliError::failed(format!(
-                "INVALID: last head {last:?} is {d:.3} m from the goal {g:?} (tolerance {})",
+                "INVALID: last head {} is {d:.3} m from the goal {} (tolerance {} m)",
+                point(last),
+                point(g),
                 a.goal_tol
             )));
         }

@@ -249,6 +249,12 @@ pub struct ExactClearance {
     pub body: Body,
 }
 
+/// Contact within rounding (m): computed distances carry floating-point error of
+/// about 1e-15 m near the map, so a body whose computed distance to an obstacle is
+/// within this of its radius touches it (docs/model.md, Interpretations). It is far
+/// below any clearance a planner keeps, and far above rounding.
+pub const CONTACT_TOLERANCE: f64 = 1e-9;
+
 /// The exact validity test of one configuration (docs/model.md "Validity of one
 /// configuration"), in `f64` for positions; limits and self-collision use the core's
 /// `f32` checks on the shape rounded to `f32`. `horizon` (m) caps how far beyond a
@@ -298,7 +304,7 @@ pub fn check_config_exact(
     for (body, a, b, radius) in bodies {
         if let Some(near) = nearest_obstacle(grid, a, b, radius + horizon) {
             let c = near.distance - radius;
-            if near.distance <= radius {
+            if near.distance <= radius + CONTACT_TOLERANCE {
                 return Err(ExactViolation::Map {
                     body,
                     clearance: c,

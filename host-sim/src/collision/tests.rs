@@ -233,3 +233,22 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn contact_within_rounding_is_contact() {
+    // A wall of cubes from x = 3.0; the head sphere's radius is r_u (f32 widened).
+    let f = map(&[([3.05, 0.0, 0.0], [3.15, 4.0, 2.0])], true);
+    let p = ChainParams::new(3);
+    let eta = zeta([0.0; 3], &Shape::line(3, 0.0))[3..].to_vec();
+    let r_u = p.unit_radius as f64;
+    let at = |gap: f64| check_config_exact(f.grid(), &p, [3.0 - r_u - gap, 2.0, 1.0], &eta, 0.5);
+    // 1e-12 m of computed clearance is rounding, not room: contact.
+    assert!(
+        matches!(at(1e-12), Err(super::exact::ExactViolation::Map { .. })),
+        "{:?}",
+        at(1e-12)
+    );
+    // A micrometre is room.
+    let ok = at(1e-6).unwrap();
+    assert!((ok.clearance - 1e-6).abs() < 1e-9, "{ok:?}");
+}

@@ -25,17 +25,75 @@ const PITCH_MARGIN: f32 = 0.02;
 /// track is nearest to one link more: on a zig-zag track (a serpentine body laid
 /// down earlier) units stay on its corners instead of cutting across them.
 pub fn lay_along(params: &ChainParams, track: &[Vector3<f32>]) -> Shape {
+    lay(
+        params,
+        Track {
+            points: track,
+            newest_last: false,
+        },
+    )
+}
+
+/// [`lay_along`] on a track stored the other way round, newest point last, so that
+/// a step of the head is a push (the follow-the-leader loop grows it step by step).
+pub fn lay_along_newest_last(params: &ChainParams, track: &[Vector3<f32>]) -> Shape {
+    lay(
+        params,
+        Track {
+            points: track,
+            newest_last: true,
+        },
+    )
+}
+
+/// A track read from the head back, whichever way it is stored.
+#[derive(Clone, Copy)]
+struct Track<'a> {
+    points: &'a [Vector3<f32>],
+    newest_last: bool,
+}
+
+impl Track<'_> {
+    fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Point `i` from the head back.
+    fn at(&self, i: usize) -> Vector3<f32> {
+        if self.newest_last {
+            self.points[self.points.len() - 1 - i]
+        } else {
+            self.points[i]
+        }
+    }
+}
+
+/// Distance along the track to each vertex, summed only as far as it is asked for:
+/// units sit within a few links of the head, so laying the chain costs its reach,
+/// not the track's length.
+struct Along {
+    s: Vec<f32>,
+}
+
+impl Along {
+    fn get(&mut self, track: Track, i: usize) -> f32 {
+        while self.s.len() <= i {
+            let k = self.s.len();
+            let next = self.s[k - 1] + (track.at(k) - track.at(k - 1)).norm();
+            self.s.push(next);
+        }
+        self.s[i]
+    }
+}
+
+fn lay(params: &ChainParams, track: Track) -> Shape {
     let l = params.link_length;
     let mut shape = Shape::line(params.units, 0.0);
-    let Some(&head) = track.first() else {
+    if track.len() == 0 {
         return shape;
-    };
-    // Distance along the track to each vertex.
-    let mut along = Vec::with_capacity(track.len());
-    along.push(0.0f32);
-    for w in track.windows(2) {
-        along.push(along[along.len() - 1] + (w[1] - w[0]).norm());
     }
+    let head = track.at(0);
+    let mut along = Along { s: vec![0.0f32] };
     let mut prev = Place {
         seg: 0,
         t: 0.0,
@@ -44,7 +102,7 @@ pub fn lay_along(params: &ChainParams, track: &[Vector3<f32>]) -> Shape {
     };
     let mut last_dir = Vector3::new(1.0, 0.0, 0.0);
     for k in 0..params.links() {
-        let next = next_unit(track, &along, &prev, l).unwrap_or(Place {
+        let next = next_unit(track, &mut along, &prev, l).unwrap_or(Place {
             p: prev.p - l * last_dir,
             s: f32::INFINITY,
             ..prev
@@ -99,15 +157,16 @@ struct Place {
 
 /// The point of the track after `prev`, `l` from `prev.p`, whose distance along the
 /// track is nearest to `prev.s + l`.
-fn next_unit(track: &[Vector3<f32>], along: &[f32], prev: &Place, l: f32) -> Option<Place> {
+fn next_unit(track: Track, along: &mut Along, prev: &Place, l: f32) -> Option<Place> {
     let target = prev.s + l;
     let mut best: Option<Place> = None;
     for i in prev.seg..track.len().saturating_sub(1) {
         let err = |s: f32| (s - target).abs();
-        if best.is_some_and(|b| along[i] - target > err(b.s)) {
+        let s_i = along.get(track, i);
+        if best.is_some_and(|b| s_i - target > err(b.s)) {
             break;
         }
-        let (a, b) = (track[i], track[i + 1]);
+        let (a, b) = (track.at(i), track.at(i + 1));
         let d = b - a;
         let dd = d.norm_squared();
         if dd < 1e-12 {
@@ -129,7 +188,7 @@ fn next_unit(track: &[Vector3<f32>], along: &[f32], prev: &Place, l: f32) -> Opt
                 continue;
             }
             let t = t.min(1.0);
-            let s = along[i] + t * dd.sqrt();
+            let s = s_i + t * dd.sqrt();
             if s > prev.s && best.is_none_or(|b| err(s) < err(b.s)) {
                 best = Some(Place {
                     seg: i,
@@ -200,6 +259,22 @@ mod tests {
                 track[k]
             );
         }
+    }
+
+    #[test]
+    fn both_storages_of_a_track_lay_the_same_chain() {
+        let p = ChainParams::new(7);
+        let track: Vec<_> = (0..400)
+            .map(|k| {
+                let a = k as f32 * 0.05;
+                v(-0.02 * k as f32, a.sin(), 0.3 * (0.5 * a).cos())
+            })
+            .collect();
+        let reversed: Vec<_> = track.iter().rev().copied().collect();
+        assert_eq!(
+            lay_along(&p, &track).as_slice(),
+            lay_along_newest_last(&p, &reversed).as_slice()
+        );
     }
 
     #[test]

@@ -111,8 +111,21 @@ impl Default for Settings {
 /// When to stop a query early.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Termination {
-    /// Give up after this long.
+    /// Give up after this long: roadmap building, growth and the query together
+    /// (docs/promises.md).
     pub time_limit: Option<Duration>,
+}
+
+impl Termination {
+    /// The moment to stop for work that began at `began`.
+    pub fn deadline(&self, began: Instant) -> Option<Instant> {
+        self.time_limit.and_then(|t| began.checked_add(t))
+    }
+}
+
+/// Whether `deadline` has passed.
+fn expired(deadline: Option<Instant>) -> bool {
+    deadline.is_some_and(|d| Instant::now() > d)
 }
 
 /// One waypoint of a solution.
@@ -174,6 +187,11 @@ pub struct Solution {
     pub stats: Stats,
 }
 
+/// A point for messages: `(x, y, z)` to the millimetre.
+fn point(p: &[f64; 3]) -> String {
+    format!("({:.3}, {:.3}, {:.3})", p[0], p[1], p[2])
+}
+
 /// Why a query has no solution, or cannot be asked.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum PlanError {
@@ -198,7 +216,11 @@ pub enum PlanError {
         tol: f64,
     },
     /// The head could be routed, but the chain found no shape for some edge.
-    #[error("no shape fits head edge {from:?} -> {to:?} after {replans} replans")]
+    #[error(
+        "no shape fits head edge {} -> {} after {replans} replans",
+        point(from),
+        point(to)
+    )]
     NoShape {
         /// The last edge tried.
         from: [f64; 3],
@@ -219,10 +241,16 @@ pub enum PlanError {
 pub struct Checker<'a> {
     ctx: &'a CollisionContext,
     time: Duration,
+    /// Past it every check fails at once, so that whatever search is under way ends
+    /// and the query reports the time limit.
+    deadline: Option<Instant>,
 }
 
 impl Checker<'_> {
-    fn timed<T>(&mut self, f: impl FnOnce(&CollisionContext) -> T) -> T {
+    fn timed(&mut self, f: impl FnOnce(&CollisionContext) -> bool) -> bool {
+        if expired(self.deadline) {
+            return false;
+        }
         let t = Instant::now();
         let r = f(self.ctx);
         self.time += t.elapsed();
@@ -291,17 +319,23 @@ impl Planner {
 
     /// Builds the head roadmap (once; later calls do nothing).
     pub fn setup(&mut self) {
+        self.setup_until(None);
+    }
+
+    /// [`Self::setup`], cut short at `deadline` (the roadmap is then smaller).
+    fn setup_until(&mut self, deadline: Option<Instant>) {
         if self.roadmap.is_none() {
             let t = Instant::now();
-            self.build_roadmap(self.settings.vertices);
+            self.build_roadmap(self.settings.vertices, deadline);
             self.roadmap_s = t.elapsed().as_secs_f64();
         }
     }
 
-    /// (Re)builds the roadmap with `vertices` vertices. The sampler restarts from the
-    /// seed, so a larger roadmap holds every vertex of a smaller one. The radius
-    /// shrinks as `(M_VT / vertices)^(1/3)`, so the number of neighbours stays the same.
-    fn build_roadmap(&mut self, vertices: usize) {
+    /// (Re)builds the roadmap with `vertices` vertices, or fewer if `deadline` passes.
+    /// The sampler restarts from the seed, so a larger roadmap holds every vertex of a
+    /// smaller one. The radius shrinks as `(M_VT / vertices)^(1/3)`, so the number of
+    /// neighbours stays the same.
+    fn build_roadmap(&mut self, vertices: usize, deadline: Option<Instant>) {
         let mut rng = Pcg64::seed_from_u64(self.settings.seed);
         let weight = (
             self.settings.clearance_weight,
@@ -310,7 +344,9 @@ impl Planner {
         let r_t =
             self.settings.r_t * (self.settings.vertices as f64 / vertices.max(1) as f64).cbrt();
         let near = (r_t, self.settings.max_neighbours);
-        self.roadmap = Some(Roadmap::build(&self.ctx, vertices, near, weight, &mut rng));
+        self.roadmap = Some(Roadmap::build(
+            &self.ctx, vertices, near, weight, &mut rng, deadline,
+        ));
     }
 
     /// Forgets the roadmap.
@@ -337,23 +373,32 @@ impl Planner {
         goal: [f64; 3],
         stop: Termination,
     ) -> Result<Solution, PlanError> {
-        self.setup();
+        // The time limit covers the roadmap too (when it is built here) and growth.
         let began = Instant::now();
+        let deadline = stop.deadline(began);
+        self.setup_until(deadline);
+        let query_began = Instant::now();
         let checks_before = self.ctx.stats();
         self.ctx
             .check_config(start, &start_shape)
             .map_err(|c| PlanError::StartInvalid(c.to_string()))?;
         if !self.ctx.is_head_free(goal) {
             let why = if self.ctx.field().grid().in_bounds(goal) {
-                format!("the head's sphere (radius + clearance) collides at {goal:?}")
+                format!(
+                    "the head's sphere (radius + clearance) collides at {}",
+                    point(&goal)
+                )
             } else {
-                format!("{goal:?} is outside the map's bounds")
+                format!("{} is outside the map's bounds", point(&goal))
             };
             return Err(PlanError::GoalInvalid(why));
         }
         // Like OMPL's PRM, grow the roadmap while the query fails and time remains.
         let mut growths = 0;
         let (steps, mut stats, size) = loop {
+            if expired(deadline) {
+                return Err(PlanError::TimeLimit { replans: 0 });
+            }
             let mut roadmap = self.roadmap.take().expect("setup built the roadmap");
             let result =
                 Construction::new(self, &mut roadmap, start, start_shape, goal, stop, began).run();
@@ -363,11 +408,16 @@ impl Planner {
             match result {
                 Ok((steps, stats)) => break (steps, stats, size),
                 Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
-                    if growths < self.settings.max_growth
-                        && stop.time_limit.is_none_or(|t| began.elapsed() <= t) =>
+                    if growths < self.settings.max_growth && !expired(deadline) =>
                 {
                     growths += 1;
-                    self.build_roadmap(self.settings.vertices << growths);
+                    self.build_roadmap(self.settings.vertices << growths, deadline);
+                }
+                // A roadmap cut short by the deadline fails for want of time.
+                Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
+                    if expired(deadline) =>
+                {
+                    return Err(PlanError::TimeLimit { replans: 0 })
                 }
                 Err(e) => return Err(e),
             }
@@ -377,7 +427,7 @@ impl Planner {
         stats.collision_checks = (after.configs + after.translations + after.shape_changes)
             - (checks_before.configs + checks_before.translations + checks_before.shape_changes);
         stats.roadmap_s = self.roadmap_s;
-        stats.planning_s = began.elapsed().as_secs_f64();
+        stats.planning_s = query_began.elapsed().as_secs_f64();
         (stats.roadmap_vertices, stats.roadmap_edges) = size;
         Ok(Solution { steps, stats })
     }
@@ -485,6 +535,7 @@ impl<'p> Construction<'p> {
             checker: Checker {
                 ctx: &planner.ctx,
                 time: Duration::ZERO,
+                deadline: stop.deadline(began),
             },
             start: s,
             goals,
@@ -671,19 +722,22 @@ impl<'p> Construction<'p> {
     }
 
     /// Follow-the-leader from `a` to `b` in steps of `follow_step`: before each step
-    /// the body is laid back along the head's track ([`follow::lay_along`]).
+    /// the body is laid back along the head's track ([`follow::lay_along_newest_last`]).
     fn follow(&mut self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<Leg>> {
         let params = *self.planner.ctx.params();
         let len = roadmap::dist(a, b);
         let n = ((len / self.planner.settings.follow_step).ceil() as usize).max(1);
+        // Newest point last: each step appends (inserting at the front made long
+        // edges quadratic).
         let mut track = self.track(a);
+        track.reverse();
         let mut shape = self.current.shape;
-        let mut legs = Vec::with_capacity(n);
+        let mut legs = Vec::with_capacity(n.min(1024));
         let mut p = a;
         for j in 1..=n {
             let t = j as f64 / n as f64;
             let q = [0, 1, 2].map(|i| a[i] + t * (b[i] - a[i]));
-            let laid = follow::lay_along(&params, &track);
+            let laid = follow::lay_along_newest_last(&params, &track);
             let mut changes = Vec::new();
             if laid.max_angle_diff(&shape) > 1e-4 {
                 let ok =
@@ -701,10 +755,11 @@ impl<'p> Construction<'p> {
                 return None;
             }
             legs.push(Leg { changes, to: q });
-            track.insert(
-                0,
-                nalgebra::Vector3::new(q[0] as f32, q[1] as f32, q[2] as f32),
-            );
+            track.push(nalgebra::Vector3::new(
+                q[0] as f32,
+                q[1] as f32,
+                q[2] as f32,
+            ));
             p = q;
         }
         Some(legs)

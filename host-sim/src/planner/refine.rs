@@ -97,13 +97,16 @@ fn differs(a: &Shape, b: &Shape) -> bool {
 
 impl Planner {
     /// Refines a solved query's plan (see the module docs). The result starts and
-    /// ends where the solution does and passes the same checks.
-    pub fn refine(&self, solution: &Solution) -> (Solution, Refinement) {
+    /// ends where the solution does and passes the same checks. Past `deadline` (the
+    /// query's time limit) refinement stops and keeps what it has; only then can two
+    /// runs differ.
+    pub fn refine(&self, solution: &Solution, deadline: Option<Instant>) -> (Solution, Refinement) {
         let began = Instant::now();
         let mut pass = Pass {
             checker: Checker {
                 ctx: &self.ctx,
                 time: std::time::Duration::ZERO,
+                deadline,
             },
             poses: &solution.steps,
             checks: 0,
@@ -150,7 +153,7 @@ impl Pass<'_> {
     }
 
     fn exhausted(&self) -> bool {
-        self.checks >= CHECK_BUDGET
+        self.checks >= CHECK_BUDGET || super::expired(self.checker.deadline)
     }
 
     /// The farthest pose (beyond the next) reachable from pose `i` directly, with

@@ -11,6 +11,7 @@
 use std::cell::Cell;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
+use std::time::Instant;
 
 use kiddo::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
@@ -69,7 +70,9 @@ pub(super) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 impl Roadmap {
     /// Samples `vertices` free head positions (at most `vertices * 200` tries) and
-    /// joins each to its `k` nearest within `r_t` (edges are kept both ways).
+    /// joins each to its `k` nearest within `r_t` (edges are kept both ways). Past
+    /// `deadline` it stops and keeps what it has: a smaller roadmap, or vertices
+    /// without their own nearest-neighbour edges.
     ///
     /// Edges weigh their length times `1 + w * max(0, 1 - c / c_ref)`, where `c` is
     /// the smaller obstacle clearance of their ends, `w` = `clearance_weight` and
@@ -83,11 +86,18 @@ impl Roadmap {
         (r_t, k): (f64, usize),
         (clearance_weight, clearance_ref): (f64, f64),
         rng: &mut Pcg64,
+        deadline: Option<Instant>,
     ) -> Self {
         let (lo, hi) = ctx.field().grid().bounds();
         let mut points = Vec::with_capacity(vertices);
         let mut tries = 0usize;
+        // Past the deadline the roadmap keeps what it has (checked every 256 tries:
+        // a sample costs a few microseconds).
+        let late = |tries: usize| tries % 256 == 0 && deadline.is_some_and(|d| Instant::now() > d);
         while points.len() < vertices && tries < vertices.saturating_mul(200).max(1000) {
+            if late(tries) {
+                break;
+            }
             tries += 1;
             let p = [
                 rng.gen_range(lo[0]..hi[0]),
@@ -104,6 +114,9 @@ impl Roadmap {
         let mut adjacent: Vec<Vec<usize>> = vec![Vec::new(); points.len()];
         let k1 = std::num::NonZero::new(k.saturating_add(1)).expect("k + 1 > 0");
         for (i, p) in points.iter().enumerate() {
+            if late(i) {
+                break; // later vertices keep only the edges found so far
+            }
             // The k nearest, then the radius: a bounded heap of k, cheaper than
             // collecting every point within r_T first.
             for n in tree.nearest_n::<SquaredEuclidean>(p, k1) {
@@ -429,7 +442,7 @@ mod tests {
         let field = Arc::new(DistanceField::new(sc.grid.clone()));
         let ctx = CollisionContext::new(field, ChainParams::new(5), 0.05).expect("context");
         let mut rng = Pcg64::seed_from_u64(3);
-        let map = Roadmap::build(&ctx, 3000, (1.5, 30), (2.0, 1.0), &mut rng);
+        let map = Roadmap::build(&ctx, 3000, (1.5, 30), (2.0, 1.0), &mut rng, None);
         (ctx, map, sc.start, sc.goal)
     }
 

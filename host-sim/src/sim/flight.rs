@@ -116,8 +116,84 @@ pub trait Obstacles {
     /// link capsule of the chain with unit centres `units` (m; `<= 0` is contact),
     /// and a description of the body and obstacle concerned.
     fn clearance(&self, units: &[V3]) -> (f64, String);
-    /// Largest motion of any unit centre between two clearance checks (m).
+    /// Largest motion of any unit centre between two clearance checks (m), whatever
+    /// the clearance (it keeps the map's bounds checked as often as docs/model.md
+    /// samples edges).
     fn check_spacing(&self) -> f64;
+}
+
+/// The reported minimum clearance is the minimum over every physics step to within
+/// this (m); contact (clearance `<= 0`) is never missed.
+pub const CLEARANCE_TOLERANCE: f64 = 1e-4;
+
+/// Most bytes a flight may record (every step is kept): 1 GiB.
+pub const MAX_RECORDED_BYTES: f64 = (1u64 << 30) as f64;
+
+/// Decides when the clearance must be measured again, and keeps the minimum.
+///
+/// Why skipping is safe: every point of the chain's bodies moves no farther than its
+/// farthest unit centre (a link is the segment between two centres, and a point of a
+/// segment moves by a convex combination of its ends' motions), and the distance to
+/// the map changes no faster than the point moves. So at any step the clearance is at
+/// least the last measured one minus the largest centre motion since; a step is
+/// skipped only when that floor is above both 0 and the minimum so far less
+/// [`CLEARANCE_TOLERANCE`].
+#[derive(Default)]
+struct ClearanceWatch {
+    /// Unit centres and clearance at the last measurement.
+    last: Option<(Vec<V3>, f64)>,
+    /// Smallest clearance, where, and when.
+    min: Option<(f64, String, f64)>,
+}
+
+impl ClearanceWatch {
+    /// Measures the clearance of `centres` at time `t` if it could be a new minimum
+    /// or a contact.
+    fn observe(&mut self, obs: &dyn Obstacles, centres: Vec<V3>, t: f64) {
+        if let Some((prev, c)) = &self.last {
+            let moved = prev
+                .iter()
+                .zip(&centres)
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max);
+            let floor = c - moved;
+            let min = self.min.as_ref().map_or(f64::INFINITY, |m| m.0);
+            if moved < obs.check_spacing() && floor > (min - CLEARANCE_TOLERANCE).max(0.0) {
+                return;
+            }
+        }
+        let (c, at) = obs.clearance(&centres);
+        if self.min.as_ref().is_none_or(|m| c < m.0) {
+            self.min = Some((c, at, t));
+        }
+        self.last = Some((centres, c));
+    }
+}
+
+/// Bytes one recorded step of an `n`-unit chain takes, about.
+fn sample_bytes(n: usize) -> f64 {
+    let per_unit = std::mem::size_of::<BodySample>() + 4 + 12;
+    let per_link = std::mem::size_of::<BodySample>() + 16;
+    (std::mem::size_of::<Sample>() + n * per_unit + n * per_link) as f64
+}
+
+/// Checks that recording a flight of up to `t_max` s fits [`MAX_RECORDED_BYTES`].
+fn check_budget(n: usize, t_ref: f64, cfg: &SimConfig) -> Result<usize, SimError> {
+    let t_max = t_ref.max(cfg.min_time) + cfg.settle_time;
+    let steps = (t_max * cfg.rate).ceil() + 1.0;
+    let bytes = steps * sample_bytes(n);
+    if bytes.is_nan() || bytes > MAX_RECORDED_BYTES {
+        return Err(SimError::Budget(format!(
+            "the flight may last {t_max:.3e} s (the plan {t_ref:.3e} s at --speed {} m/s, \
+             then --settle-time {} s), {steps:.3e} steps at --rate {} Hz; recording them \
+             needs {:.3e} GiB, over the budget of 1 GiB",
+            cfg.limits.speed,
+            cfg.settle_time,
+            cfg.rate,
+            bytes / MAX_RECORDED_BYTES
+        )));
+    }
+    Ok(steps as usize)
 }
 
 /// A recorded body state, compact (`f32`).
@@ -260,6 +336,9 @@ pub enum SimError {
     /// The plan cannot be flown (edge kinds, sizes).
     #[error("plan: {0}")]
     Plan(String),
+    /// The flight would record more than [`MAX_RECORDED_BYTES`].
+    #[error("{0}")]
+    Budget(String),
     /// The dynamics cannot be built.
     #[error(transparent)]
     Dynamics(#[from] DynamicsError),
@@ -371,19 +450,17 @@ fn fly(
         .collect();
     let t_ref = reference.duration();
     let t_max = t_ref.max(cfg.min_time) + cfg.settle_time;
-    progress
-        .total
-        .store((t_max * cfg.rate).ceil() as u64 + 1, Ordering::Relaxed);
+    let steps = check_budget(n, t_ref, cfg)?;
+    progress.total.store(steps as u64, Ordering::Relaxed);
     let theta_max = params.theta_max as f64;
     let beta_max = params.beta_max as f64;
 
     let wall = Instant::now();
-    let mut samples = Vec::with_capacity(((t_max + 1.0) * cfg.rate) as usize);
+    let mut samples = Vec::with_capacity(steps);
     let (mut head_sq, mut head_max, mut link_sq, mut link_max) = (0.0, 0.0f64, 0.0, 0.0f64);
     let mut link_count = 0usize;
     let mut limits = LimitExcursions::default();
-    let mut min_clear: Option<(f64, String, f64)> = None;
-    let mut last_check: Option<Vec<V3>> = None;
+    let mut watch = ClearanceWatch::default();
     let mut min_self_gap = f64::INFINITY;
     let mut at_goal_since: Option<f64> = None;
     let mut completed: Option<f64> = None;
@@ -442,23 +519,9 @@ fn fly(
             min_self_gap = min_self_gap.min(gap as f64);
             true
         });
-        // Clearance to the map, whenever some unit has moved enough.
+        // Clearance to the map, whenever it could be a new minimum or a contact.
         if let Some(obs) = obstacles {
-            let centres: Vec<V3> = units.iter().map(|u| u.p).collect();
-            let due = match &last_check {
-                None => true,
-                Some(prev) => prev
-                    .iter()
-                    .zip(&centres)
-                    .any(|(a, b)| (a - b).norm() >= obs.check_spacing()),
-            };
-            if due {
-                let (c, at) = obs.clearance(&centres);
-                if min_clear.as_ref().is_none_or(|m| c < m.0) {
-                    min_clear = Some((c, at, t));
-                }
-                last_check = Some(centres);
-            }
+            watch.observe(obs, units.iter().map(|u| u.p).collect(), t);
         }
         samples.push(Sample {
             t,
@@ -526,6 +589,7 @@ fn fly(
     let count = samples.len().max(1) as f64;
     let simulated_time = samples.last().map_or(0.0, |s| s.t);
     let (solves, failures) = controller.mpc_counts();
+    let min_clear = watch.min;
     let contact = min_clear.as_ref().is_some_and(|m| m.0 <= 0.0);
     let report = FlightReport {
         units: n,
