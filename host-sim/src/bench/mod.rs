@@ -416,6 +416,7 @@ fn plan_error_outcome(e: &PlanError) -> &'static str {
         PlanError::TimeLimit { .. } => "time_limit",
         PlanError::NoShape { .. } => "no_shape",
         PlanError::Unreachable { .. } => "unreachable",
+        PlanError::Separated { .. } => "separated",
         PlanError::StartInvalid(_) => "start_invalid",
         PlanError::GoalInvalid(_) => "goal_invalid",
         PlanError::TablesMismatch { .. } => "error",
