@@ -78,7 +78,7 @@ const NARROW_SURCHARGE: f64 = 4.0;
 const CLEARANCE_REF: f64 = 0.5;
 /// Inflation of the A* heuristic (weighted A*): routes within this factor of the
 /// cheapest, found with far fewer expansions.
-const HEURISTIC_WEIGHT: f64 = 1.5;
+const HEURISTIC_WEIGHT: f64 = 2.5;
 /// Longest step (lattice spacings) in open space.
 const MAX_JUMP: f64 = 16.0;
 /// A string-pulled segment keeps the clearance of the points it replaces up to this
@@ -139,6 +139,8 @@ struct Flood {
     queue: VecDeque<u64>,
     count: usize,
     active: bool,
+    /// Record parents (the flood from the start, after the A*).
+    parents: bool,
 }
 
 impl Flood {
@@ -151,13 +153,14 @@ impl Flood {
             queue: seeds.iter().copied().collect(),
             count: seeds.len(),
             active,
+            parents: false,
         }
     }
 
     /// A flood from `seeds`, marking `closed` (after the A*: every mark is reset).
     fn new_mark(nodes: &mut Nodes, seeds: &[u64]) -> Self {
         for n in nodes.map.values_mut() {
-            n.closed = false;
+            (n.closed, n.parent) = (false, u64::MAX);
         }
         for &q in seeds {
             nodes.get(q).closed = true;
@@ -166,6 +169,7 @@ impl Flood {
             queue: seeds.iter().copied().collect(),
             count: seeds.len(),
             active: true,
+            parents: true,
         }
     }
 
@@ -193,6 +197,9 @@ impl Flood {
             let m = mark(nn);
             if !*m {
                 *m = true;
+                if self.parents {
+                    nn.parent = q;
+                }
                 self.count += 1;
                 self.queue.push_back(n);
             }
@@ -259,29 +266,42 @@ fn offsets26() -> [[i64; 3]; 26] {
 }
 
 /// The exact distance from `p` to the nearest obstacle voxel cube of the field's grid,
-/// when it is below `cap`; otherwise some value `>= cap`. Enumerates the voxels whose
-/// cube may come within `cap` of `p`.
-pub fn exact_clearance(field: &DistanceField, p: [f64; 3], cap: f64) -> f64 {
+/// when it is above `stop` and below `cap`; otherwise some value `<= stop` (the first
+/// cube found within `stop`) or `>= cap`. The voxels are visited in rings around the
+/// one holding `p`, nearest first, so a blocked point is settled after a few.
+pub fn exact_clearance(field: &DistanceField, p: [f64; 3], stop: f64, cap: f64) -> f64 {
     let g = field.grid();
     let r = g.resolution();
-    let lo = g.lattice_index([p[0] - cap, p[1] - cap, p[2] - cap]);
-    let hi = g.lattice_index([p[0] + cap, p[1] + cap, p[2] + cap]);
+    let c0 = g.lattice_index(p);
+    let rings = (cap / r).ceil() as i32 + 1;
     let mut best = cap;
-    for z in lo[2]..=hi[2] {
-        for y in lo[1]..=hi[1] {
-            for x in lo[0]..=hi[0] {
-                let i = [x, y, z];
-                if !g.is_obstacle(i) {
-                    continue;
-                }
-                let c = g.voxel_center(i);
-                let d = point_box_distance(
-                    p,
-                    [c[0] - r / 2.0, c[1] - r / 2.0, c[2] - r / 2.0],
-                    [c[0] + r / 2.0, c[1] + r / 2.0, c[2] + r / 2.0],
-                );
-                if d < best {
-                    best = d;
+    for k in 0..=rings {
+        // Every cube of ring k is at least (k - 1) r away.
+        if (k - 1) as f64 * r >= best {
+            break;
+        }
+        for dz in -k..=k {
+            for dy in -k..=k {
+                for dx in -k..=k {
+                    if dx.abs().max(dy.abs()).max(dz.abs()) != k {
+                        continue;
+                    }
+                    let i = [c0[0] + dx, c0[1] + dy, c0[2] + dz];
+                    if !g.is_obstacle(i) {
+                        continue;
+                    }
+                    let c = g.voxel_center(i);
+                    let d = point_box_distance(
+                        p,
+                        [c[0] - r / 2.0, c[1] - r / 2.0, c[2] - r / 2.0],
+                        [c[0] + r / 2.0, c[1] + r / 2.0, c[2] + r / 2.0],
+                    );
+                    if d < best {
+                        best = d;
+                        if d <= stop {
+                            return d;
+                        }
+                    }
                 }
             }
         }
@@ -298,36 +318,10 @@ struct Node {
     g: f64,
     /// A* parent (`u64::MAX`: none).
     parent: u64,
-    /// Expanded by the A*.
+    /// Expanded by the A* (or reached by the flood from the start).
     closed: bool,
     /// Reached by the flood from the goal.
     flooded: bool,
-}
-
-/// The exact distance from `p` to the nearest obstacle cube among the 27 voxels
-/// around the one holding `p` (an upper bound on the distance to all cubes).
-fn exact_clearance_near(field: &DistanceField, p: [f64; 3]) -> f64 {
-    let g = field.grid();
-    let r = g.resolution();
-    let c0 = g.lattice_index(p);
-    let mut best = f64::INFINITY;
-    for dz in -1..=1 {
-        for dy in -1..=1 {
-            for dx in -1..=1 {
-                let i = [c0[0] + dx, c0[1] + dy, c0[2] + dz];
-                if g.is_obstacle(i) {
-                    let c = g.voxel_center(i);
-                    let d = point_box_distance(
-                        p,
-                        [c[0] - r / 2.0, c[1] - r / 2.0, c[2] - r / 2.0],
-                        [c[0] + r / 2.0, c[1] + r / 2.0, c[2] + r / 2.0],
-                    );
-                    best = best.min(d);
-                }
-            }
-        }
-    }
-    best
 }
 
 /// Per-query state of the lattice points touched.
@@ -438,12 +432,7 @@ impl HeadLattice {
         if c + r_v * 3f64.sqrt() < self.r_min {
             return None;
         }
-        // Blocked for sure by a cube next to the point's own voxel (most points
-        // inside and along walls)? Only otherwise measure every cube in reach.
-        if exact_clearance_near(field, p) <= self.r_min {
-            return None;
-        }
-        let e = exact_clearance(field, p, self.r_min + self.h);
+        let e = exact_clearance(field, p, self.r_min, self.r_pref + self.h);
         (e > self.r_min).then_some(e)
     }
 
@@ -456,7 +445,10 @@ impl HeadLattice {
     fn factor(&self, c: f64) -> f64 {
         let mut f = 1.0 + self.weight * (1.0 - (c - self.unit_r) / CLEARANCE_REF).max(0.0);
         if c <= self.r_pref {
-            f += NARROW_SURCHARGE;
+            // Below the preferred clearance: the more so the narrower, so routes
+            // through tight openings keep to their middle.
+            let span = (self.r_pref - self.r_min).max(1e-6);
+            f += NARROW_SURCHARGE * (0.5 + (self.r_pref - c) / span);
         }
         f
     }
@@ -464,6 +456,30 @@ impl HeadLattice {
     /// Free points of the stride-`stride` sub-lattice near `p` (within two of its
     /// spacings), nearest first. Stride 2 is the lattice of voxel centres (odd indices).
     fn anchors(&self, nodes: &mut Nodes, p: [f64; 3], stride: i64) -> Vec<u64> {
+        if stride == 2 {
+            // Voxel centres one unit step from an anchor of the whole lattice, so
+            // that a route over the centres is one over the whole lattice too.
+            let mut out: Vec<(f64, u64)> = Vec::new();
+            for a in self.anchors(nodes, p, 1) {
+                let i = Self::unpack(a);
+                for dz in -1..=1 {
+                    for dy in -1..=1 {
+                        for dx in -1..=1 {
+                            let j = [i[0] + dx, i[1] + dy, i[2] + dz];
+                            if j.iter().any(|v| v % 2 == 0) {
+                                continue;
+                            }
+                            let Some(k) = self.pack(j) else { continue };
+                            if nodes.clear(k).is_some() && !out.iter().any(|x| x.1 == k) {
+                                out.push((dist(p, self.point(k)), k));
+                            }
+                        }
+                    }
+                }
+            }
+            out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            return out.into_iter().map(|x| x.1).collect();
+        }
         let off = stride - 1;
         let base = [0, 1, 2].map(|a| {
             let q = (p[a] - self.lo[a]) / self.h;
@@ -568,11 +584,11 @@ impl HeadLattice {
         }
         pts.push(goal);
         clear.push(nodes.clear(*keys.last().expect("non-empty")).unwrap_or(0.0));
+        self.centre(nodes, &mut pts, &mut clear);
         let (mut narrowest, mut nc) = (pts[1], f64::INFINITY);
-        for (j, &k) in keys.iter().enumerate() {
-            let c = clear[j + 1];
-            if c < nc {
-                (narrowest, nc) = (self.point(k), c);
+        for j in 1..pts.len() - 1 {
+            if clear[j] < nc {
+                (narrowest, nc) = (pts[j], clear[j]);
             }
         }
         let points = self.simplify(ctx_min, &pts, &clear);
@@ -582,6 +598,57 @@ impl HeadLattice {
             narrowest_margin: nc - self.unit_r,
             expanded,
         })
+    }
+
+    /// Moves the path's points where it is narrower than the preferred radius across
+    /// the path, up the exact clearance, to the middle of the passage (a few lattice
+    /// steps at most): the A*'s cost leans that way, but a weighted A* stops at the
+    /// first route it finds.
+    fn centre(&self, nodes: &mut Nodes, pts: &mut [[f64; 3]], clear: &mut [f64]) {
+        let field = nodes.field;
+        let cap = self.r_pref + 4.0 * self.h;
+        let exact = |p: [f64; 3]| exact_clearance(field, p, 0.0, cap);
+        let offs = offsets26();
+        for j in 1..pts.len().saturating_sub(1) {
+            if clear[j] >= self.r_pref + 2.0 * self.h {
+                continue;
+            }
+            let d = sub(pts[j + 1], pts[j - 1]);
+            let dn = norm(d).max(1e-12);
+            let base = [0, 1, 2].map(|a| ((pts[j][a] - self.lo[a]) / self.h).round() as i64);
+            let Some(mut cur) = self.pack(base) else {
+                continue;
+            };
+            let mut best = exact(self.point(cur));
+            for _ in 0..8 {
+                let i = Self::unpack(cur);
+                let mut next = None;
+                for o in &offs {
+                    let on = norm([o[0] as f64, o[1] as f64, o[2] as f64]);
+                    let along =
+                        (o[0] as f64 * d[0] + o[1] as f64 * d[1] + o[2] as f64 * d[2]) / (on * dn);
+                    if along.abs() > 0.35 {
+                        continue;
+                    }
+                    let Some(n) = self.pack([i[0] + o[0], i[1] + o[1], i[2] + o[2]]) else {
+                        continue;
+                    };
+                    if nodes.clear(n).is_none() {
+                        continue;
+                    }
+                    let e = exact(self.point(n));
+                    if e > best + 1e-9 && next.is_none_or(|(_, b)| e > b) {
+                        next = Some((n, e));
+                    }
+                }
+                match next {
+                    Some((n, e)) => (cur, best) = (n, e),
+                    None => break,
+                }
+            }
+            pts[j] = self.point(cur);
+            clear[j] = best;
+        }
     }
 
     /// One A* over the stride-`stride` sub-lattice. With stride 1, a flood from the
@@ -641,10 +708,10 @@ impl HeadLattice {
                         }
                         None => return Search::Budget,
                     }
-                    if goals.iter().any(|&g| nodes.get(g).closed) {
-                        // The long steps missed a way the flood found: give up on
-                        // the lattice (the roadmap remains).
-                        return Search::Budget;
+                    if let Some(&g) = goals.iter().find(|&&g| nodes.get(g).closed) {
+                        // The long steps missed a way the flood found: take the
+                        // flood's path.
+                        return Search::Found(self.path_to(nodes, g), expanded);
                     }
                     if nodes.map.len() > budget {
                         return Search::Budget;
@@ -681,6 +748,14 @@ impl HeadLattice {
                 else {
                     continue;
                 };
+                if step == 2 {
+                    // A step over one point of the whole lattice: that point must be
+                    // free too (longer steps are covered by the clearance at `k`).
+                    let mid = self.pack([i[0] + o[0], i[1] + o[1], i[2] + o[2]]);
+                    if mid.is_none_or(|m| nodes.clear(m).is_none()) {
+                        continue;
+                    }
+                }
                 let nn = nodes.get(n);
                 if nn.closed || nn.clear.is_nan() {
                     continue;
@@ -714,7 +789,12 @@ impl HeadLattice {
             }
         };
         self.searched.set(Some(expanded));
-        let mut keys = vec![found];
+        Search::Found(self.path_to(nodes, found), expanded)
+    }
+
+    /// The path of parents from a seed to `k`, the seed first.
+    fn path_to(&self, nodes: &mut Nodes, k: u64) -> Vec<u64> {
+        let mut keys = vec![k];
         loop {
             let p = nodes.get(*keys.last().expect("non-empty")).parent;
             if p == u64::MAX {
@@ -723,7 +803,7 @@ impl HeadLattice {
             keys.push(p);
         }
         keys.reverse();
-        Search::Found(keys, expanded)
+        keys
     }
 
     /// Pulls a lattice path taut: from each kept point, the farthest later point that
@@ -754,7 +834,7 @@ impl HeadLattice {
             (0..=n).all(|s| {
                 let t = s as f64 / n as f64;
                 let p = [0, 1, 2].map(|a| pts[i][a] + t * (pts[j][a] - pts[i][a]));
-                field.clearance(p) + 1e-9 >= need - self.h
+                field.clearance(p) + 1e-3 >= need
             })
         };
         let mut out = vec![pts[0]];
@@ -792,7 +872,211 @@ impl HeadLattice {
     }
 }
 
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
 /// Euclidean distance (m).
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use arc_core::ChainParams;
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::map::grid::{Cell, Grid};
+
+    /// A closed box of `dims` voxels at `res`, free inside a one-voxel shell.
+    fn boxed(res: f64, dims: [usize; 3]) -> Grid {
+        let mut g = Grid::new(res, [0; 3], dims, Cell::Occupied, true).unwrap();
+        let e = 1e-6;
+        let hi = dims.map(|d| (d - 1) as f64 * res - e);
+        g.fill_box([res + e; 3], hi, Cell::Free);
+        g
+    }
+
+    fn ctx(g: Grid, clearance: f64) -> CollisionContext {
+        let field = Arc::new(DistanceField::new(g));
+        CollisionContext::new(field, ChainParams::new(4), clearance).unwrap()
+    }
+
+    /// A wall across x at voxel column `wx` with the voxels `hole` (y, z ranges) open.
+    fn wall_with_hole(g: &mut Grid, wx: i32, ys: std::ops::Range<i32>, zs: std::ops::Range<i32>) {
+        let [_, ny, nz] = g.dims();
+        for z in 0..nz as i32 {
+            for y in 0..ny as i32 {
+                if !(ys.contains(&y) && zs.contains(&z)) {
+                    g.set([wx, y, z], Cell::Occupied);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_passage_one_voxel_wide_is_found_where_uniform_samples_miss_it() {
+        // 0.35 m voxels: a one-voxel hole leaves the head's centre (r 0.15 m, no
+        // clearance) a 0.05 m x 0.05 m x 0.35 m tube in a 7 x 7 x 3.5 m box.
+        let res = 0.35;
+        let mut g = boxed(res, [20, 20, 10]);
+        wall_with_hole(&mut g, 10, 10..11, 5..6);
+        let c = ctx(g, 0.0);
+        let lat = HeadLattice::new(&c, 0.0, 2.0);
+        let (a, b) = ([1.5, 1.5, 1.5], [5.5, 5.5, 1.5]);
+        let LatticeOutcome::Found(r) = lat.route(&c, a, b) else {
+            panic!("no route");
+        };
+        // The route passes the hole's centre (10.5, 10.5, 5.5) voxels.
+        let hole = [10.5 * res, 10.5 * res, 5.5 * res];
+        assert!(dist(r.narrowest, hole) < 1e-6, "{:?}", r.narrowest);
+        assert!(r.narrowest_margin > 0.0);
+        // Every route point keeps the head's sphere free by the exact test.
+        for &p in &r.points {
+            assert!(exact_clearance(c.field(), p, 0.0, 1.0) > 0.15, "{p:?}");
+        }
+        // The uniform roadmap of the same size misses it: 1500 samples, not one in
+        // the tube (deterministic seed).
+        let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(1);
+        let map = super::super::roadmap::Roadmap::build(&c, 1500, (1.5, 30), (2.0, 1.0), &mut rng);
+        let in_tube = (0..map.vertex_count())
+            .filter(|&v| {
+                let p = map.point(v);
+                (p[0] - hole[0]).abs() < res / 2.0
+                    && (p[1] - hole[1]).abs() < 0.03
+                    && (p[2] - hole[2]).abs() < 0.03
+            })
+            .count();
+        assert_eq!(in_tube, 0);
+    }
+
+    #[test]
+    fn a_gap_two_voxels_wide_is_found_on_its_face_centred_line() {
+        // 0.2 m voxels, a 2 x 2 voxel hole (0.4 m): the head (0.15 m) fits only
+        // near the hole's centre, which is on voxel faces, not on voxel centres.
+        let res = 0.2;
+        let mut g = boxed(res, [30, 20, 15]);
+        wall_with_hole(&mut g, 15, 9..11, 7..9);
+        let c = ctx(g, 0.0);
+        let lat = HeadLattice::new(&c, 0.0, 2.0);
+        let (a, b) = ([1.0, 2.0, 1.5], [5.0, 2.0, 1.5]);
+        let centre = [2.0, 2.0, 1.6];
+        // No voxel centre in the hole is free.
+        for y in [9.5, 10.5] {
+            for z in [7.5, 8.5] {
+                assert!(!lat.is_free(c.field(), [15.5 * res, y * res, z * res]));
+            }
+        }
+        assert!(lat.is_free(c.field(), [15.5 * res, centre[1], centre[2]]));
+        let LatticeOutcome::Found(r) = lat.route(&c, a, b) else {
+            panic!("no route");
+        };
+        assert!(
+            (r.narrowest[1] - centre[1]).abs() < 1e-6 && (r.narrowest[2] - centre[2]).abs() < 1e-6
+        );
+        assert!(
+            (r.narrowest_margin - 0.05).abs() < 1e-6,
+            "{}",
+            r.narrowest_margin
+        );
+    }
+
+    #[test]
+    fn a_wall_without_an_opening_separates_the_regions() {
+        let mut g = boxed(0.2, [30, 20, 15]);
+        wall_with_hole(&mut g, 15, 0..0, 0..0);
+        let c = ctx(g, 0.05);
+        let lat = HeadLattice::new(&c, 0.0, 2.0);
+        match lat.route(&c, [1.0, 2.0, 1.5], [5.0, 2.0, 1.5]) {
+            LatticeOutcome::Separated { .. } => {}
+            other => panic!("{other:?}"),
+        }
+    }
+
+    /// Reference: a breadth-first flood over the whole lattice with the same exact
+    /// test, from the start's anchors to the goal's.
+    fn flood_connects(
+        lat: &HeadLattice,
+        c: &CollisionContext,
+        a: [f64; 3],
+        b: [f64; 3],
+    ) -> Option<bool> {
+        let mut nodes = Nodes {
+            lat,
+            field: c.field(),
+            map: KeyMap::default(),
+        };
+        let starts = lat.anchors(&mut nodes, a, 1);
+        let goals: KeySet = lat.anchors(&mut nodes, b, 1).into_iter().collect();
+        if starts.is_empty() || goals.is_empty() {
+            return None;
+        }
+        let mut seen: KeySet = starts.iter().copied().collect();
+        let mut queue: VecDeque<u64> = starts.into_iter().collect();
+        while let Some(q) = queue.pop_front() {
+            if goals.contains(&q) {
+                return Some(true);
+            }
+            let i = HeadLattice::unpack(q);
+            for o in offsets26() {
+                if let Some(n) = lat.pack([i[0] + o[0], i[1] + o[1], i[2] + o[2]]) {
+                    if lat.is_free(c.field(), lat.point(n)) && seen.insert(n) {
+                        queue.push_back(n);
+                    }
+                }
+            }
+        }
+        Some(false)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+        /// The search finds a route exactly when the flood connects start and goal.
+        #[test]
+        fn route_exactly_when_the_flood_connects(
+            seed in 0u64..1_000_000,
+            density in 0.05f64..0.35,
+            res in prop::sample::select(vec![0.1f64, 0.15, 0.2]),
+        ) {
+            use rand::{Rng, SeedableRng};
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+            let dims = [14, 10, 8];
+            let mut g = boxed(res, dims);
+            for z in 1..dims[2] as i32 - 1 {
+                for y in 1..dims[1] as i32 - 1 {
+                    for x in 1..dims[0] as i32 - 1 {
+                        if rng.gen_bool(density) {
+                            g.set([x, y, z], Cell::Occupied);
+                        }
+                    }
+                }
+            }
+            let c = ctx(g, 0.0);
+            let lat = HeadLattice::new(&c, 0.0, 2.0);
+            let (lo, hi) = c.field().grid().bounds();
+            let pick = |rng: &mut rand_pcg::Pcg64| {
+                [0, 1, 2].map(|k| rng.gen_range(lo[k] + 0.2..hi[k] - 0.2))
+            };
+            let (a, b) = (pick(&mut rng), pick(&mut rng));
+            let reference = flood_connects(&lat, &c, a, b);
+            let got = lat.route(&c, a, b);
+            match (reference, &got) {
+                (None, LatticeOutcome::NoAnchor { .. }) => {}
+                (Some(true), LatticeOutcome::Found(r)) => {
+                    prop_assert_eq!(r.points[0], a);
+                    prop_assert_eq!(*r.points.last().unwrap(), b);
+                }
+                (Some(false), LatticeOutcome::Separated { .. }) => {}
+                (r, g) => prop_assert!(false, "flood {:?}, search {:?}", r, g),
+            }
+        }
+    }
 }

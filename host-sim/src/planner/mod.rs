@@ -263,15 +263,15 @@ fn narrow_note(n: &Option<([f64; 3], f64)>) -> String {
 }
 
 /// Collision checks with time and count bookkeeping.
-pub struct Checker<'a> {
-    ctx: &'a CollisionContext,
+pub struct Checker {
+    ctx: CollisionContext,
     time: Duration,
 }
 
-impl Checker<'_> {
+impl Checker {
     fn timed<T>(&mut self, f: impl FnOnce(&CollisionContext) -> T) -> T {
         let t = Instant::now();
-        let r = f(self.ctx);
+        let r = f(&self.ctx);
         self.time += t.elapsed();
         r
     }
@@ -527,6 +527,22 @@ fn trail_yaw(params: &arc_core::ChainParams, shape: &Shape) -> f32 {
     c.y.atan2(c.x)
 }
 
+/// A lower bound on the head unit's margin (distance to the map minus `r_u`) along
+/// the segment `a b`, sampled every quarter voxel (m, at least 0).
+fn head_margin(ctx: &CollisionContext, a: [f64; 3], b: [f64; 3]) -> f64 {
+    let step = ctx.field().grid().resolution() / 4.0;
+    let n = (roadmap::dist(a, b) / step).ceil().max(1.0) as usize;
+    let r_u = ctx.params().unit_radius as f64;
+    (0..=n)
+        .map(|i| {
+            let t = i as f64 / n as f64;
+            let p = [0, 1, 2].map(|k| a[k] + t * (b[k] - a[k]));
+            ctx.clearance(p) - r_u
+        })
+        .fold(f64::INFINITY, f64::min)
+        .max(0.0)
+}
+
 /// One leg of a head edge: shape changes where the head is, then a translation.
 struct Leg {
     changes: Vec<Candidate>,
@@ -549,7 +565,7 @@ const FAILS_BEFORE_BACKING_UP: usize = 4;
 struct Construction<'p> {
     planner: &'p Planner,
     roadmap: &'p mut Roadmap,
-    checker: Checker<'p>,
+    checker: Checker,
     start: VertexId,
     goals: Vec<VertexId>,
     /// Cost-to-go of every vertex: the routes' heuristic.
@@ -594,7 +610,7 @@ impl<'p> Construction<'p> {
             planner,
             roadmap,
             checker: Checker {
-                ctx: &planner.ctx,
+                ctx: planner.ctx.clone(),
                 time: Duration::ZERO,
             },
             start: s,
@@ -769,23 +785,42 @@ impl<'p> Construction<'p> {
             return Some(legs);
         }
         let p = self.planner;
-        if p.ctx_min.clearance_margin() < p.ctx.clearance_margin()
-            && self.roadmap.is_query(v)
-            && self.roadmap.is_query(u)
-        {
-            self.checker.ctx = &p.ctx_min;
-            let legs = self.connect_at(v, u);
-            self.checker.ctx = &p.ctx;
-            if legs.is_some() {
-                self.relaxed.push((
-                    self.steps.len(),
-                    p.ctx_min.clearance_margin(),
-                    self.roadmap.point(v),
-                ));
-            }
-            return legs;
+        let (c_min, c_pref) = (p.ctx_min.clearance_margin(), p.ctx.clearance_margin());
+        if !(c_min < c_pref && self.roadmap.is_query(v) && self.roadmap.is_query(u)) {
+            return None;
         }
-        None
+        // Give way step by step: first to 90 % of the head's own margin along the
+        // edge (what the passage leaves on its narrowest side), then to the floor.
+        let (a, b) = (self.roadmap.point(v), self.roadmap.point(u));
+        let head = head_margin(&p.ctx, a, b);
+        let mid = ((0.9 * head * 1000.0).floor() / 1000.0).clamp(c_min, c_pref);
+        let mut levels = vec![(mid, None)];
+        if mid > c_min {
+            levels.push((c_min, Some(p.ctx_min.clone())));
+        }
+        let mut legs = None;
+        for (c, ctx) in levels {
+            let ctx = match ctx {
+                Some(x) => x,
+                None => {
+                    match CollisionContext::new(p.ctx.field_arc().clone(), *p.ctx.params(), c) {
+                        Ok(mut x) => {
+                            x.set_min_step(p.ctx.min_step());
+                            x
+                        }
+                        Err(_) => continue,
+                    }
+                }
+            };
+            self.checker.ctx = ctx;
+            legs = self.connect_at(v, u);
+            if legs.is_some() {
+                self.relaxed.push((self.steps.len(), c, a));
+                break;
+            }
+        }
+        self.checker.ctx = p.ctx.clone();
+        legs
     }
 
     /// [`Self::connect`] at the checker's clearance.
