@@ -18,6 +18,7 @@
 
 pub mod paper;
 pub mod plot;
+pub mod robust;
 pub mod scale;
 
 use std::collections::BTreeMap;
