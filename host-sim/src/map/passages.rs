@@ -13,6 +13,7 @@
 //! | `door` | none | width (m) of a door in a second wall 2.5 m behind the first, 0.4 to 1.0 |
 //! | `door_offset` | 0 | door centre off the room's axis (m), -0.4 to 0.4 |
 //! | `res` | 0.05 | map resolution (m), 0.025 to 0.1 |
+//! | `sealed` | 0 | 1: the window is walled up (no way through; for failure reports) |
 //!
 //! Every instance carries a hand-made centre line ([`Scenario::route`]): straight in
 //! along the approach, a turn 1 m before the wall onto its normal, straight through the
@@ -41,6 +42,8 @@ pub struct PassageSpec {
     pub door: Option<(f64, f64)>,
     /// Map resolution (m).
     pub res: f64,
+    /// The window is walled up: start and goal in separate free regions.
+    pub sealed: bool,
 }
 
 impl Default for PassageSpec {
@@ -52,6 +55,7 @@ impl Default for PassageSpec {
             wall: 0.2,
             door: None,
             res: 0.05,
+            sealed: false,
         }
     }
 }
@@ -90,9 +94,10 @@ impl PassageSpec {
                 "door" => door = Some(v),
                 "door_offset" => door_offset = v,
                 "res" => s.res = v,
+                "sealed" => s.sealed = v != 0.0,
                 other => {
                     return Err(format!(
-                    "unknown key {other:?}; known: w, angle, offset, wall, door, door_offset, res"
+                    "unknown key {other:?}; known: w, angle, offset, wall, door, door_offset, res, sealed"
                 ))
                 }
             }
@@ -135,6 +140,9 @@ impl PassageSpec {
         if self.res != 0.05 {
             n += &format!(",res={}", self.res);
         }
+        if self.sealed {
+            n += ",sealed=1";
+        }
         n
     }
 
@@ -153,6 +161,7 @@ impl PassageSpec {
             wall: cm(rng.gen_range(0.1..=0.3)),
             door,
             res: 0.05,
+            sealed: false,
         }
     }
 
@@ -201,7 +210,9 @@ impl PassageSpec {
         let (y0, y1) = (down(yc - hw), up(yc + hw));
         let (z0, z1) = (down(Z_C - hw), up(Z_C + hw));
         let (yc, zc) = ((y0 + y1) / 2.0, (z0 + z1) / 2.0);
-        fill(&mut g, [WALL_X, y0, z0], [WALL_X + t, y1, z1], Cell::Free);
+        if !self.sealed {
+            fill(&mut g, [WALL_X, y0, z0], [WALL_X + t, y1, z1], Cell::Free);
+        }
         let mut goal = [WALL_X + t + 1.5, yc, zc];
         let a = self.angle_deg.to_radians();
         let turn = [WALL_X - 1.0, yc, zc];
