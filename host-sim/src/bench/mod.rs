@@ -18,6 +18,7 @@
 
 pub mod paper;
 pub mod plot;
+pub mod robust;
 pub mod scale;
 
 use std::collections::BTreeMap;
@@ -416,6 +417,7 @@ fn plan_error_outcome(e: &PlanError) -> &'static str {
         PlanError::TimeLimit { .. } => "time_limit",
         PlanError::NoShape { .. } => "no_shape",
         PlanError::Unreachable { .. } => "unreachable",
+        PlanError::Separated { .. } => "separated",
         PlanError::StartInvalid(_) => "start_invalid",
         PlanError::GoalInvalid(_) => "goal_invalid",
         PlanError::TablesMismatch { .. } => "error",

@@ -9,7 +9,7 @@ use super::checks;
 use super::common::{ChainArgs, MapArgs, Query, QueryArgs, Report};
 use super::{CliError, CliResult};
 use crate::baseline::{self, FullStatePrm, PrmError, PrmSettings};
-use crate::bench::{self, paper, scale};
+use crate::bench::{self, paper, robust, scale};
 use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use crate::planner::Termination;
 
@@ -24,6 +24,9 @@ pub enum BenchCommand {
     /// (corridor:10..100), with a plot (SVG and PNG).
     #[command(after_help = "Example:\n  arc bench scale --quick --out-dir out/scale")]
     Scale(ScaleArgs),
+    /// Robustness on the hard-case family (`passage:`): random instances with
+    /// witnesses, N = 4..8, `arc plan`'s defaults; CSV, markdown and a plot.
+    Robust(RobustArgs),
     /// One plan by the full-state lazy PRM baseline (arc-plan/1, verified exactly).
     #[command(
         after_help = "Example:\n  arc bench prm --scenario window --units 4 --vertices 15000 --out prm.json"
@@ -92,6 +95,26 @@ pub struct ScaleArgs {
     /// (default 100).
     #[arg(long)]
     corridor_density: Option<f64>,
+}
+
+/// `arc bench robust`
+#[derive(Args, Debug)]
+pub struct RobustArgs {
+    /// Instances.
+    #[arg(long, default_value_t = 200)]
+    instances: usize,
+    /// Seed of the instance generator.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Time limit per query in seconds; 0 for none.
+    #[arg(long, default_value_t = 30.0)]
+    time_limit: f64,
+    /// Where CSV, markdown and the plot go.
+    #[arg(long, default_value = "bench-out")]
+    out_dir: PathBuf,
+    /// Worker threads (default: RAYON_NUM_THREADS, else every core).
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 /// `arc bench prm`
@@ -401,6 +424,54 @@ fn check_prm(a: &PrmArgs) -> Result<Option<Duration>, CliError> {
     checks::time_limit(a.time_limit)
 }
 
+fn run_robust(a: RobustArgs) -> CliResult {
+    if a.instances == 0 {
+        return Err(CliError::input("--instances 0: must be at least 1"));
+    }
+    if !(a.time_limit.is_finite() && a.time_limit >= 0.0) {
+        return Err(CliError::input(format!(
+            "--time-limit {}: must be a number of seconds >= 0",
+            a.time_limit
+        )));
+    }
+    let o = robust::RobustOptions {
+        instances: a.instances,
+        seed: a.seed,
+        time_limit: (a.time_limit > 0.0).then_some(a.time_limit),
+        ..robust::RobustOptions::full()
+    };
+    let t = Instant::now();
+    let (specs, redrawn) = robust::draw(&o);
+    eprintln!(
+        "arc bench robust: {} instances with witnesses ({redrawn} redrawn) in {:.0} s",
+        specs.len(),
+        t.elapsed().as_secs_f64()
+    );
+    let results = robust::run(&specs, a.threads, 10).map_err(CliError::input)?;
+    let md = robust::markdown(
+        &results,
+        redrawn,
+        &format!(
+            "Seed {}, {} instances; wall time of the whole study {:.0} s.",
+            a.seed,
+            specs.len(),
+            t.elapsed().as_secs_f64()
+        ),
+    );
+    let svg = robust::figure(&results).map_err(CliError::failed)?;
+    let dir = &a.out_dir;
+    let files = [
+        write(dir, "robust_runs.csv", bench::runs_csv(&results).as_bytes())?,
+        write(dir, "robust.md", md.as_bytes())?,
+        write(dir, "robust.svg", svg.as_bytes())?,
+    ];
+    println!("{md}");
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
 fn run_prm(a: PrmArgs) -> CliResult {
     let time_limit = check_prm(&a)?;
     let loaded = a.map.load()?;
@@ -489,6 +560,7 @@ pub fn run(c: BenchCommand) -> CliResult {
     match c {
         BenchCommand::Paper(a) => run_paper(a),
         BenchCommand::Scale(a) => run_scale(a),
+        BenchCommand::Robust(a) => run_robust(a),
         BenchCommand::Prm(a) => run_prm(*a),
     }
 }

@@ -63,6 +63,14 @@ pub struct PlanArgs {
     /// Clearance margin added to every body's radius (m): plans keep this far from walls.
     #[arg(long, default_value_t = DEFAULT_CLEARANCE)]
     clearance: f64,
+    /// Smallest clearance margin (m) the planner may give way to, only along a passage
+    /// narrower than --clearance allows (0: the exact contract of docs/model.md).
+    #[arg(long, default_value_t = 0.0)]
+    clearance_min: f64,
+    /// Head route search over the map's half-cell lattice (off: the paper's uniform
+    /// head roadmap only).
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    head_lattice: bool,
     /// Step (m) of follow-the-leader motion, where the body is laid back along the
     /// head's track (long chains through windows and doors); 0 turns it off (the paper).
     #[arg(long, default_value_t = 0.1)]
@@ -142,6 +150,7 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
         checks::MAX_REPLANS,
         "dropped edges per query",
     )?;
+    checks::length("--clearance-min", a.clearance_min, false)?;
     checks::time_limit(a.time_limit)?;
     checks::count(
         "--srs",
@@ -219,6 +228,8 @@ pub fn run(a: PlanArgs) -> CliResult {
         clearance_weight: a.clearance_weight,
         goal_tol: a.goal_tol,
         follow_step: a.follow_step,
+        clearance_min: a.clearance_min,
+        head_lattice: a.head_lattice,
     };
     let mut planner =
         Planner::new(ctx, tables, settings).map_err(|e| CliError::input(e.to_string()))?;
@@ -279,6 +290,21 @@ pub fn run(a: PlanArgs) -> CliResult {
         s.collision_checks
     ));
     print_quality(&report, &quality, refinement.as_ref());
+    match s.min_margin_at {
+        Some(p) => report.line(format_args!(
+            "  smallest clearance margin kept: {:.3} m (below --clearance {:.3} m from ({:.2}, {:.2}, {:.2}) on)",
+            s.min_margin, a.clearance, p[0], p[1], p[2]
+        )),
+        None => report.line(format_args!("  smallest clearance margin kept: {:.3} m", s.min_margin)),
+    }
+    if s.route_points > 0 {
+        report.line(format_args!(
+            "  head route: {} points ({} lattice points expanded, {:.1} ms)",
+            s.route_points,
+            s.lattice_expanded,
+            s.lattice_s * 1e3
+        ));
+    }
     if let Some(pic) = &a.picture {
         let grid = planner.context().field().grid();
         crate::plan_picture::draw(

@@ -2,5 +2,6 @@
 pub mod distance;
 pub mod grid;
 pub mod octomap;
+pub mod passages;
 pub mod picture;
 pub mod scenarios;

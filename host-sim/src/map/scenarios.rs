@@ -75,14 +75,16 @@ pub fn build(name: &str) -> Result<Scenario, String> {
         "silos" => Ok(silos()),
         "corridor" => corridor(DEFAULT_CORRIDOR_LENGTH),
         _ => {
-            if let Some(len) = name.strip_prefix("corridor:") {
+            if let Some(spec) = name.strip_prefix("passage:") {
+                super::passages::PassageSpec::parse(spec)?.build()
+            } else if let Some(len) = name.strip_prefix("corridor:") {
                 let l: f64 = len
                     .parse()
                     .map_err(|_| format!("corridor length {len:?} is not a number"))?;
                 corridor(l)
             } else {
                 Err(format!(
-                    "unknown scenario {name:?}; known: {}, corridor:LENGTH",
+                    "unknown scenario {name:?}; known: {}, corridor:LENGTH, passage:KEY=VALUE,...",
                     NAMES.join(", ")
                 ))
             }

@@ -15,6 +15,7 @@
 
 pub mod candidates;
 pub mod follow;
+pub mod lattice;
 pub mod motion;
 pub mod refine;
 pub mod roadmap;
@@ -86,6 +87,13 @@ pub struct Settings {
     /// Step (m) of follow-the-leader motion ([`follow`]), tried after the library
     /// and before SRSConnect; 0 turns it off (the paper's planner).
     pub follow_step: f64,
+    /// Smallest clearance margin (m) the planner may give way to where a passage is
+    /// narrower than the context's (preferred) clearance; 0 is docs/model.md's exact
+    /// contract. Values above the preferred clearance are taken as it.
+    pub clearance_min: f64,
+    /// Search a head route over the half-cell lattice of the map ([`lattice`]) and add
+    /// it to the roadmap before each query; off: the paper's uniform roadmap only.
+    pub head_lattice: bool,
 }
 
 impl Default for Settings {
@@ -104,6 +112,8 @@ impl Default for Settings {
             clearance_weight: 2.0,
             goal_tol: 0.3,
             follow_step: 0.1,
+            clearance_min: 0.0,
+            head_lattice: true,
         }
     }
 }
@@ -170,6 +180,19 @@ pub struct Stats {
     pub replans: usize,
     /// Times the roadmap was doubled during the query.
     pub roadmap_growths: usize,
+    /// Smallest clearance margin (m) in force on any edge of the plan: every body kept
+    /// at least this far from the map (the preferred clearance unless the planner gave
+    /// way in a narrow passage).
+    pub min_margin: f64,
+    /// Head position at the start of the first edge flown at [`Self::min_margin`],
+    /// when that is below the preferred clearance.
+    pub min_margin_at: Option<[f64; 3]>,
+    /// Head route search ([`lattice`]): lattice points expanded (0: not used).
+    pub lattice_expanded: usize,
+    /// Head route search time (s), part of the query time.
+    pub lattice_s: f64,
+    /// Points of the head route added to the roadmap (start and goal included).
+    pub route_points: usize,
     /// Full-chain collision checks (configurations, translations, shape changes).
     pub collision_checks: u64,
     /// Roadmap vertices and candidate edges.
@@ -217,9 +240,10 @@ pub enum PlanError {
     },
     /// The head could be routed, but the chain found no shape for some edge.
     #[error(
-        "no shape fits head edge {} -> {} after {replans} replans",
+        "no shape fits head edge {} -> {} after {replans} replans{}",
         point(from),
-        point(to)
+        point(to),
+        narrow_note(.narrowest)
     )]
     NoShape {
         /// The last edge tried.
@@ -228,6 +252,22 @@ pub enum PlanError {
         to: [f64; 3],
         /// Replans made.
         replans: usize,
+        /// The head route's narrowest point and the head's margin there (m), when the
+        /// lattice found a route.
+        narrowest: Option<([f64; 3], f64)>,
+    },
+    /// The head's sphere cannot get from the start to the goal at all: the lattice
+    /// search flooded one side's free region without meeting the other.
+    #[error("start and goal are in separate free regions for the head's sphere (radius {radius:.3} m, the smallest clearance included): the {side}'s region ({visited} lattice points at {spacing:.3} m) does not reach the other")]
+    Separated {
+        /// Sphere radius tested (m).
+        radius: f64,
+        /// Which side's region was flooded ("start" or "goal").
+        side: &'static str,
+        /// Lattice points in it.
+        visited: usize,
+        /// Lattice spacing (m).
+        spacing: f64,
     },
     /// The termination condition stopped the query.
     #[error("time limit reached after {replans} replans")]
@@ -237,22 +277,33 @@ pub enum PlanError {
     },
 }
 
+/// The tail of [`PlanError::NoShape`]'s message: where the head route is narrowest.
+fn narrow_note(n: &Option<([f64; 3], f64)>) -> String {
+    match n {
+        Some((p, m)) => format!(
+            "; the head route is narrowest at ({:.3}, {:.3}, {:.3}), where the head keeps {:.3} m from the map",
+            p[0], p[1], p[2], m
+        ),
+        None => String::new(),
+    }
+}
+
 /// Collision checks with time and count bookkeeping.
-pub struct Checker<'a> {
-    ctx: &'a CollisionContext,
+pub struct Checker {
+    ctx: CollisionContext,
     time: Duration,
     /// Past it every check fails at once, so that whatever search is under way ends
     /// and the query reports the time limit.
     deadline: Option<Instant>,
 }
 
-impl Checker<'_> {
+impl Checker {
     fn timed(&mut self, f: impl FnOnce(&CollisionContext) -> bool) -> bool {
         if expired(self.deadline) {
             return false;
         }
         let t = Instant::now();
-        let r = f(self.ctx);
+        let r = f(&self.ctx);
         self.time += t.elapsed();
         r
     }
@@ -281,6 +332,9 @@ impl Checker<'_> {
 /// The planner: a map context, a chain's shape tables, settings, and the roadmap.
 pub struct Planner {
     ctx: CollisionContext,
+    /// The same map and chain at the smallest clearance (`Settings::clearance_min`).
+    ctx_min: CollisionContext,
+    lattice: lattice::HeadLattice,
     tables: ShapeTables,
     /// Per SRS shape: the yaw from the head to the centroid of its units.
     trail_yaw: Vec<f32>,
@@ -307,8 +361,15 @@ impl Planner {
             .iter()
             .map(|s| trail_yaw(&tables.params, s))
             .collect();
+        let c_min = settings.clearance_min.clamp(0.0, ctx.clearance_margin());
+        let mut ctx_min = CollisionContext::new(ctx.field_arc().clone(), *ctx.params(), c_min)
+            .map_err(|e| PlanError::StartInvalid(format!("clearance_min: {e}")))?;
+        ctx_min.set_min_step(ctx.min_step());
+        let lattice = lattice::HeadLattice::new(&ctx, c_min, settings.clearance_weight);
         Ok(Self {
             ctx,
+            ctx_min,
+            lattice,
             tables,
             trail_yaw,
             settings,
@@ -364,6 +425,46 @@ impl Planner {
         &self.settings
     }
 
+    /// The lattice's head route (`Ok(None)`: the lattice cannot say within `budget`);
+    /// [`PlanError::Separated`] when it proves that none exists. Adds its time to `s`.
+    fn head_route(
+        &self,
+        start: [f64; 3],
+        goal: [f64; 3],
+        budget: usize,
+        deadline: Option<Instant>,
+        s: &mut f64,
+    ) -> Result<Option<lattice::HeadRoute>, PlanError> {
+        let t = Instant::now();
+        let outcome = self
+            .lattice
+            .route_within(&self.ctx_min, start, goal, budget, deadline);
+        *s += t.elapsed().as_secs_f64();
+        match outcome {
+            lattice::LatticeOutcome::Found(r) if r.points.len() >= 2 => Ok(Some(r)),
+            lattice::LatticeOutcome::Separated { side, visited } => Err(PlanError::Separated {
+                radius: self.lattice.radius_min(),
+                side,
+                visited,
+                spacing: self.lattice.spacing(),
+            }),
+            _ => Ok(None),
+        }
+    }
+
+    /// Full-chain checks made so far by both contexts.
+    fn check_count(&self) -> u64 {
+        [self.ctx.stats(), self.ctx_min.stats()]
+            .iter()
+            .map(|c| c.configs + c.translations + c.shape_changes)
+            .sum()
+    }
+
+    /// The head route search.
+    pub fn lattice(&self) -> &lattice::HeadLattice {
+        &self.lattice
+    }
+
     /// Plans from `start` (head position and shape) to within the goal tolerance of
     /// `goal`. Calls [`Self::setup`] if needed.
     pub fn solve(
@@ -378,11 +479,11 @@ impl Planner {
         let deadline = stop.deadline(began);
         self.setup_until(deadline);
         let query_began = Instant::now();
-        let checks_before = self.ctx.stats();
-        self.ctx
+        let checks_before = self.check_count();
+        self.ctx_min
             .check_config(start, &start_shape)
             .map_err(|c| PlanError::StartInvalid(c.to_string()))?;
-        if !self.ctx.is_head_free(goal) {
+        if !self.ctx_min.is_head_free(goal) {
             let why = if self.ctx.field().grid().in_bounds(goal) {
                 format!(
                     "the head's sphere (radius + clearance) collides at {}",
@@ -393,6 +494,12 @@ impl Planner {
             };
             return Err(PlanError::GoalInvalid(why));
         }
+        // The head route over the lattice ([`lattice`]), searched when the uniform
+        // roadmap fails (where it works, it is cheaper in rooms and mazes): the route
+        // joins the roadmap, and a proof that none exists ends the query.
+        let mut route = None;
+        let (mut lattice_expanded, mut lattice_s) = (0, 0.0);
+        let mut lattice_done = !self.settings.head_lattice;
         // Like OMPL's PRM, grow the roadmap while the query fails and time remains.
         let mut growths = 0;
         let (steps, mut stats, size) = loop {
@@ -400,13 +507,36 @@ impl Planner {
                 return Err(PlanError::TimeLimit { replans: 0 });
             }
             let mut roadmap = self.roadmap.take().expect("setup built the roadmap");
-            let result =
-                Construction::new(self, &mut roadmap, start, start_shape, goal, stop, began).run();
+            let inner = route
+                .as_ref()
+                .map(|r: &lattice::HeadRoute| &r.points[1..r.points.len() - 1]);
+            let result = Construction::new(
+                self,
+                &mut roadmap,
+                (start, start_shape),
+                (goal, inner),
+                stop,
+                began,
+            )
+            .run();
             roadmap.clear_query();
             let size = (roadmap.vertex_count(), roadmap.edge_count());
             self.roadmap = Some(roadmap);
             match result {
                 Ok((steps, stats)) => break (steps, stats, size),
+                Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
+                    if !lattice_done && !expired(deadline) =>
+                {
+                    // The roadmap alone failed: now the full lattice search.
+                    lattice_done = true;
+                    let budget = self.lattice.budget;
+                    if let Some(r) =
+                        self.head_route(start, goal, budget, deadline, &mut lattice_s)?
+                    {
+                        lattice_expanded = r.expanded;
+                        route = Some(r);
+                    }
+                }
                 Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
                     if growths < self.settings.max_growth && !expired(deadline) =>
                 {
@@ -419,13 +549,24 @@ impl Planner {
                 {
                     return Err(PlanError::TimeLimit { replans: 0 })
                 }
+                Err(PlanError::NoShape {
+                    from, to, replans, ..
+                }) => {
+                    return Err(PlanError::NoShape {
+                        from,
+                        to,
+                        replans,
+                        narrowest: route.map(|r| (r.narrowest, r.narrowest_margin)),
+                    })
+                }
                 Err(e) => return Err(e),
             }
         };
         stats.roadmap_growths = growths;
-        let after = self.ctx.stats();
-        stats.collision_checks = (after.configs + after.translations + after.shape_changes)
-            - (checks_before.configs + checks_before.translations + checks_before.shape_changes);
+        stats.collision_checks = self.check_count() - checks_before;
+        stats.lattice_expanded = lattice_expanded;
+        stats.lattice_s = lattice_s;
+        stats.route_points = route.as_ref().map_or(0, |r| r.points.len());
         stats.roadmap_s = self.roadmap_s;
         stats.planning_s = query_began.elapsed().as_secs_f64();
         (stats.roadmap_vertices, stats.roadmap_edges) = size;
@@ -470,6 +611,22 @@ fn count_sources(steps: &[Step], stats: &mut Stats) {
     }
 }
 
+/// A lower bound on the head unit's margin (distance to the map minus `r_u`) along
+/// the segment `a b`, sampled every quarter voxel (m, at least 0).
+fn head_margin(ctx: &CollisionContext, a: [f64; 3], b: [f64; 3]) -> f64 {
+    let step = ctx.field().grid().resolution() / 4.0;
+    let n = (roadmap::dist(a, b) / step).ceil().max(1.0) as usize;
+    let r_u = ctx.params().unit_radius as f64;
+    (0..=n)
+        .map(|i| {
+            let t = i as f64 / n as f64;
+            let p = [0, 1, 2].map(|k| a[k] + t * (b[k] - a[k]));
+            ctx.clearance(p) - r_u
+        })
+        .fold(f64::INFINITY, f64::min)
+        .max(0.0)
+}
+
 /// One leg of a head edge: shape changes where the head is, then a translation.
 struct Leg {
     changes: Vec<Candidate>,
@@ -492,7 +649,7 @@ const FAILS_BEFORE_BACKING_UP: usize = 4;
 struct Construction<'p> {
     planner: &'p Planner,
     roadmap: &'p mut Roadmap,
-    checker: Checker<'p>,
+    checker: Checker,
     start: VertexId,
     goals: Vec<VertexId>,
     /// Cost-to-go of every vertex: the routes' heuristic.
@@ -503,20 +660,24 @@ struct Construction<'p> {
     stats: Stats,
     stop: Termination,
     began: Instant,
+    /// Edges flown below the preferred clearance: steps before, margin, where.
+    relaxed: Vec<(usize, f64, [f64; 3])>,
 }
 
 impl<'p> Construction<'p> {
     fn new(
         planner: &'p Planner,
         roadmap: &'p mut Roadmap,
-        start: [f64; 3],
-        shape: Shape,
-        goal: [f64; 3],
+        (start, shape): ([f64; 3], Shape),
+        (goal, route): ([f64; 3], Option<&[[f64; 3]]>),
         stop: Termination,
         began: Instant,
     ) -> Self {
         let s = roadmap.add_query_vertex(start);
         let g = roadmap.add_query_vertex(goal);
+        if let Some(inner) = route {
+            roadmap.add_route(&planner.ctx, s, inner, g);
+        }
         let tol = planner.settings.goal_tol;
         let mut goals = vec![g];
         goals.extend((0..roadmap.vertex_count()).filter(|&v| {
@@ -533,7 +694,7 @@ impl<'p> Construction<'p> {
             planner,
             roadmap,
             checker: Checker {
-                ctx: &planner.ctx,
+                ctx: planner.ctx.clone(),
                 time: Duration::ZERO,
                 deadline: stop.deadline(began),
             },
@@ -551,6 +712,7 @@ impl<'p> Construction<'p> {
             stats: Stats::default(),
             stop,
             began,
+            relaxed: Vec::new(),
         }
     }
 
@@ -611,6 +773,7 @@ impl<'p> Construction<'p> {
                         from,
                         to,
                         replans: self.stats.replans,
+                        narrowest: None,
                     });
                 }
                 let here = trail.last().map(|t| t.0).unwrap_or(self.start);
@@ -635,6 +798,7 @@ impl<'p> Construction<'p> {
                             from,
                             to,
                             replans: self.stats.replans,
+                            narrowest: None,
                         })
                     }
                 }
@@ -642,6 +806,13 @@ impl<'p> Construction<'p> {
             i = 0;
         }
         count_sources(&self.steps, &mut self.stats);
+        self.stats.min_margin = self.planner.ctx.clearance_margin();
+        for &(len, m, at) in &self.relaxed {
+            if len < self.steps.len() && m < self.stats.min_margin {
+                self.stats.min_margin = m;
+                self.stats.min_margin_at = Some(at);
+            }
+        }
         self.stats.collision_s = self.checker.time.as_secs_f64();
         Ok((self.steps, self.stats))
     }
@@ -673,8 +844,54 @@ impl<'p> Construction<'p> {
         }
     }
 
-    /// The legs that take the chain from `v` to `u`, or None.
+    /// The legs that take the chain from `v` to `u`, or None. On the head route (both
+    /// ends query vertices) the planner gives way to the smallest clearance when the
+    /// preferred one fails.
     fn connect(&mut self, v: VertexId, u: VertexId) -> Option<Vec<Leg>> {
+        if let Some(legs) = self.connect_at(v, u) {
+            return Some(legs);
+        }
+        let p = self.planner;
+        let (c_min, c_pref) = (p.ctx_min.clearance_margin(), p.ctx.clearance_margin());
+        if !(c_min < c_pref && self.roadmap.is_query(v) && self.roadmap.is_query(u)) {
+            return None;
+        }
+        // Give way step by step: first to 90 % of the head's own margin along the
+        // edge (what the passage leaves on its narrowest side), then to the floor.
+        let (a, b) = (self.roadmap.point(v), self.roadmap.point(u));
+        let head = head_margin(&p.ctx, a, b);
+        let mid = ((0.9 * head * 1000.0).floor() / 1000.0).clamp(c_min, c_pref);
+        let mut levels = vec![(mid, None)];
+        if mid > c_min {
+            levels.push((c_min, Some(p.ctx_min.clone())));
+        }
+        let mut legs = None;
+        for (c, ctx) in levels {
+            let ctx = match ctx {
+                Some(x) => x,
+                None => {
+                    match CollisionContext::new(p.ctx.field_arc().clone(), *p.ctx.params(), c) {
+                        Ok(mut x) => {
+                            x.set_min_step(p.ctx.min_step());
+                            x
+                        }
+                        Err(_) => continue,
+                    }
+                }
+            };
+            self.checker.ctx = ctx;
+            legs = self.connect_at(v, u);
+            if legs.is_some() {
+                self.relaxed.push((self.steps.len(), c, a));
+                break;
+            }
+        }
+        self.checker.ctx = p.ctx.clone();
+        legs
+    }
+
+    /// [`Self::connect`] at the checker's clearance.
+    fn connect_at(&mut self, v: VertexId, u: VertexId) -> Option<Vec<Leg>> {
         let (a, b) = (self.roadmap.point(v), self.roadmap.point(u));
         if let Some(changes) = self.connect_rigid(a, b) {
             return Some(vec![Leg { changes, to: b }]);

@@ -48,6 +48,8 @@ pub fn to_plan(
         ("collision_checks", st.collision_checks),
         ("roadmap_vertices", st.roadmap_vertices as u64),
         ("roadmap_edges", st.roadmap_edges as u64),
+        ("lattice_expanded", st.lattice_expanded as u64),
+        ("route_points", st.route_points as u64),
     ];
     let timing = Timing {
         roadmap_s: st.roadmap_s,
@@ -70,6 +72,13 @@ pub fn to_plan(
         .collect();
     plan.stats
         .insert("waypoint_sources".into(), Value::Array(labels));
+    // The smallest clearance margin in force, and where (docs/model.md "Files").
+    plan.stats
+        .insert("min_margin".into(), serde_json::json!(st.min_margin));
+    if let Some(at) = st.min_margin_at {
+        plan.stats
+            .insert("min_margin_at".into(), serde_json::json!(at));
+    }
     plan
 }
 

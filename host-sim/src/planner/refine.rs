@@ -104,7 +104,7 @@ impl Planner {
         let began = Instant::now();
         let mut pass = Pass {
             checker: Checker {
-                ctx: &self.ctx,
+                ctx: self.ctx.clone(),
                 time: std::time::Duration::ZERO,
                 deadline,
             },
@@ -127,7 +127,7 @@ impl Planner {
 
 /// One refinement pass over a plan's poses.
 struct Pass<'a> {
-    checker: Checker<'a>,
+    checker: Checker,
     poses: &'a [Step],
     checks: u64,
 }

@@ -239,6 +239,72 @@ impl Roadmap {
         id
     }
 
+    /// Adds a head route (from the lattice search, [`super::lattice`]) between the query
+    /// vertices `from` and `to`: its inner points become query vertices chained by
+    /// edges known to be free (the route was pulled taut with the head's check) that
+    /// weigh their length, so the route is the cheapest way. Each route vertex is also
+    /// joined to the sampled vertices within `r_T`, by edges weighted by clearance as
+    /// the roadmap's own, so that replanning can leave the route. Removed by
+    /// [`Self::clear_query`]. Returns the route's vertices, `from` and `to` included.
+    pub fn add_route(
+        &mut self,
+        ctx: &CollisionContext,
+        from: VertexId,
+        inner: &[[f64; 3]],
+        to: VertexId,
+    ) -> Vec<VertexId> {
+        let (w, r) = (self.clearance_weight, self.clearance_ref.max(1e-9));
+        let mut ids = vec![from];
+        for &p in inner {
+            let id = self.points.len();
+            let c = ctx.clearance(p);
+            self.points.push(p);
+            self.clearance.push(c);
+            self.edges.push(Vec::new());
+            let mut near = self
+                .tree
+                .within_unsorted::<SquaredEuclidean>(&p, self.r_t * self.r_t);
+            near.sort_by_key(|n| n.item);
+            for n in near {
+                let j = n.item as usize;
+                let cj = c.min(self.clearance[j]);
+                let length = n.distance.sqrt() * (1.0 + w * (1.0 - cj / r).max(0.0));
+                for (x, y) in [(id, j), (j, id)] {
+                    self.edges[x].push(Edge {
+                        to: y,
+                        length,
+                        state: Cell::new(EdgeState::Unchecked),
+                    });
+                }
+            }
+            ids.push(id);
+        }
+        ids.push(to);
+        for wnd in ids.windows(2) {
+            let (a, b) = (wnd[0], wnd[1]);
+            let length = dist(self.points[a], self.points[b]);
+            for (x, y) in [(a, b), (b, a)] {
+                match self.edges[x].iter_mut().find(|e| e.to == y) {
+                    Some(e) => {
+                        e.length = length;
+                        e.state.set(EdgeState::Free);
+                    }
+                    None => self.edges[x].push(Edge {
+                        to: y,
+                        length,
+                        state: Cell::new(EdgeState::Free),
+                    }),
+                }
+            }
+        }
+        ids
+    }
+
+    /// Whether `v` is a query vertex (start, goal or route), not a sampled one.
+    pub fn is_query(&self, v: VertexId) -> bool {
+        v >= self.sampled
+    }
+
     /// Removes the query vertices and their edges; the sampled roadmap and what is
     /// known about its edges stay.
     pub fn clear_query(&mut self) {

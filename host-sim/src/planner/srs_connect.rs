@@ -29,15 +29,15 @@ use super::Checker;
 
 /// Lazy answers to "is shape `v` valid at `xi_i`" and "is it admissible along the
 /// edge": each asked at most once, and only for shapes the search reaches.
-struct Oracle<'c, 'p> {
-    checker: &'c mut Checker<'p>,
+struct Oracle<'c> {
+    checker: &'c mut Checker,
     from: [f64; 3],
     to: [f64; 3],
     valid: Vec<Option<bool>>,
     admissible: Vec<Option<bool>>,
 }
 
-impl Oracle<'_, '_> {
+impl Oracle<'_> {
     fn valid(&mut self, v: usize, nodes: &[Candidate]) -> bool {
         if self.valid[v].is_none() {
             self.valid[v] = Some(self.checker.placement(self.from, &nodes[v].shape));
@@ -64,7 +64,7 @@ impl Oracle<'_, '_> {
 /// placement is checked when the search first reaches it, its admissibility when
 /// it is the nearest open shape. The answer is the one the eager sets would give.
 pub fn connect(
-    checker: &mut Checker<'_>,
+    checker: &mut Checker,
     from: [f64; 3],
     to: [f64; 3],
     current: &Candidate,
@@ -180,7 +180,7 @@ impl<'a> Graph<'a> {
 /// the change is checked (at `xi_i`: limits, self-collision, map) when that entry
 /// is popped, and a failed one is dropped, which prunes that edge. So each edge is
 /// checked at most once and the path returned is checked throughout.
-fn cheapest(graph: &mut Graph<'_>, oracle: &mut Oracle<'_, '_>) -> Option<Vec<usize>> {
+fn cheapest(graph: &mut Graph<'_>, oracle: &mut Oracle<'_>) -> Option<Vec<usize>> {
     let n = graph.nodes.len();
     let nodes = graph.nodes;
     let mut parent = vec![usize::MAX; n];

@@ -1,0 +1,205 @@
+//! `arc bench robust`: the ARCplanner with `arc plan`'s defaults on random instances of
+//! the hard-case family ([`crate::map::passages`]), N = 4..8.
+//!
+//! Each instance is drawn from a seeded generator; it is kept only when its witness
+//! (follow-the-leader along the hand-made centre line, checked by the exact verifier,
+//! no planner involved) proves it solvable for its N, and redrawn otherwise; the count
+//! of redraws is reported. Every plan is verified exactly. Maps are built in chunks so
+//! that memory stays bounded.
+
+use rand::{Rng, SeedableRng};
+
+use super::{plot, run_all, ArcMode, Envs, Method, RunResult, RunSpec, Spread};
+use crate::map::passages::{witness, PassageSpec};
+
+/// Options of the study.
+#[derive(Clone, Debug)]
+pub struct RobustOptions {
+    /// Instances.
+    pub instances: usize,
+    /// Seed of the instance generator (the planner's seed is the instance index + 1).
+    pub seed: u64,
+    /// Head roadmap vertices.
+    pub vertices: usize,
+    /// Random shapes.
+    pub srs: usize,
+    /// Time limit per query (s).
+    pub time_limit: Option<f64>,
+}
+
+impl RobustOptions {
+    /// The full study: 200 instances.
+    pub fn full() -> Self {
+        Self {
+            instances: 200,
+            seed: 1,
+            vertices: 1500,
+            srs: 500,
+            time_limit: Some(30.0),
+        }
+    }
+}
+
+/// The drawn instances and how many draws were redrawn for lack of a witness.
+pub fn draw(o: &RobustOptions) -> (Vec<RunSpec>, usize) {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(o.seed);
+    let mut specs = Vec::with_capacity(o.instances);
+    let mut redrawn = 0;
+    while specs.len() < o.instances {
+        let p = PassageSpec::random(&mut rng);
+        let units: u8 = rng.gen_range(4..=8);
+        let ok = p.build().ok().is_some_and(|sc| {
+            arc_core::ChainParams::new(units)
+                .validate()
+                .is_ok_and(|params| witness(&sc, &params).is_ok())
+        });
+        if !ok {
+            redrawn += 1;
+            continue;
+        }
+        specs.push(RunSpec {
+            study: "robust".into(),
+            scenario: p.name(),
+            units,
+            method: Method::Arc(ArcMode::Follow),
+            vertices: o.vertices,
+            srs: o.srs,
+            seed: specs.len() as u64 + 1,
+            time_limit: o.time_limit,
+            query: None,
+        });
+    }
+    (specs, redrawn)
+}
+
+/// Runs the specs in chunks of `chunk` maps.
+pub fn run(
+    specs: &[RunSpec],
+    threads: Option<usize>,
+    chunk: usize,
+) -> Result<Vec<RunResult>, String> {
+    let mut out = Vec::with_capacity(specs.len());
+    let bar = indicatif::ProgressBar::new(specs.len() as u64);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "arc bench robust [{bar:40}] {pos}/{len} instances ({elapsed}, eta {eta})",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    for part in specs.chunks(chunk.max(1)) {
+        let envs = Envs::for_specs(part)?;
+        out.extend(run_all(&envs, part, threads, "arc bench robust", false)?);
+        bar.inc(part.len() as u64);
+    }
+    bar.finish_and_clear();
+    Ok(out)
+}
+
+/// The `q`-quantile of `v` (nearest rank), 0 when empty.
+fn quantile(v: &[f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    s[((q * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1]
+}
+
+/// The markdown summary.
+pub fn markdown(results: &[RunResult], redrawn: usize, meta: &str) -> String {
+    let n = results.len();
+    let solved: Vec<&RunResult> = results.iter().filter(|r| r.success).collect();
+    let verified = solved.iter().filter(|r| r.verified == Some(true)).count();
+    let ms =
+        |f: &dyn Fn(&RunResult) -> f64| -> Vec<f64> { solved.iter().map(|r| f(r) * 1e3).collect() };
+    let road = ms(&|r| r.roadmap_s);
+    let plan = ms(&|r| r.planning_s);
+    let total = ms(&|r| r.roadmap_s + r.planning_s);
+    let mut s = String::new();
+    s += "# Robustness: the hard-case family (`arc bench robust`)\n\n";
+    s += &format!(
+        "{n} random instances of `passage:` (windows 0.45-0.6 m, walls 0.1-0.3 m, approach 0-60 degrees either way, \
+         offsets up to 0.3 m, a second wall with a door in half), N = 4..8, `arc plan`'s defaults. \
+         Every instance has a witness checked by the exact verifier; {redrawn} draws without one were redrawn.\n\n"
+    );
+    s += "| instances | solved | verified | roadmap median / p95 (ms) | planning median / p95 (ms) | total median / p95 (ms) |\n|---|---|---|---|---|---|\n";
+    s += &format!(
+        "| {n} | {} ({:.1} %) | {verified} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} / {:.1} |\n\n",
+        solved.len(),
+        100.0 * solved.len() as f64 / n.max(1) as f64,
+        quantile(&road, 0.5),
+        quantile(&road, 0.95),
+        quantile(&plan, 0.5),
+        quantile(&plan, 0.95),
+        quantile(&total, 0.5),
+        quantile(&total, 0.95),
+    );
+    s += "| N | instances | solved | planning median (ms) |\n|---|---|---|---|\n";
+    for u in 4..=8u8 {
+        let all: Vec<&RunResult> = results.iter().filter(|r| r.spec.units == u).collect();
+        let ok: Vec<f64> = all
+            .iter()
+            .filter(|r| r.success)
+            .map(|r| r.planning_s * 1e3)
+            .collect();
+        s += &format!(
+            "| {u} | {} | {} | {:.1} |\n",
+            all.len(),
+            ok.len(),
+            Spread::of(ok.iter().copied()).median
+        );
+    }
+    let failed: Vec<&RunResult> = results.iter().filter(|r| !r.success).collect();
+    if !failed.is_empty() {
+        s += "\nFailures:\n\n";
+        for r in failed {
+            s += &format!(
+                "- `{}` N = {}: {} ({})\n",
+                r.spec.scenario, r.spec.units, r.outcome, r.message
+            );
+        }
+    }
+    s += &format!("\n{meta}\n");
+    s
+}
+
+/// The figure: sorted roadmap and planning times of the solved instances.
+pub fn figure(results: &[RunResult]) -> Result<String, String> {
+    let sorted = |f: &dyn Fn(&RunResult) -> f64| -> Vec<(f64, f64, f64, f64)> {
+        let mut v: Vec<f64> = results
+            .iter()
+            .filter(|r| r.success)
+            .map(|r| (f(r) * 1e3).max(1e-3))
+            .collect();
+        v.sort_by(f64::total_cmp);
+        let n = v.len().max(1) as f64;
+        v.iter()
+            .enumerate()
+            .map(|(i, &t)| (100.0 * (i + 1) as f64 / n, t, t, t))
+            .collect()
+    };
+    let curves = vec![
+        plot::Curve {
+            label: "planning (query)".into(),
+            colour: plotters::style::RGBColor(200, 60, 40),
+            points: sorted(&|r| r.planning_s),
+        },
+        plot::Curve {
+            label: "roadmap".into(),
+            colour: plotters::style::RGBColor(40, 90, 200),
+            points: sorted(&|r| r.roadmap_s),
+        },
+    ];
+    let hi = curves
+        .iter()
+        .flat_map(|c| c.points.iter().map(|p| p.1))
+        .fold(1.0f64, f64::max);
+    let chart = plot::Chart {
+        title: "arc bench robust: times of the solved instances, sorted".into(),
+        x_label: "instances (%)".into(),
+        y_label: "time (ms)".into(),
+        log_y: true,
+        y_range: (0.1, hi * 2.0),
+        curves,
+    };
+    plot::svg(&[chart], 1, 1, (900, 500))
+}

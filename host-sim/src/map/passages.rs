@@ -1,0 +1,307 @@
+//! A parametric family of hard cases: tight, oblique openings (issue 13).
+//!
+//! `passage:KEY=VALUE,...` builds a room (at 0.05 m by default) split by a wall with
+//! a square window, approached obliquely and off centre, optionally followed by a
+//! second wall with a door:
+//!
+//! | key | default | meaning |
+//! |---|---|---|
+//! | `w` | 0.5 | window width and height (m), 0.4 to 1.0, widened to whole voxels |
+//! | `angle` | 45 | approach angle off the wall's normal (degrees), -60 to 60 |
+//! | `offset` | 0 | window centre off the room's axis (m), -0.4 to 0.4 |
+//! | `wall` | 0.2 | wall thickness (m), 0.1 to 0.3 |
+//! | `door` | none | width (m) of a door in a second wall 2.5 m behind the first, 0.4 to 1.0 |
+//! | `door_offset` | 0 | door centre off the room's axis (m), -0.4 to 0.4 |
+//! | `res` | 0.05 | map resolution (m), 0.025 to 0.1 |
+//! | `sealed` | 0 | 1: the window is walled up (no way through; for failure reports) |
+//!
+//! Every instance carries a hand-made centre line ([`Scenario::route`]): straight in
+//! along the approach, a turn 1 m before the wall onto its normal, straight through the
+//! window's centre (and on through the door). [`witness`] lays the chain along it,
+//! follow-the-leader fashion, and the exact verifier checks the result: an instance
+//! with a witness is solvable, whatever the planner does.
+
+use arc_core::ChainParams;
+
+use super::grid::{Cell, Grid};
+use super::scenarios::Scenario;
+use crate::collision::verify_plan;
+
+/// Parameters of one instance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassageSpec {
+    /// Window width and height (m).
+    pub w: f64,
+    /// Approach angle off the wall's normal (degrees).
+    pub angle_deg: f64,
+    /// Window centre off the room's axis (m).
+    pub offset: f64,
+    /// Wall thickness (m).
+    pub wall: f64,
+    /// Door in a second wall: width (m) and offset (m).
+    pub door: Option<(f64, f64)>,
+    /// Map resolution (m).
+    pub res: f64,
+    /// The window is walled up: start and goal in separate free regions.
+    pub sealed: bool,
+}
+
+impl Default for PassageSpec {
+    fn default() -> Self {
+        Self {
+            w: 0.5,
+            angle_deg: 45.0,
+            offset: 0.0,
+            wall: 0.2,
+            door: None,
+            res: 0.05,
+            sealed: false,
+        }
+    }
+}
+
+/// Room width (y) and height (z), m.
+const ROOM_Y: f64 = 10.0;
+const ROOM_Z: f64 = 2.6;
+/// Outer shell thickness (m).
+const SHELL: f64 = 0.2;
+/// Where the first wall begins (x, m).
+const WALL_X: f64 = 6.0;
+/// Gap between the first wall and the second (m).
+const WALL_GAP: f64 = 2.5;
+/// Height of the window's centre (m).
+const Z_C: f64 = 1.3;
+
+impl PassageSpec {
+    /// Parses `KEY=VALUE,...` (see the module docs).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let mut s = Self::default();
+        let mut door_offset = 0.0;
+        let mut door = None;
+        for part in text.split(',').filter(|p| !p.trim().is_empty()) {
+            let (k, v) = part
+                .split_once('=')
+                .ok_or_else(|| format!("{part:?}: expected KEY=VALUE"))?;
+            let v: f64 = v
+                .trim()
+                .parse()
+                .map_err(|_| format!("{part:?}: {v:?} is not a number"))?;
+            match k.trim() {
+                "w" => s.w = v,
+                "angle" => s.angle_deg = v,
+                "offset" => s.offset = v,
+                "wall" => s.wall = v,
+                "door" => door = Some(v),
+                "door_offset" => door_offset = v,
+                "res" => s.res = v,
+                "sealed" => s.sealed = v != 0.0,
+                other => {
+                    return Err(format!(
+                    "unknown key {other:?}; known: w, angle, offset, wall, door, door_offset, res, sealed"
+                ))
+                }
+            }
+        }
+        s.door = door.map(|d| (d, door_offset));
+        s.check()?;
+        Ok(s)
+    }
+
+    /// Checks the ranges of the module docs.
+    pub fn check(&self) -> Result<(), String> {
+        let within = |name: &str, v: f64, lo: f64, hi: f64| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(format!("{name} = {v} is outside {lo}..={hi}"))
+            }
+        };
+        within("w", self.w, 0.4, 1.0)?;
+        within("angle", self.angle_deg, -60.0, 60.0)?;
+        within("offset", self.offset, -0.4, 0.4)?;
+        within("wall", self.wall, 0.1, 0.3)?;
+        within("res", self.res, 0.025, 0.1)?;
+        if let Some((d, o)) = self.door {
+            within("door", d, 0.4, 1.0)?;
+            within("door_offset", o, -0.4, 0.4)?;
+        }
+        Ok(())
+    }
+
+    /// The name that builds this instance.
+    pub fn name(&self) -> String {
+        let mut n = format!(
+            "passage:w={},angle={},offset={},wall={}",
+            self.w, self.angle_deg, self.offset, self.wall
+        );
+        if let Some((d, o)) = self.door {
+            n += &format!(",door={d},door_offset={o}");
+        }
+        if self.res != 0.05 {
+            n += &format!(",res={}", self.res);
+        }
+        if self.sealed {
+            n += ",sealed=1";
+        }
+        n
+    }
+
+    /// A random instance of the family (widths 0.45-0.6 m, walls 0.1-0.3 m, angles
+    /// up to 60 degrees either way, offsets up to 0.3 m, a door half of the time),
+    /// rounded to the centimetre and degree so that names stay short.
+    pub fn random(rng: &mut impl rand::Rng) -> Self {
+        let cm = |v: f64| (v * 100.0).round() / 100.0;
+        let door = rng
+            .gen_bool(0.5)
+            .then(|| (cm(rng.gen_range(0.5..=0.8)), cm(rng.gen_range(-0.3..=0.3))));
+        Self {
+            w: cm(rng.gen_range(0.45..=0.6)),
+            angle_deg: rng.gen_range(-60.0f64..=60.0).round(),
+            offset: cm(rng.gen_range(-0.3..=0.3)),
+            wall: cm(rng.gen_range(0.1..=0.3)),
+            door,
+            res: 0.05,
+            sealed: false,
+        }
+    }
+
+    /// The scenario.
+    pub fn build(&self) -> Result<Scenario, String> {
+        self.check()?;
+        let r = self.res;
+        let snap = |v: f64| (v / r).round() * r;
+        // Openings: faces on the lattice, outward (at least as wide as asked).
+        let down = |v: f64| (v / r + 1e-6).floor() * r;
+        let up = |v: f64| (v / r - 1e-6).ceil() * r;
+        let t = snap(self.wall).max(2.0 * r);
+        let yc = ROOM_Y / 2.0 + self.offset;
+        let wall2 = self.door.map(|_| WALL_X + t + WALL_GAP);
+        let sx = snap(match wall2 {
+            Some(x2) => x2 + 0.2 + 3.0,
+            None => WALL_X + t + 3.5,
+        });
+        let dims = [sx, ROOM_Y, ROOM_Z].map(|v| (v / r).round() as usize);
+        let mut g =
+            Grid::new(r, [0; 3], dims, Cell::Occupied, true).map_err(|e| format!("grid: {e}"))?;
+        let e = 1e-6;
+        let fill = |g: &mut Grid, lo: [f64; 3], hi: [f64; 3], c: Cell| {
+            g.fill_box(
+                [lo[0] + e, lo[1] + e, lo[2] + e],
+                [hi[0] - e, hi[1] - e, hi[2] - e],
+                c,
+            )
+        };
+        let size = [dims[0] as f64 * r, dims[1] as f64 * r, dims[2] as f64 * r];
+        fill(
+            &mut g,
+            [SHELL; 3],
+            [size[0] - SHELL, size[1] - SHELL, size[2] - SHELL],
+            Cell::Free,
+        );
+        fill(
+            &mut g,
+            [WALL_X, 0.0, 0.0],
+            [WALL_X + t, size[1], size[2]],
+            Cell::Occupied,
+        );
+        // The window's faces on the lattice, as near the asked ones as it allows; the
+        // route goes through the centre of what is built.
+        let hw = self.w / 2.0;
+        let (y0, y1) = (down(yc - hw), up(yc + hw));
+        let (z0, z1) = (down(Z_C - hw), up(Z_C + hw));
+        let (yc, zc) = ((y0 + y1) / 2.0, (z0 + z1) / 2.0);
+        if !self.sealed {
+            fill(&mut g, [WALL_X, y0, z0], [WALL_X + t, y1, z1], Cell::Free);
+        }
+        let mut goal = [WALL_X + t + 1.5, yc, zc];
+        let a = self.angle_deg.to_radians();
+        let turn = [WALL_X - 1.0, yc, zc];
+        let start = [turn[0] - a.cos(), turn[1] - a.sin(), zc];
+        let mut route = vec![start, turn, [WALL_X + t + 0.8, yc, zc]];
+        if let (Some(x2), Some((dw, doff))) = (wall2, self.door) {
+            let (d0, d1) = (
+                down(ROOM_Y / 2.0 + doff - dw / 2.0),
+                up(ROOM_Y / 2.0 + doff + dw / 2.0),
+            );
+            let yd = (d0 + d1) / 2.0;
+            fill(
+                &mut g,
+                [x2, 0.0, 0.0],
+                [x2 + 0.2, size[1], size[2]],
+                Cell::Occupied,
+            );
+            fill(&mut g, [x2, d0, SHELL], [x2 + 0.2, d1, 2.0], Cell::Free);
+            route.push([x2 - 0.8, yd, zc]);
+            goal = [x2 + 0.2 + 1.5, yd, zc];
+        }
+        route.push(goal);
+        let door_text = match self.door {
+            Some((d, o)) => format!(
+                ", then a second wall {WALL_GAP} m behind it with a door {d} m wide ({o:+} m off the axis)"
+            ),
+            None => String::new(),
+        };
+        Ok(Scenario {
+            name: self.name(),
+            description: format!(
+                "A room at {r} m with a {t} m wall holding a {w} m x {w} m window {off:+} m off the \
+                 axis, approached at {ang} degrees off its normal{door_text}.",
+                w = self.w,
+                off = self.offset,
+                ang = self.angle_deg
+            ),
+            grid: g,
+            start,
+            start_yaw: a,
+            goal,
+            default_units: 5,
+            route,
+        })
+    }
+}
+
+/// The witness of an instance for a chain: the follow-the-leader plan along the
+/// scenario's centre line ([`Scenario::route_plan`], steps of a quarter voxel),
+/// checked by the EXACT verifier. `Err` says why there is none.
+pub fn witness(sc: &Scenario, params: &ChainParams) -> Result<crate::plan::Plan, String> {
+    let plan = sc.route_plan(params, sc.grid.resolution())?;
+    let report = verify_plan(&sc.grid, &plan);
+    if !report.ok {
+        return Err(format!("witness is invalid: {:?}", report.violation));
+    }
+    Ok(plan)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_ranges_are_checked() {
+        let s = PassageSpec::parse("w=0.5,angle=45,door=0.7,door_offset=-0.2").unwrap();
+        assert_eq!(s.door, Some((0.7, -0.2)));
+        assert_eq!(
+            PassageSpec::parse(&s.name()["passage:".len()..]).unwrap(),
+            s
+        );
+        assert!(PassageSpec::parse("w=0.3").is_err());
+        assert!(PassageSpec::parse("angle=80").is_err());
+        assert!(PassageSpec::parse("nope=1").is_err());
+        assert!(PassageSpec::parse("w").is_err());
+    }
+
+    #[test]
+    fn the_window_is_as_wide_as_asked_and_the_witness_flies() {
+        let s = PassageSpec::default();
+        let sc = s.build().unwrap();
+        // The wall is solid beside the window and open in it.
+        let g = &sc.grid;
+        let y = ROOM_Y / 2.0;
+        assert!(!g.is_obstacle_at([WALL_X + 0.1, y, Z_C]));
+        assert!(g.is_obstacle_at([WALL_X + 0.1, y + 0.3, Z_C]));
+        assert!(g.is_obstacle_at([WALL_X + 0.1, y, Z_C + 0.3]));
+        for n in [4u8, 6, 8] {
+            witness(&sc, &ChainParams::new(n)).unwrap();
+        }
+    }
+}

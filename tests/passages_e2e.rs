@@ -1,0 +1,107 @@
+//! End to end on the hard-case family (issue 13): tight, oblique openings, a map cut
+//! in two, checked by the exact verifier (`verify_plan`), never by the planner.
+
+use std::path::Path;
+
+use arc_host_sim::cli;
+use arc_host_sim::collision::verify_plan;
+use arc_host_sim::map::grid::{Cell, Grid};
+use arc_host_sim::map::passages::{witness, PassageSpec};
+use arc_host_sim::map::scenarios;
+use arc_host_sim::plan::Plan;
+
+fn arc(args: &[&str]) -> Result<(), cli::CliError> {
+    let mut v = vec!["arc"];
+    v.extend_from_slice(args);
+    cli::run(v)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+/// Plans `scenario` with default flags, verifies exactly; returns the plan.
+fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
+    let out = dir.join(format!("plan-{units}.json"));
+    let n = units.to_string();
+    arc(&[
+        "plan",
+        "--scenario",
+        scenario,
+        "--units",
+        &n,
+        "--out",
+        s(&out),
+    ])
+    .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
+    let plan = Plan::read(&out).expect("plan reads back");
+    let sc = scenarios::build(scenario).expect("family instance");
+    let report = verify_plan(&sc.grid, &plan);
+    assert!(report.ok, "{scenario} N={units}: {:?}", report.violation);
+    let last = plan.waypoints[plan.waypoints.len() - 1].xi();
+    let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
+    assert!(d <= 0.3 + 1e-9, "ends {d} m from the goal");
+    assert!(plan.stats.contains_key("min_margin"));
+    plan
+}
+
+#[test]
+fn half_metre_windows_at_45_degrees_plan_for_5_and_6_units() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, n) in [
+        ("passage:w=0.5,angle=45", 5u8),
+        ("passage:w=0.5,angle=45,offset=0.2,wall=0.3", 6),
+        ("passage:w=0.5,angle=-45,door=0.6,door_offset=0.2", 6),
+    ] {
+        // Solvable by a witness that does not use the planner.
+        let sc = scenarios::build(name).unwrap();
+        witness(&sc, &arc_core::ChainParams::new(n)).unwrap();
+        plan_and_verify(name, n, dir.path());
+    }
+}
+
+#[test]
+fn family_names_parse_and_build() {
+    let spec = PassageSpec::parse("w=0.55,angle=30,door=0.7").unwrap();
+    let sc = scenarios::build(&spec.name()).unwrap();
+    assert_eq!(sc.name, spec.name());
+    assert!(scenarios::build("passage:w=2").is_err());
+}
+
+#[test]
+fn a_map_cut_in_two_exits_1_with_the_reason_whatever_max_growth_says() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut g = Grid::new(0.1, [0, 0, 0], [80, 40, 30], Cell::Free, true).unwrap();
+    let wall = |g: &mut Grid, lo: [f64; 3], hi: [f64; 3]| g.fill_box(lo, hi, Cell::Occupied);
+    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 4.0, 0.2]);
+    wall(&mut g, [0.0, 0.0, 2.8], [8.0, 4.0, 3.0]);
+    wall(&mut g, [0.0, 0.0, 0.0], [0.2, 4.0, 3.0]);
+    wall(&mut g, [7.8, 0.0, 0.0], [8.0, 4.0, 3.0]);
+    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 0.2, 3.0]);
+    wall(&mut g, [0.0, 3.8, 0.0], [8.0, 4.0, 3.0]);
+    wall(&mut g, [3.9, 0.0, 0.0], [4.1, 4.0, 3.0]);
+    let map = dir.path().join("cut.bt");
+    g.to_octree().unwrap().write_bt(&map).unwrap();
+    let out = dir.path().join("p.json");
+    let e = arc(&[
+        "plan",
+        "--map",
+        s(&map),
+        "--units",
+        "4",
+        "--start",
+        "3,2,1.5",
+        "--start-yaw-deg",
+        "0",
+        "--goal",
+        "6,2,1.5",
+        "--max-growth",
+        "8",
+        "--out",
+        s(&out),
+    ])
+    .unwrap_err();
+    assert_eq!(e.code, 1, "{e}");
+    assert!(e.message.contains("separate free regions"), "{e}");
+    assert!(!out.exists());
+}
