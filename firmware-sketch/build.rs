@@ -5,7 +5,7 @@
 //! 2. Makes the shape-table image for the table flash slot: a little-endian
 //!    `u32` length and the table blob. The blob is the file named by `ARC_TABLE`
 //!    (e.g. the output of `arc tables build`) or, by default, a table generated
-//!    here with arc-core's own generators and encoder for the chain this unit is
+//!    here with aerial-chain-core's own generators and encoder for the chain this unit is
 //!    built for. With feature `corrupt-table` one byte in its middle is flipped;
 //!    with feature `external-table` no table is made (the slot is flashed apart).
 //! 3. Writes `unit_config.rs`: the build-time constants of this unit.
@@ -94,15 +94,15 @@ fn main() {
     fs::write(out.join("unit_config.rs"), config).expect("write unit_config.rs");
 }
 
-/// Table generation with arc-core's generators and encoder (host side).
+/// Table generation with aerial-chain-core's generators and encoder (host side).
 mod tables {
-    use arc_core::lsc::library;
-    use arc_core::srs::{build_roadmap, Neighbours, Sampler, SrsSettings};
-    use arc_core::table::encode_into;
-    use arc_core::{ChainParams, Shape, MAX_SHAPE_DIM, MAX_UNITS};
+    use aerial_chain_core::lsc::library;
+    use aerial_chain_core::srs::{build_roadmap, Neighbours, Sampler, SrsSettings};
+    use aerial_chain_core::table::encode_into;
+    use aerial_chain_core::{ChainParams, Shape, MAX_SHAPE_DIM, MAX_UNITS};
 
     /// Roadmap degree cap of a generated table: the host's
-    /// (`arc_host_sim::tables::DEGREE`), so both make the same bytes.
+    /// (`aerial_chain::tables::DEGREE`), so both make the same bytes.
     const DEGREE: usize = 12;
 
     /// The table for `units` units (docs/model.md default parameters): the full

@@ -4,11 +4,11 @@
 
 use std::path::PathBuf;
 
-use arc_host_sim::bench::{self, ArcMode, Method, RunSpec};
-use arc_host_sim::cli;
-use arc_host_sim::collision::verify_plan;
-use arc_host_sim::map::scenarios;
-use arc_host_sim::plan::Plan;
+use aerial_chain::bench::{self, ArcMode, Method, RunSpec};
+use aerial_chain::cli;
+use aerial_chain::collision::verify_plan;
+use aerial_chain::map::scenarios;
+use aerial_chain::plan::Plan;
 
 /// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {

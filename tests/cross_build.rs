@@ -1,4 +1,4 @@
-//! `arc-core` must build for the units' autopilots: thumbv7em-none-eabihf
+//! `aerial-chain-core` must build for the units' autopilots: thumbv7em-none-eabihf
 //! (Cortex-M4F/M7F), no_std, no alloc, with and without its `defmt` feature.
 
 use arc_tests::{cargo, require_thumbv7em_target};
@@ -10,7 +10,7 @@ fn build_core(features: &[&str]) {
         "build",
         "--release",
         "-p",
-        "arc-core",
+        "aerial-chain-core",
         "--target",
         "thumbv7em-none-eabihf",
     ]);
@@ -20,7 +20,7 @@ fn build_core(features: &[&str]) {
     let out = c.output().expect("cargo runs");
     assert!(
         out.status.success(),
-        "arc-core failed to build for thumbv7em-none-eabihf (features {features:?}):\n{}",
+        "aerial-chain-core failed to build for thumbv7em-none-eabihf (features {features:?}):\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
 }

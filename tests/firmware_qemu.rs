@@ -23,11 +23,11 @@ use std::sync::atomic::AtomicUsize;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use arc_core::lsc::library;
-use arc_core::srs::{Srs, SrsSettings};
-use arc_core::table::{encode_into, TableView};
-use arc_core::ChainParams;
-use arc_host_sim::tables::{ShapeTables, TableSettings};
+use aerial_chain::tables::{ShapeTables, TableSettings};
+use aerial_chain_core::lsc::library;
+use aerial_chain_core::srs::{Srs, SrsSettings};
+use aerial_chain_core::table::{encode_into, TableView};
+use aerial_chain_core::ChainParams;
 use arc_tests::{cargo, require_thumbv7em_target, require_tool, workspace_root};
 use defmt_decoder::{DecodeError, Table};
 

@@ -3,12 +3,12 @@
 
 use std::path::Path;
 
-use arc_host_sim::cli;
-use arc_host_sim::collision::verify_plan;
-use arc_host_sim::map::grid::{Cell, Grid};
-use arc_host_sim::map::passages::{witness, PassageSpec};
-use arc_host_sim::map::scenarios;
-use arc_host_sim::plan::Plan;
+use aerial_chain::cli;
+use aerial_chain::collision::verify_plan;
+use aerial_chain::map::grid::{Cell, Grid};
+use aerial_chain::map::passages::{witness, PassageSpec};
+use aerial_chain::map::scenarios;
+use aerial_chain::plan::Plan;
 
 fn arc(args: &[&str]) -> Result<(), cli::CliError> {
     let mut v = vec!["arc"];
@@ -55,7 +55,7 @@ fn half_metre_windows_at_45_degrees_plan_for_5_and_6_units() {
     ] {
         // Solvable by a witness that does not use the planner.
         let sc = scenarios::build(name).unwrap();
-        witness(&sc, &arc_core::ChainParams::new(n)).unwrap();
+        witness(&sc, &aerial_chain_core::ChainParams::new(n)).unwrap();
         plan_and_verify(name, n, dir.path());
     }
 }

@@ -4,11 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use arc_host_sim::cli;
-use arc_host_sim::collision::verify_plan;
-use arc_host_sim::map::grid::{Cell, Grid};
-use arc_host_sim::map::scenarios;
-use arc_host_sim::plan::Plan;
+use aerial_chain::cli;
+use aerial_chain::collision::verify_plan;
+use aerial_chain::map::grid::{Cell, Grid};
+use aerial_chain::map::scenarios;
+use aerial_chain::plan::Plan;
 
 fn arc(args: &[&str]) -> Result<(), cli::CliError> {
     let mut v = vec!["arc"];

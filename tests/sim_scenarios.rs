@@ -13,8 +13,8 @@
 
 use std::path::Path;
 
-use arc_host_sim::cli;
-use arc_host_sim::collision::DEFAULT_CLEARANCE;
+use aerial_chain::cli;
+use aerial_chain::collision::DEFAULT_CLEARANCE;
 
 fn arc(args: &[&str]) -> Result<(), cli::CliError> {
     let mut v = vec!["arc"];
@@ -153,18 +153,18 @@ fn bad_plans_are_input_errors() {
 fn a_plan_into_a_wall_fails_with_exit_1() {
     // A straight translation of the window scenario's start chain into the wall.
     let dir = tempfile::tempdir().expect("temporary directory");
-    let sc = arc_host_sim::map::scenarios::build("window").unwrap();
-    let params = arc_core::ChainParams::new(4);
+    let sc = aerial_chain::map::scenarios::build("window").unwrap();
+    let params = aerial_chain_core::ChainParams::new(4);
     let shape = sc.start_shape(4).unwrap();
     let start = sc.start;
     let goal = [sc.goal[0], start[1], start[2]];
-    let plan = arc_host_sim::plan::Plan {
-        format: arc_host_sim::plan::FORMAT.into(),
-        chain: arc_host_sim::plan::ChainSection::from_params(&params),
-        map: arc_host_sim::plan::MapSection::new(sc.grid.resolution(), true),
+    let plan = aerial_chain::plan::Plan {
+        format: aerial_chain::plan::FORMAT.into(),
+        chain: aerial_chain::plan::ChainSection::from_params(&params),
+        map: aerial_chain::plan::MapSection::new(sc.grid.resolution(), true),
         waypoints: vec![
-            arc_host_sim::plan::Waypoint::new(start, &shape),
-            arc_host_sim::plan::Waypoint::new(goal, &shape),
+            aerial_chain::plan::Waypoint::new(start, &shape),
+            aerial_chain::plan::Waypoint::new(goal, &shape),
         ],
         stats: Default::default(),
     };

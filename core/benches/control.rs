@@ -1,9 +1,9 @@
 //! Cost of the geometric attitude controller and of its helpers (ns per call).
-//! `cargo bench -p arc-core --bench control`.
+//! `cargo bench -p aerial-chain-core --bench control`.
 
 use std::hint::black_box;
 
-use arc_core::control::{
+use aerial_chain_core::control::{
     desired_attitude, from_euler_zyx, link_attitude, orthonormalize, step_attitude,
     AttitudeController, AttitudeGains, AttitudeSetpoint, AttitudeState, Mat3, Vec3,
 };

@@ -1,13 +1,13 @@
 //! Core benchmarks (issue 2): SRS sampling with roadmap, table decode + CRC, forward
-//! kinematics. Run with `cargo bench -p arc-core --bench core`.
+//! kinematics. Run with `cargo bench -p aerial-chain-core --bench core`.
 
 use std::hint::black_box;
 
-use arc_core::kinematics::offsets;
-use arc_core::lsc::library;
-use arc_core::srs::{Srs, SrsSettings};
-use arc_core::table::{encode_into, TableView};
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::kinematics::offsets;
+use aerial_chain_core::lsc::library;
+use aerial_chain_core::srs::{Srs, SrsSettings};
+use aerial_chain_core::table::{encode_into, TableView};
+use aerial_chain_core::{ChainParams, Shape};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 /// Capacity of the benchmarked SRS and its roadmap degree (the host's defaults).

@@ -1,4 +1,4 @@
-//! # arc-core: what runs on every unit of the Aerial Robotic Chain
+//! # aerial-chain-core: what runs on every unit of the Aerial Robotic Chain
 //!
 //! The Aerial Robotic Chain (ARC) is N quadrotors ("units") joined by rigid links
 //! through 3-DoF joints at the unit centres. This crate holds the parts of the

@@ -5,17 +5,17 @@
 //! one it trails. A shape command therefore gives each unit one direction to
 //! reach: the pitch `theta` and yaw `psi` of its link in the world frame
 //! (docs/model.md), i.e. the desired attitude `R_d = Rz(psi) Ry(theta)` whose
-//! body x axis is the link direction (`arc_core::control::link_attitude`).
+//! body x axis is the link direction (`aerial_chain_core::control::link_attitude`).
 //!
 //! The loop is the core's Lee-Leok-McClamroch SO(3) controller
-//! (`arc_core::control::AttitudeController`) at [`DT`] against the core's f32
-//! rigid-body integrator (`arc_core::control::step_attitude`), standing in for
+//! (`aerial_chain_core::control::AttitudeController`) at [`DT`] against the core's f32
+//! rigid-body integrator (`aerial_chain_core::control::step_attitude`), standing in for
 //! the real link. Forces at a link's two ends cannot twist it about its own
 //! axis, so the twist axis (body x) gets no attitude gain, only rate damping;
 //! the error that counts is the angle between the link's direction and the
 //! target direction.
 
-use arc_core::control::{
+use aerial_chain_core::control::{
     link_angles, link_attitude, step_attitude, AttitudeController, AttitudeGains, AttitudeOutput,
     AttitudeSetpoint, AttitudeState, Mat3, Vec3,
 };

@@ -23,8 +23,8 @@ mod platform;
 mod slot;
 mod stack;
 
-use arc_core::table::TableView;
-use arc_core::ChainParams;
+use aerial_chain_core::table::TableView;
+use aerial_chain_core::ChainParams;
 use cortex_m_rt::entry;
 
 use mission::{Refusal, DEG};

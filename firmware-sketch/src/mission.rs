@@ -15,9 +15,9 @@
 //! that final stay began. It fails when that has not happened [`SETTLE_ALLOWANCE`]
 //! seconds after the reference arrived.
 
-use arc_core::angle::{diff, wrap};
-use arc_core::table::{TableError, TableView};
-use arc_core::Shape;
+use aerial_chain_core::angle::{diff, wrap};
+use aerial_chain_core::table::{TableError, TableView};
+use aerial_chain_core::Shape;
 
 use crate::link::{setpoint, LinkLoop, DT};
 

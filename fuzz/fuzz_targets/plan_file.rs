@@ -6,9 +6,9 @@
 
 use std::sync::OnceLock;
 
-use arc_host_sim::collision::verify_plan;
-use arc_host_sim::map::grid::{Cell, Grid};
-use arc_host_sim::plan::Plan;
+use aerial_chain::collision::verify_plan;
+use aerial_chain::map::grid::{Cell, Grid};
+use aerial_chain::plan::Plan;
 use libfuzzer_sys::fuzz_target;
 
 /// A free 2 x 2 x 1 m room at 0.1 m with one occupied box, built once.

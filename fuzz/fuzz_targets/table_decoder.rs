@@ -1,9 +1,9 @@
-//! Fuzz target: `arc_core::table::TableView::open` on arbitrary bytes, then every
+//! Fuzz target: `aerial_chain_core::table::TableView::open` on arbitrary bytes, then every
 //! lookup the units and the host make. Nothing may panic; whatever `open` accepts
 //! must be readable in full.
 #![no_main]
 
-use arc_core::table::TableView;
+use aerial_chain_core::table::TableView;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

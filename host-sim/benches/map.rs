@@ -5,11 +5,11 @@
 use std::hint::black_box;
 use std::sync::Arc;
 
-use arc_core::{ChainParams, Shape};
-use arc_host_sim::collision::CollisionContext;
-use arc_host_sim::map::distance::DistanceField;
-use arc_host_sim::map::grid::{Cell, Grid};
-use arc_host_sim::map::octomap::OcTree;
+use aerial_chain::collision::CollisionContext;
+use aerial_chain::map::distance::DistanceField;
+use aerial_chain::map::grid::{Cell, Grid};
+use aerial_chain::map::octomap::OcTree;
+use aerial_chain_core::{ChainParams, Shape};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 /// A small deterministic generator (no dependency needed for a benchmark's clutter).
@@ -92,7 +92,7 @@ fn bench(c: &mut Criterion) {
         &[0.3, 0.0, 0.3, 0.2, 0.8, -0.1, 0.2, 0.0, -0.5, 0.1, 0.1],
     )
     .unwrap();
-    assert!(arc_core::validity::check_shape(ctx.params(), &shape).is_ok());
+    assert!(aerial_chain_core::validity::check_shape(ctx.params(), &shape).is_ok());
     let mut r = Lcg(11);
     let mut configs = Vec::new();
     let mut edges = Vec::new();

@@ -2,20 +2,20 @@
 //! ARCplanner query on `window` with N = 5, batches of translation and shape-change
 //! checks, and the full-state PRM's roadmap build for comparison.
 //!
-//! `cargo bench -p arc-host-sim --bench planner`
+//! `cargo bench -p aerial-chain --bench planner`
 
 use std::hint::black_box;
 use std::sync::atomic::AtomicUsize;
 use std::sync::Arc;
 use std::time::Duration;
 
-use arc_core::{ChainParams, Shape};
-use arc_host_sim::baseline::{FullStatePrm, PrmSettings};
-use arc_host_sim::collision::{CollisionContext, DEFAULT_CLEARANCE};
-use arc_host_sim::map::distance::DistanceField;
-use arc_host_sim::map::scenarios::{self, Scenario};
-use arc_host_sim::planner::{Planner, Settings, Termination};
-use arc_host_sim::tables::{ShapeTables, TableSettings};
+use aerial_chain::baseline::{FullStatePrm, PrmSettings};
+use aerial_chain::collision::{CollisionContext, DEFAULT_CLEARANCE};
+use aerial_chain::map::distance::DistanceField;
+use aerial_chain::map::scenarios::{self, Scenario};
+use aerial_chain::planner::{Planner, Settings, Termination};
+use aerial_chain::tables::{ShapeTables, TableSettings};
+use aerial_chain_core::{ChainParams, Shape};
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use rand::{Rng, SeedableRng};
 

@@ -1,4 +1,4 @@
-//! Chain simulation costs: `cargo bench -p arc-host-sim --bench sim`.
+//! Chain simulation costs: `cargo bench -p aerial-chain --bench sim`.
 //!
 //! - `sim/flight_n6`: a whole N = 6 flight (a shape change, then a 2.2 m translation;
 //!   about 20 simulated seconds at 500 Hz, every body recorded); the real-time factor
@@ -11,13 +11,13 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use arc_core::ChainParams;
-use arc_host_sim::sim::dynamics::{ChainDynamics, Formulation, UnitCommand};
-use arc_host_sim::sim::mpc::{HeadMpc, MpcConfig, MpcRef};
-use arc_host_sim::sim::{
+use aerial_chain::sim::dynamics::{ChainDynamics, Formulation, UnitCommand};
+use aerial_chain::sim::mpc::{HeadMpc, MpcConfig, MpcRef};
+use aerial_chain::sim::{
     simulate, ChainController, ChainModel, ControllerConfig, Reference, ReferenceLimits, SimConfig,
     V3,
 };
+use aerial_chain_core::ChainParams;
 use criterion::{criterion_group, criterion_main, Criterion};
 
 const N: usize = 6;

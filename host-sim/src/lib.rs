@@ -1,4 +1,4 @@
-//! # arc-host-sim: the Aerial Robotic Chain on the host
+//! # aerial-chain: the Aerial Robotic Chain on the host
 //!
 //! Maps (OctoMap `.bt` files, occupancy grids, distance fields, scenario
 //! generators), collision of the chain against a map, the ARCplanner, the chain's

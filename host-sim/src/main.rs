@@ -1,4 +1,4 @@
-//! The `arc` command line. All logic lives in [`arc_host_sim::cli`].
+//! The `arc` command line. All logic lives in [`aerial_chain::cli`].
 fn main() -> std::process::ExitCode {
-    arc_host_sim::cli::main()
+    aerial_chain::cli::main()
 }

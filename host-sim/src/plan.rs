@@ -9,7 +9,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::{ChainParams, Shape};
 use serde::{Deserialize, Serialize};
 
 /// The format tag every plan carries.

@@ -1,16 +1,16 @@
 //! Shape tables on the host: build them with the core generators, write and read
-//! them as the very postcard blob the units flash (`arc_core::table`), and hand the
+//! them as the very postcard blob the units flash (`aerial_chain_core::table`), and hand the
 //! planner growable copies.
 
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use arc_core::lsc::LIMIT_MARGIN;
-use arc_core::lsc::{library, LscEntry, LscKind};
-use arc_core::srs::{nearest_later, Neighbours, Sampler, SrsError, SrsSettings};
-use arc_core::table::{encode_into, TableError, TableView};
-use arc_core::validity::{check_transition, Violation};
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::lsc::LIMIT_MARGIN;
+use aerial_chain_core::lsc::{library, LscEntry, LscKind};
+use aerial_chain_core::srs::{nearest_later, Neighbours, Sampler, SrsError, SrsSettings};
+use aerial_chain_core::table::{encode_into, TableError, TableView};
+use aerial_chain_core::validity::{check_transition, Violation};
+use aerial_chain_core::{ChainParams, Shape};
 use rayon::prelude::*;
 
 /// Roadmap degree the host builds `G_SRS` with.
@@ -23,7 +23,7 @@ pub struct TableSettings {
     pub srs: usize,
     /// Seed of the SRS sampler.
     pub seed: u64,
-    /// Roadmap radius `r_S` (in the `C_T` metric); `None`: `arc_core::srs::default_r_s`.
+    /// Roadmap radius `r_S` (in the `C_T` metric); `None`: `aerial_chain_core::srs::default_r_s`.
     pub r_s: Option<f32>,
 }
 
@@ -88,7 +88,7 @@ fn indexed_roadmap(params: &ChainParams, shapes: &[Shape], r_s: f32) -> Vec<Neig
     let mut by_yaw: Vec<(f32, usize)> = shapes
         .iter()
         .enumerate()
-        .map(|(i, s)| (arc_core::angle::wrap(s.head_yaw()), i))
+        .map(|(i, s)| (aerial_chain_core::angle::wrap(s.head_yaw()), i))
         .collect();
     by_yaw.sort_by(|a, b| a.0.total_cmp(&b.0));
     let yaws: Vec<f32> = by_yaw.iter().map(|p| p.0).collect();
@@ -110,7 +110,7 @@ fn indexed_roadmap(params: &ChainParams, shapes: &[Shape], r_s: f32) -> Vec<Neig
         .into_par_iter()
         .map(|i| {
             let mut later: Vec<usize> = Vec::new();
-            for (lo, hi) in window(arc_core::angle::wrap(shapes[i].head_yaw())) {
+            for (lo, hi) in window(aerial_chain_core::angle::wrap(shapes[i].head_yaw())) {
                 let a = yaws.partition_point(|&y| y < lo);
                 let b = yaws.partition_point(|&y| y <= hi);
                 later.extend(by_yaw[a..b].iter().map(|p| p.1).filter(|&j| j > i));
@@ -175,7 +175,7 @@ impl ShapeTables {
         })
     }
 
-    /// The postcard blob (`arc_core::table` format).
+    /// The postcard blob (`aerial_chain_core::table` format).
     pub fn encode(&self) -> Result<Vec<u8>, TableError> {
         // Upper bound: header + LSC (name, shape, headings) + SRS + adjacency + CRC.
         let dim = self.params.shape_dim();
@@ -277,7 +277,7 @@ mod tests {
             let shapes: Vec<Shape> = (0..count).map(|_| sampler.next_shape().unwrap()).collect();
             let r_s = r_s.unwrap_or(SrsSettings::new(units, count, 7).r_s);
             let mut core = vec![Neighbours::<DEGREE>::new(); count];
-            arc_core::srs::build_roadmap(&p, &shapes, r_s, &mut core);
+            aerial_chain_core::srs::build_roadmap(&p, &shapes, r_s, &mut core);
             let host = indexed_roadmap(&p, &shapes, r_s);
             assert_eq!(host, core, "N = {units}");
             assert!(core.iter().map(|a| a.len()).sum::<usize>() > count);
@@ -313,7 +313,8 @@ mod tests {
         )
         .unwrap();
         let core =
-            arc_core::srs::Srs::<30, DEGREE>::generate(p, &SrsSettings::new(4, 30, 9)).unwrap();
+            aerial_chain_core::srs::Srs::<30, DEGREE>::generate(p, &SrsSettings::new(4, 30, 9))
+                .unwrap();
         assert_eq!(t.srs, core.shapes.to_vec());
         let adj: Vec<Vec<u16>> = core.adjacency.iter().map(|a| a.to_vec()).collect();
         assert_eq!(t.adjacency, adj);

@@ -3,12 +3,12 @@
 
 use std::sync::Arc;
 
-use arc_core::ChainParams;
-use arc_host_sim::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
-use arc_host_sim::map::distance::DistanceField;
-use arc_host_sim::map::grid::Grid;
-use arc_host_sim::map::octomap::OcTree;
-use arc_host_sim::map::scenarios;
+use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
+use aerial_chain::map::distance::DistanceField;
+use aerial_chain::map::grid::Grid;
+use aerial_chain::map::octomap::OcTree;
+use aerial_chain::map::scenarios;
+use aerial_chain_core::ChainParams;
 
 #[test]
 fn exported_scenarios_fly_from_the_file() {
@@ -55,14 +55,14 @@ fn unknown_space_switch_matters_for_partial_maps() {
         (0..40).flat_map(|x| (0..20).flat_map(move |y| (0..20).map(move |z| ([x, y, z], false))));
     let tree = OcTree::from_voxels(0.1, voxels).unwrap();
     let p = ChainParams::new(3);
-    let shape = arc_core::Shape::line(3, 0.0);
+    let shape = aerial_chain_core::Shape::line(3, 0.0);
     for (occ, ok) in [(true, false), (false, true)] {
         let mut grid = Grid::from_octree(&tree, occ).unwrap();
         // Make x >= 2.0 unknown inside the bounds.
         for x in 20..40 {
             for y in 0..20 {
                 for z in 0..20 {
-                    grid.set([x, y, z], arc_host_sim::map::grid::Cell::Unknown);
+                    grid.set([x, y, z], aerial_chain::map::grid::Cell::Unknown);
                 }
             }
         }

@@ -1,4 +1,4 @@
-//! Our OctoMap reader and writer (`arc_host_sim::map::octomap`) against the real OctoMap
+//! Our OctoMap reader and writer (`aerial_chain::map::octomap`) against the real OctoMap
 //! library.
 //!
 //! * `tests/fixtures/octomap/*.bt|*.ot` were written by OctoMap (`make_fixtures.sh`), and
@@ -18,7 +18,7 @@ use std::process::Command;
 use std::sync::OnceLock;
 use std::time::Instant;
 
-use arc_host_sim::map::octomap::OcTree;
+use aerial_chain::map::octomap::OcTree;
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/octomap")

@@ -28,7 +28,7 @@
 
 use std::num::NonZero;
 
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::{ChainParams, Shape};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 

@@ -45,7 +45,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 use std::time::{Duration, Instant};
 
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::{ChainParams, Shape};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use serde_json::json;
@@ -238,11 +238,11 @@ pub struct FullStatePrm {
 fn random_shape(params: &ChainParams, rng: &mut Pcg64) -> Shape {
     let pi = std::f32::consts::PI;
     let mut s = Shape::line(params.units, 0.0);
-    s.set_head_yaw(arc_core::angle::wrap(rng.gen_range(-pi..pi)));
+    s.set_head_yaw(aerial_chain_core::angle::wrap(rng.gen_range(-pi..pi)));
     let t = params.theta_max;
     for k in 0..s.links() {
         let pitch = rng.gen_range(-t..=t);
-        let yaw = arc_core::angle::wrap(rng.gen_range(-pi..pi));
+        let yaw = aerial_chain_core::angle::wrap(rng.gen_range(-pi..pi));
         s.set_link(k, pitch, yaw);
     }
     s

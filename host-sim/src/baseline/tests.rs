@@ -1,7 +1,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::{ChainParams, Shape};
 
 use super::*;
 use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};

@@ -28,8 +28,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use arc_core::lsc::{library, LscKind};
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::lsc::{library, LscKind};
+use aerial_chain_core::{ChainParams, Shape};
 use rayon::prelude::*;
 
 use crate::baseline::{self, FullStatePrm, PrmError, PrmSettings};
@@ -395,7 +395,7 @@ pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, Str
                 let yaw = yaw0 + j as f32 * std::f32::consts::FRAC_PI_4;
                 let shape = e
                     .shape
-                    .rotated(arc_core::angle::diff(e.shape.head_yaw(), yaw));
+                    .rotated(aerial_chain_core::angle::diff(e.shape.head_yaw(), yaw));
                 if ctx.check_config(p, &shape).is_ok() {
                     return Ok(Query {
                         start: p,

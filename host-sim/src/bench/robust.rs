@@ -49,7 +49,7 @@ pub fn draw(o: &RobustOptions) -> (Vec<RunSpec>, usize) {
         let p = PassageSpec::random(&mut rng);
         let units: u8 = rng.gen_range(4..=8);
         let ok = p.build().ok().is_some_and(|sc| {
-            arc_core::ChainParams::new(units)
+            aerial_chain_core::ChainParams::new(units)
                 .validate()
                 .is_ok_and(|params| witness(&sc, &params).is_ok())
         });

@@ -13,7 +13,7 @@
 
 use std::fmt::Write as _;
 
-use arc_core::lsc::library;
+use aerial_chain_core::lsc::library;
 use plotters::style::RGBColor;
 
 use super::plot::{self, Chart, Curve};
@@ -112,7 +112,7 @@ pub fn specs(o: &ScaleOptions) -> Result<(Vec<RunSpec>, Vec<StartChoice>), Strin
             .entries
             .iter()
             .find(|e| {
-                let d = arc_core::angle::diff(e.shape.head_yaw(), q.shape.head_yaw());
+                let d = aerial_chain_core::angle::diff(e.shape.head_yaw(), q.shape.head_yaw());
                 e.shape.rotated(d).max_angle_diff(&q.shape) < 1e-5
             })
             .map_or("?", |e| e.kind.name());

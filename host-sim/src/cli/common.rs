@@ -3,9 +3,9 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use arc_core::lsc::{library, LscKind};
-use arc_core::params::ParamError;
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::lsc::{library, LscKind};
+use aerial_chain_core::params::ParamError;
+use aerial_chain_core::{ChainParams, Shape};
 use clap::Args;
 
 use super::{checks, CliError};
@@ -22,13 +22,13 @@ pub struct ChainArgs {
     #[arg(long, short = 'n')]
     pub units: Option<u8>,
     /// Link length l (m).
-    #[arg(long, default_value_t = arc_core::ChainParams::DEFAULT_LINK_LENGTH)]
+    #[arg(long, default_value_t = aerial_chain_core::ChainParams::DEFAULT_LINK_LENGTH)]
     pub link_length: f32,
     /// Unit collision sphere radius r_u (m).
-    #[arg(long, default_value_t = arc_core::ChainParams::DEFAULT_UNIT_RADIUS)]
+    #[arg(long, default_value_t = aerial_chain_core::ChainParams::DEFAULT_UNIT_RADIUS)]
     pub unit_radius: f32,
     /// Link capsule radius r_l (m).
-    #[arg(long, default_value_t = arc_core::ChainParams::DEFAULT_LINK_RADIUS)]
+    #[arg(long, default_value_t = aerial_chain_core::ChainParams::DEFAULT_LINK_RADIUS)]
     pub link_radius: f32,
     /// Pitch limit theta_max (degrees).
     #[arg(long, default_value_t = 60.0)]
@@ -40,7 +40,7 @@ pub struct ChainArgs {
 
 impl ChainArgs {
     /// Validated chain parameters, with `default_units` when `--units` is absent.
-    pub fn params(&self, default_units: u8) -> Result<arc_core::ChainParams, CliError> {
+    pub fn params(&self, default_units: u8) -> Result<aerial_chain_core::ChainParams, CliError> {
         let units = self.units.unwrap_or(default_units);
         if self.link_length.is_nan() || self.link_length > checks::MAX_LINK_LENGTH_M {
             return Err(checks::bad(
@@ -53,13 +53,13 @@ impl ChainArgs {
                 ),
             ));
         }
-        arc_core::ChainParams {
+        aerial_chain_core::ChainParams {
             units,
             link_length: self.link_length,
             unit_radius: self.unit_radius,
             link_radius: self.link_radius,
-            theta_max: arc_core::angle::deg(self.theta_max_deg),
-            beta_max: arc_core::angle::deg(self.beta_max_deg),
+            theta_max: aerial_chain_core::angle::deg(self.theta_max_deg),
+            beta_max: aerial_chain_core::angle::deg(self.beta_max_deg),
         }
         .validate()
         .map_err(|e| self.param_error(units, e))
@@ -297,7 +297,7 @@ pub fn start_shape(params: &ChainParams, name: &str, yaw: f32) -> Result<Shape, 
         ))
     })?;
     Ok(e.shape
-        .rotated(arc_core::angle::diff(e.shape.head_yaw(), yaw)))
+        .rotated(aerial_chain_core::angle::diff(e.shape.head_yaw(), yaw)))
 }
 
 /// Parses `x,y,z`.

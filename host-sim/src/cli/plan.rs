@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicUsize;
 use std::time::Instant;
 
-use arc_core::ChainParams;
+use aerial_chain_core::ChainParams;
 use clap::Args;
 
 use super::checks;

@@ -4,9 +4,9 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 
-use arc_core::kinematics::offsets;
-use arc_core::lsc::library;
-use arc_core::table::TableView;
+use aerial_chain_core::kinematics::offsets;
+use aerial_chain_core::lsc::library;
+use aerial_chain_core::table::TableView;
 use clap::{Args, Subcommand};
 
 use super::checks;

@@ -2,8 +2,8 @@
 //! verification. Independent of the distance field: the obstacle voxels near a body are
 //! enumerated from the [`Grid`] and measured one by one.
 
-use arc_core::validity::{check_shape, Body, Violation};
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::validity::{check_shape, Body, Violation};
+use aerial_chain_core::{ChainParams, Shape};
 
 use crate::map::grid::Grid;
 
@@ -270,7 +270,7 @@ pub fn check_config_exact(
     if eta.len() != 2 * n - 1 || eta.iter().chain(head.iter()).any(|v| !v.is_finite()) {
         return Err(ExactViolation::BadShape);
     }
-    let mut e32 = [0f32; arc_core::MAX_SHAPE_DIM];
+    let mut e32 = [0f32; aerial_chain_core::MAX_SHAPE_DIM];
     for (d, s) in e32.iter_mut().zip(eta) {
         *d = *s as f32;
     }

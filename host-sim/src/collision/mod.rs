@@ -32,7 +32,7 @@
 //! crossed in a few samples and no collision is ever skipped. A body whose margin falls
 //! below [`CollisionContext::min_step`] is reported as colliding (conservatively), which
 //! also bounds the work per edge. Limits and self-collision along a shape change come
-//! from `arc_core::validity::check_transition`.
+//! from `aerial_chain_core::validity::check_transition`.
 
 pub mod exact;
 pub mod verify;
@@ -42,9 +42,9 @@ use std::fmt;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use arc_core::kinematics::offsets;
-use arc_core::validity::{check_shape, check_transition, Body, Violation};
-use arc_core::{ChainParams, Shape, MAX_UNITS};
+use aerial_chain_core::kinematics::offsets;
+use aerial_chain_core::validity::{check_shape, check_transition, Body, Violation};
+use aerial_chain_core::{ChainParams, Shape, MAX_UNITS};
 
 use crate::map::distance::DistanceField;
 
@@ -172,7 +172,7 @@ thread_local! {
     static LAST_SHAPE: RefCell<Option<ShapeAnswer>> = const { RefCell::new(None) };
 }
 
-/// `arc_core::validity::check_shape`, remembering the last answer per thread (an exact
+/// `aerial_chain_core::validity::check_shape`, remembering the last answer per thread (an exact
 /// repeat of the same chain and shape gets the same answer without the work).
 fn shape_validity(params: &ChainParams, shape: &Shape) -> Result<(), Violation> {
     LAST_SHAPE.with(|c| {
@@ -601,8 +601,8 @@ impl CollisionContext {
         // speed[i]: bound on unit i's speed per unit of the edge parameter.
         let mut speed = [0.0f64; MAX_UNITS];
         for k in 0..n - 1 {
-            let dp = arc_core::angle::diff(from.pitch(k), to.pitch(k)) as f64;
-            let dy = arc_core::angle::diff(from.yaw(k), to.yaw(k)) as f64;
+            let dp = aerial_chain_core::angle::diff(from.pitch(k), to.pitch(k)) as f64;
+            let dy = aerial_chain_core::angle::diff(from.yaw(k), to.yaw(k)) as f64;
             // A small relative allowance for the f32 angle differences.
             speed[k + 1] = speed[k] + l * (dp * dp + dy * dy).sqrt() * (1.0 + 1e-6);
         }

@@ -2,8 +2,8 @@
 
 use std::sync::Arc;
 
-use arc_core::validity::Body;
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::validity::Body;
+use aerial_chain_core::{ChainParams, Shape};
 use proptest::prelude::*;
 
 use super::exact::check_config_exact;

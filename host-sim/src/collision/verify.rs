@@ -13,8 +13,8 @@
 
 use std::f64::consts::{PI, TAU};
 
-use arc_core::validity::Body;
-use arc_core::ChainParams;
+use aerial_chain_core::validity::Body;
+use aerial_chain_core::ChainParams;
 
 use super::exact::{check_config_exact, ExactViolation};
 use crate::map::grid::Grid;
@@ -441,7 +441,7 @@ mod tests {
     use super::*;
     use crate::map::grid::{Cell, Grid};
     use crate::plan::{ChainSection, MapSection, Waypoint, FORMAT};
-    use arc_core::Shape;
+    use aerial_chain_core::Shape;
 
     fn plan(points: &[([f64; 3], Shape)]) -> Plan {
         Plan {

@@ -21,7 +21,7 @@
 //! follow-the-leader fashion, and the exact verifier checks the result: an instance
 //! with a witness is solvable, whatever the planner does.
 
-use arc_core::ChainParams;
+use aerial_chain_core::ChainParams;
 
 use super::grid::{Cell, Grid};
 use super::scenarios::Scenario;

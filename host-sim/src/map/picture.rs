@@ -152,8 +152,8 @@ pub fn map_figure(grid: &Grid, scenario: Option<&Scenario>, opts: &MapPictureOpt
     if let Some(s) = scenario {
         let route: Vec<(f64, f64)> = s.route.iter().map(|q| (q[0], q[1])).collect();
         p.polyline(&route, palette::PATH, 1.5, true);
-        let l = arc_core::ChainParams::DEFAULT_LINK_LENGTH as f64;
-        let r = arc_core::ChainParams::DEFAULT_UNIT_RADIUS as f64;
+        let l = aerial_chain_core::ChainParams::DEFAULT_LINK_LENGTH as f64;
+        let r = aerial_chain_core::ChainParams::DEFAULT_UNIT_RADIUS as f64;
         let (c, sn) = (s.start_yaw.cos(), s.start_yaw.sin());
         let pts: Vec<(f64, f64)> = (0..s.default_units)
             .map(|k| {

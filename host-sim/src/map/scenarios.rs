@@ -26,7 +26,7 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::{ChainParams, Shape};
 
 use super::grid::{Cell, Grid};
 use crate::plan::{ChainSection, MapSection, MapSource, Plan, Waypoint};
@@ -322,7 +322,7 @@ impl Scenario {
 
     /// The start shape: the straight line LI at the start yaw.
     pub fn start_shape(&self, units: u8) -> Result<Shape, String> {
-        if !(2..=arc_core::MAX_UNITS as u8).contains(&units) {
+        if !(2..=aerial_chain_core::MAX_UNITS as u8).contains(&units) {
             return Err(format!("units = {units} is outside 2..=16"));
         }
         Ok(Shape::line(units, self.start_yaw as f32))

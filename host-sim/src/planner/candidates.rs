@@ -3,9 +3,9 @@
 
 use std::f32::consts::TAU;
 
-use arc_core::cost::transition_cost_sq;
-use arc_core::lsc::{LscEntry, LscKind};
-use arc_core::Shape;
+use aerial_chain_core::cost::transition_cost_sq;
+use aerial_chain_core::lsc::{LscEntry, LscKind};
+use aerial_chain_core::Shape;
 
 /// Where a shape of the plan came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,14 +40,14 @@ pub struct Candidate {
 /// straight behind the head) and `n_psi` evenly spaced turns from it.
 pub fn headings(edge_yaw: f32, n_psi: usize) -> impl Iterator<Item = f32> {
     let n = n_psi.max(1);
-    (0..n).map(move |k| arc_core::angle::wrap(edge_yaw + TAU * k as f32 / n as f32))
+    (0..n).map(move |k| aerial_chain_core::angle::wrap(edge_yaw + TAU * k as f32 / n as f32))
 }
 
 /// Yaw rotations of `current` that point it at each heading (except itself),
 /// cheapest first.
 pub fn rotations(current: &Shape, edge_yaw: f32, n_psi: usize) -> Vec<Candidate> {
     let mut out: Vec<Candidate> = headings(edge_yaw, n_psi)
-        .map(|h| current.rotated(arc_core::angle::diff(current.head_yaw(), h)))
+        .map(|h| current.rotated(aerial_chain_core::angle::diff(current.head_yaw(), h)))
         .filter(|s| s.max_angle_diff(current) > 1e-4)
         .map(|shape| Candidate {
             shape,
@@ -72,7 +72,7 @@ pub fn library(
             // Library shapes look along +x: rotate their head to the heading.
             let shape = e
                 .shape
-                .rotated(arc_core::angle::diff(e.shape.head_yaw(), h));
+                .rotated(aerial_chain_core::angle::diff(e.shape.head_yaw(), h));
             out.push(Candidate {
                 shape,
                 source: Source::Lsc(e.kind),
@@ -93,9 +93,9 @@ pub fn sort_by_cost(from: &Shape, c: &mut [Candidate]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use arc_core::cost::transition_cost;
-    use arc_core::lsc::library as lib;
-    use arc_core::ChainParams;
+    use aerial_chain_core::cost::transition_cost;
+    use aerial_chain_core::lsc::library as lib;
+    use aerial_chain_core::ChainParams;
 
     #[test]
     fn rotations_are_sorted_and_skip_the_identity() {

@@ -8,8 +8,8 @@
 //! translate" (docs/model.md): the translation moves the body off its track by at most
 //! one step, the next shape change puts it back.
 
-use arc_core::kinematics::link_direction;
-use arc_core::{ChainParams, Shape};
+use aerial_chain_core::kinematics::link_direction;
+use aerial_chain_core::{ChainParams, Shape};
 use nalgebra::Vector3;
 
 /// How far inside the pitch limit a clamped link stays (rad): a controller tracking a
@@ -205,7 +205,7 @@ fn next_unit(track: Track, along: &mut Along, prev: &Place, l: f32) -> Option<Pl
 #[cfg(test)]
 mod tests {
     use super::*;
-    use arc_core::kinematics::offsets;
+    use aerial_chain_core::kinematics::offsets;
 
     fn v(x: f32, y: f32, z: f32) -> Vector3<f32> {
         Vector3::new(x, y, z)

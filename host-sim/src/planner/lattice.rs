@@ -219,7 +219,8 @@ impl Limit {
     /// is read once every 1024 steps).
     fn reached(&self, touched: usize, work: usize) -> bool {
         touched > self.budget
-            || (work % 1024 == 0 && self.deadline.is_some_and(|d| std::time::Instant::now() > d))
+            || (work.is_multiple_of(1024)
+                && self.deadline.is_some_and(|d| std::time::Instant::now() > d))
     }
 }
 
@@ -906,7 +907,7 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 mod tests {
     use std::sync::Arc;
 
-    use arc_core::ChainParams;
+    use aerial_chain_core::ChainParams;
     use proptest::prelude::*;
 
     use super::*;

@@ -24,8 +24,8 @@ pub mod srs_connect;
 use std::collections::BTreeSet;
 use std::time::{Duration, Instant};
 
-use arc_core::lsc::LscKind;
-use arc_core::Shape;
+use aerial_chain_core::lsc::LscKind;
+use aerial_chain_core::Shape;
 use rand::SeedableRng;
 use rand_pcg::Pcg64;
 
@@ -66,7 +66,7 @@ pub struct Settings {
     /// Discrete headings per library shape and rotations of the current shape.
     pub n_psi: usize,
     /// `G_Val` connection radius `d_c` (`C_T` metric); `None`: the roadmap radius
-    /// `arc_core::srs::default_r_s` for the chain and the SRS size.
+    /// `aerial_chain_core::srs::default_r_s` for the chain and the SRS size.
     pub d_c: Option<f32>,
     /// Shape sources.
     pub mode: Mode,
@@ -575,8 +575,8 @@ impl Planner {
 }
 
 /// Yaw of the direction from the head to the centroid of the units of `shape`.
-fn trail_yaw(params: &arc_core::ChainParams, shape: &Shape) -> f32 {
-    let p = arc_core::kinematics::offsets(params, shape);
+fn trail_yaw(params: &aerial_chain_core::ChainParams, shape: &Shape) -> f32 {
+    let p = aerial_chain_core::kinematics::offsets(params, shape);
     let c = p
         .iter()
         .take(shape.units())
@@ -1003,7 +1003,7 @@ impl<'p> Construction<'p> {
                 }
                 continue;
             }
-            let body = arc_core::kinematics::offsets(params, &st.shape);
+            let body = aerial_chain_core::kinematics::offsets(params, &st.shape);
             let body: Vec<_> = body.iter().take(params.n()).map(|o| v(st.xi) + o).collect();
             if st.source == Source::Follow {
                 track.extend(body);
@@ -1035,8 +1035,10 @@ impl<'p> Construction<'p> {
                 source: Source::Srs(k as u16),
             });
             // The same shape turned so that its body trails straight behind the edge.
-            let turn =
-                arc_core::angle::diff(self.planner.trail_yaw[k], edge_yaw + std::f32::consts::PI);
+            let turn = aerial_chain_core::angle::diff(
+                self.planner.trail_yaw[k],
+                edge_yaw + std::f32::consts::PI,
+            );
             pool.push(Candidate {
                 shape: shape.rotated(turn),
                 source: Source::SrsTurned(k as u16),
@@ -1051,7 +1053,7 @@ impl<'p> Construction<'p> {
             &pool,
             &self.planner.tables.adjacency,
             s.d_c.unwrap_or_else(|| {
-                arc_core::srs::default_r_s(self.planner.tables.params.units, srs.len())
+                aerial_chain_core::srs::default_r_s(self.planner.tables.params.units, srs.len())
             }),
         )
     }

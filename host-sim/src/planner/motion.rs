@@ -4,7 +4,7 @@
 //! then one translation (shape fixed). Timings go under `stats.timing`, the only
 //! part of a plan that differs between two runs with the same seed.
 
-use arc_core::ChainParams;
+use aerial_chain_core::ChainParams;
 use serde_json::Value;
 
 use super::candidates::Source;

@@ -23,9 +23,9 @@
 
 use std::time::Instant;
 
-use arc_core::angle;
-use arc_core::cost::transition_cost;
-use arc_core::Shape;
+use aerial_chain_core::angle;
+use aerial_chain_core::cost::transition_cost;
+use aerial_chain_core::Shape;
 
 use super::candidates::Source;
 use super::{Checker, Planner, Solution, Step};

@@ -93,7 +93,9 @@ impl Roadmap {
         let mut tries = 0usize;
         // Past the deadline the roadmap keeps what it has (checked every 256 tries:
         // a sample costs a few microseconds).
-        let late = |tries: usize| tries % 256 == 0 && deadline.is_some_and(|d| Instant::now() > d);
+        let late = |tries: usize| {
+            tries.is_multiple_of(256) && deadline.is_some_and(|d| Instant::now() > d)
+        };
         while points.len() < vertices && tries < vertices.saturating_mul(200).max(1000) {
             if late(tries) {
                 break;
@@ -496,7 +498,7 @@ impl PartialOrd for Open {
 mod tests {
     use std::sync::Arc;
 
-    use arc_core::ChainParams;
+    use aerial_chain_core::ChainParams;
     use rand::SeedableRng;
 
     use super::*;

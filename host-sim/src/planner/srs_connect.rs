@@ -22,7 +22,7 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-use arc_core::cost::transition_cost;
+use aerial_chain_core::cost::transition_cost;
 
 use super::candidates::{Candidate, Source};
 use super::Checker;

@@ -2,7 +2,7 @@
 //! ([`crate::collision::exact::nearest_obstacle`]: point and segment to voxel-cube
 //! distances), for [`super::flight::Obstacles`].
 
-use arc_core::ChainParams;
+use aerial_chain_core::ChainParams;
 
 use super::dynamics::V3;
 use super::flight::Obstacles;

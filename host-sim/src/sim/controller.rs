@@ -2,7 +2,7 @@
 //!
 //! 1. the head's position MPC ([`super::mpc::HeadMpc`]) gives the head's acceleration;
 //! 2. N - 1 link angular controllers (the core's geometric SO(3) controller,
-//!    [`arc_core::control::AttitudeController`]) track the planned link pitch and yaw
+//!    [`aerial_chain_core::control::AttitudeController`]) track the planned link pitch and yaw
 //!    and give each link's angular acceleration;
 //! 3. the mixer turns these into one force per unit: the desired accelerations of all
 //!    unit centres follow from the head's and the links' by the chain's kinematics,
@@ -16,11 +16,11 @@
 //!    its desired attitude into body moments.
 //!
 //! The link controller works in the link's twist-free frame `Rz(psi) Ry(theta)`
-//! ([`arc_core::control::link_attitude`]), built from the measured unit positions; a
+//! ([`aerial_chain_core::control::link_attitude`]), built from the measured unit positions; a
 //! link cannot be twisted by forces at its ends, so its x gains and x inertia are
 //! zero and the output is the angular acceleration across the link.
 
-use arc_core::control::{
+use aerial_chain_core::control::{
     desired_attitude, euler_zyx, link_attitude, AttitudeController, AttitudeGains,
     AttitudeSetpoint, AttitudeState, Mat3, Vec3,
 };
@@ -142,7 +142,7 @@ fn measure_link(front: &BodyState, back: &BodyState) -> LinkMeasure {
         V3::zeros()
     };
     let omega = d.cross(&ddot);
-    // docs/model.md's angles of d (as arc_core::control::direction_angles, in f64).
+    // docs/model.md's angles of d (as aerial_chain_core::control::direction_angles, in f64).
     let pitch = (-d.z).clamp(-1.0, 1.0).asin();
     let yaw = if d.x.abs() + d.y.abs() > 1e-12 {
         d.y.atan2(d.x)
@@ -486,7 +486,7 @@ impl ChainController {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use arc_core::ChainParams;
+    use aerial_chain_core::ChainParams;
 
     fn state(p: V3) -> BodyState {
         BodyState {

@@ -14,7 +14,7 @@
 //!   point mass of the unit at its back end (link 1 also the head), joined by
 //!   spherical joints; each unit's thrust is applied at its joint point and each
 //!   unit's attitude is integrated on its own by the core's rigid-body integrator
-//!   ([`arc_core::control::step_attitude`]). Same equations of motion, half the
+//!   ([`aerial_chain_core::control::step_attitude`]). Same equations of motion, half the
 //!   multibody's degrees of freedom: 6 + 3(N - 2) instead of 6 + 6(N - 1), and the
 //!   engine's dense mass-matrix work shrinks accordingly (about 4x for N = 6).
 //! - [`Formulation::Full`]: every unit and every link a rapier body in one multibody
@@ -26,7 +26,7 @@
 //! in `f32` with glam types; this module converts at its boundary to the `f64`
 //! nalgebra types the rest of the simulation uses.
 
-use arc_core::control::{step_attitude, AttitudeState, Mat3, Vec3};
+use aerial_chain_core::control::{step_attitude, AttitudeState, Mat3, Vec3};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rapier3d::glamx::{Mat3 as GMat3, Quat as GQuat, Vec3 as GVec3};
 use rapier3d::prelude::{
@@ -403,7 +403,7 @@ impl ChainDynamics {
     pub fn set_unit_attitude(&mut self, i: usize, r: &M3) -> bool {
         match (self.formulation, self.unit_attitude.get_mut(i)) {
             (Formulation::Lumped, Some(a)) if r.iter().all(|v| v.is_finite()) => {
-                a.r = arc_core::control::orthonormalize(&Mat3::from_fn(|row, col| {
+                a.r = aerial_chain_core::control::orthonormalize(&Mat3::from_fn(|row, col| {
                     r[(row, col)] as f32
                 }));
                 true
@@ -579,7 +579,7 @@ impl ChainDynamics {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use arc_core::ChainParams;
+    use aerial_chain_core::ChainParams;
 
     fn hover(model: &ChainModel) -> Vec<Actuator> {
         // Each unit carries itself and half of each adjacent link.

@@ -11,10 +11,10 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use arc_core::control::{desired_attitude, Vec3};
-use arc_core::kinematics::Points;
-use arc_core::validity::visit_pairs;
-use arc_core::{ChainParams, MAX_UNITS};
+use aerial_chain_core::control::{desired_attitude, Vec3};
+use aerial_chain_core::kinematics::Points;
+use aerial_chain_core::validity::visit_pairs;
+use aerial_chain_core::{ChainParams, MAX_UNITS};
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Serialize;
 

@@ -4,7 +4,7 @@
 //! [`ChainParams`]; everything else here is a documented default of a small
 //! quadrotor (about 1 kg, 0.17 m arms) and a carbon tube link, configurable.
 
-use arc_core::ChainParams;
+use aerial_chain_core::ChainParams;
 
 /// Standard gravity (m/s^2).
 pub const GRAVITY: f64 = 9.81;

@@ -1,7 +1,7 @@
 //! Closed-loop flights on hand-made plans: the whole stack (MPC, link controllers,
 //! mixer, unit attitude loops) on the multibody dynamics.
 
-use arc_core::ChainParams;
+use aerial_chain_core::ChainParams;
 
 use super::dynamics::V3;
 use super::flight::{simulate, Gust, SimConfig};

@@ -2,8 +2,8 @@
 
 use std::sync::Arc;
 
-use arc_core::validity::Body;
-use arc_core::ChainParams;
+use aerial_chain_core::validity::Body;
+use aerial_chain_core::ChainParams;
 
 use super::*;
 use crate::collision::exact::check_config_exact;
@@ -104,12 +104,12 @@ fn scenarios_can_be_flown() {
         let ctx = CollisionContext::new(f, p, DEFAULT_CLEARANCE).unwrap();
         for (e, w) in plan.waypoints.windows(2).enumerate() {
             let (a, b) = (&w[0], &w[1]);
-            let sa = arc_core::Shape::from_slice(
+            let sa = aerial_chain_core::Shape::from_slice(
                 p.units,
                 &a.eta().iter().map(|&v| v as f32).collect::<Vec<_>>(),
             )
             .unwrap();
-            let sb = arc_core::Shape::from_slice(
+            let sb = aerial_chain_core::Shape::from_slice(
                 p.units,
                 &b.eta().iter().map(|&v| v as f32).collect::<Vec<_>>(),
             )
