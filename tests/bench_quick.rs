@@ -5,10 +5,10 @@
 use std::path::PathBuf;
 
 use aerial_chain::bench::{self, ArcMode, Method, RunSpec};
-use aerial_chain::cli;
 use aerial_chain::collision::verify_plan;
 use aerial_chain::map::scenarios;
 use aerial_chain::plan::Plan;
+use arc_tests::arc;
 
 /// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {
@@ -16,12 +16,6 @@ fn scratch(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-fn arc(args: &[&str]) -> Result<(), cli::CliError> {
-    let mut v = vec!["arc"];
-    v.extend_from_slice(args);
-    cli::run(v)
 }
 
 #[test]

@@ -1,24 +1,14 @@
-//! End to end on the hard-case family (issue 13): tight, oblique openings, a map cut
+//! End to end on the hard-case family: tight, oblique openings, a map cut
 //! in two, checked by the exact verifier (`verify_plan`), never by the planner.
 
 use std::path::Path;
 
-use aerial_chain::cli;
 use aerial_chain::collision::verify_plan;
 use aerial_chain::map::grid::{Cell, Grid};
 use aerial_chain::map::passages::{witness, PassageSpec};
 use aerial_chain::map::scenarios;
 use aerial_chain::plan::Plan;
-
-fn arc(args: &[&str]) -> Result<(), cli::CliError> {
-    let mut v = vec!["arc"];
-    v.extend_from_slice(args);
-    cli::run(v)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
+use arc_tests::{arc, s};
 
 /// Plans `scenario` with default flags, verifies exactly; returns the plan.
 fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {

@@ -4,24 +4,14 @@
 
 use std::path::{Path, PathBuf};
 
-use aerial_chain::cli;
 use aerial_chain::collision::verify_plan;
 use aerial_chain::map::grid::{Cell, Grid};
 use aerial_chain::map::scenarios;
 use aerial_chain::plan::Plan;
-
-fn arc(args: &[&str]) -> Result<(), cli::CliError> {
-    let mut v = vec!["arc"];
-    v.extend_from_slice(args);
-    cli::run(v)
-}
+use arc_tests::{arc, s};
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().expect("temporary directory")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
 }
 
 /// Plans `scenario` with `units`, verifies it exactly, returns the plan.

@@ -11,20 +11,8 @@
 //!   degree); with 0.5 m links that moves a unit at most 1.7 cm per link;
 //! - the flown chain keeps a positive exact clearance and reaches the plan's goal.
 
-use std::path::Path;
-
-use aerial_chain::cli;
 use aerial_chain::collision::DEFAULT_CLEARANCE;
-
-fn arc(args: &[&str]) -> Result<(), cli::CliError> {
-    let mut v = vec!["arc"];
-    v.extend_from_slice(args);
-    cli::run(v)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
+use arc_tests::{arc, s};
 
 fn plan_and_fly(scenario: &str, units: u8) {
     plan_and_fly_with(scenario, units, &[]);

@@ -1,6 +1,6 @@
 //! Helpers shared by the end-to-end tests.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The workspace root.
@@ -60,4 +60,16 @@ pub fn require_thumbv7em_target() {
         "the Rust target thumbv7em-none-eabihf is not installed (sysroot {sysroot:?}): \
          rustup target add thumbv7em-none-eabihf, or run ./test, which does"
     );
+}
+
+/// Runs the `arc` command line in-process with `args` (the program name is added).
+pub fn arc(args: &[&str]) -> Result<(), aerial_chain::cli::CliError> {
+    let mut v = vec!["arc"];
+    v.extend_from_slice(args);
+    aerial_chain::cli::run(v)
+}
+
+/// A path as the `&str` a command line takes.
+pub fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
 }

@@ -1,4 +1,4 @@
-//! Core benchmarks (issue 2): SRS sampling with roadmap, table decode + CRC, forward
+//! Core benchmarks: SRS sampling with roadmap, table decode + CRC, forward
 //! kinematics. Run with `cargo bench -p aerial-chain-core --bench core`.
 
 use std::hint::black_box;

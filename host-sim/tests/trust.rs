@@ -1,4 +1,4 @@
-//! Regressions of issue 14 ("trust"), on the real `arc` binary: the checker's
+//! Regressions on trust (the checker and bad input), on the real `arc` binary: the checker's
 //! assumptions come from its command line, flags are checked before any work, and
 //! one exit-code table holds for every subcommand.
 

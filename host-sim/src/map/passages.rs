@@ -1,4 +1,4 @@
-//! A parametric family of hard cases: tight, oblique openings (issue 13).
+//! A parametric family of hard cases: tight, oblique openings.
 //!
 //! `passage:KEY=VALUE,...` builds a room (at 0.05 m by default) split by a wall with
 //! a square window, approached obliquely and off centre, optionally followed by a

@@ -1,5 +1,5 @@
 //! Chain simulation: the ARC's rigid multibody dynamics flown by its control stack
-//! along a plan (issue 6, "Fly the plan"). See `README.md` beside this file.
+//! along a plan. See `README.md` beside this file.
 //!
 //! - [`model`]: bodies, actuators and their default numbers;
 //! - [`dynamics`]: the multibody (rapier3d, spherical joints at the unit centres);
