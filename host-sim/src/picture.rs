@@ -352,6 +352,9 @@ fn fmt_tick(v: f64, step: f64) -> String {
     }
 }
 
+/// Height of one extra row of legend entries (px).
+const LEGEND_ROW: f64 = 16.0;
+
 /// A figure of panels, with a title and an optional legend.
 pub struct Figure {
     width: f64,
@@ -384,12 +387,31 @@ impl Figure {
         self.legend.push((colour, label.to_string()));
     }
 
-    /// The SVG document.
+    /// Where each legend entry goes: `(x, row)`, wrapping onto a new row where an
+    /// entry would run past the figure's right edge.
+    fn legend_layout(&self) -> Vec<(f64, usize)> {
+        let (mut x, mut row) = (10.0, 0);
+        let mut out = Vec::with_capacity(self.legend.len());
+        for (_, label) in &self.legend {
+            let w = 24.0 + 6.5 * label.len() as f64;
+            if x > 10.0 && x + w > self.width - 10.0 {
+                (x, row) = (10.0, row + 1);
+            }
+            out.push((x, row));
+            x += w;
+        }
+        out
+    }
+
+    /// The SVG document. Extra legend rows add to the figure's height.
     pub fn to_svg(&self) -> String {
+        let layout = self.legend_layout();
+        let extra_rows = layout.last().map_or(0, |l| l.1);
+        let height = self.height + LEGEND_ROW * extra_rows as f64;
         let mut doc = Document::new()
-            .set("viewBox", (0.0, 0.0, self.width, self.height))
+            .set("viewBox", (0.0, 0.0, self.width, height))
             .set("width", self.width)
-            .set("height", self.height)
+            .set("height", height)
             .add(
                 Rectangle::new()
                     .set("width", "100%")
@@ -410,26 +432,18 @@ impl Figure {
         for g in &self.panels {
             doc = doc.add(g.clone());
         }
-        let mut x = 10.0;
-        for (c, label) in &self.legend {
+        for ((c, label), &(x, row)) in self.legend.iter().zip(&layout) {
+            let y = self.height + LEGEND_ROW * row as f64;
             doc = doc
                 .add(
                     Rectangle::new()
                         .set("x", x)
-                        .set("y", self.height - 14.0)
+                        .set("y", y - 14.0)
                         .set("width", 10)
                         .set("height", 10)
                         .set("fill", *c),
                 )
-                .add(text(
-                    x + 14.0,
-                    self.height - 5.0,
-                    label,
-                    11.0,
-                    palette::INK,
-                    "start",
-                ));
-            x += 24.0 + 6.5 * label.len() as f64;
+                .add(text(x + 14.0, y - 5.0, label, 11.0, palette::INK, "start"));
         }
         doc.to_string()
     }
