@@ -3,34 +3,15 @@
 
 use std::path::Path;
 
-use aerial_chain::collision::verify_plan;
 use aerial_chain::map::grid::{Cell, Grid};
 use aerial_chain::map::passages::{witness, PassageSpec};
 use aerial_chain::map::scenarios;
 use aerial_chain::plan::Plan;
-use arc_tests::{arc, s};
+use arc_tests::{arc, plan_verified, s};
 
 /// Plans `scenario` with default flags, verifies exactly; returns the plan.
 fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
-    let out = dir.join(format!("plan-{units}.json"));
-    let n = units.to_string();
-    arc(&[
-        "plan",
-        "--scenario",
-        scenario,
-        "--units",
-        &n,
-        "--out",
-        s(&out),
-    ])
-    .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
-    let plan = Plan::read(&out).expect("plan reads back");
-    let sc = scenarios::build(scenario).expect("family instance");
-    let report = verify_plan(&sc.grid, &plan);
-    assert!(report.ok, "{scenario} N={units}: {:?}", report.violation);
-    let last = plan.waypoints[plan.waypoints.len() - 1].xi();
-    let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
-    assert!(d <= 0.3 + 1e-9, "ends {d} m from the goal");
+    let (plan, _) = plan_verified(scenario, units, dir);
     assert!(plan.stats.contains_key("min_margin"));
     plan
 }

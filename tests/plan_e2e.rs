@@ -8,46 +8,28 @@ use aerial_chain::collision::verify_plan;
 use aerial_chain::map::grid::{Cell, Grid};
 use aerial_chain::map::scenarios;
 use aerial_chain::plan::Plan;
-use arc_tests::{arc, s};
+use arc_tests::{arc, plan_verified, s};
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().expect("temporary directory")
 }
 
-/// Plans `scenario` with `units`, verifies it exactly, returns the plan.
+/// Plans `scenario` with `units`, verifies it exactly (through `arc verify` too),
+/// returns the plan.
 fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
+    let (plan, sc) = plan_verified(scenario, units, dir);
     let out = dir.join(format!("{scenario}-{units}.json"));
-    let n = units.to_string();
-    arc(&[
-        "plan",
-        "--scenario",
-        scenario,
-        "--units",
-        &n,
-        "--out",
-        s(&out),
-    ])
-    .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
     arc(&["verify", "--scenario", scenario, "--plan", s(&out)])
         .unwrap_or_else(|e| panic!("{scenario} N={units}: arc verify: {e}"));
-    let plan = Plan::read(&out).expect("plan file reads back");
-    let sc = scenarios::build(scenario).expect("built-in scenario");
     let report = verify_plan(&sc.grid, &plan);
-    assert!(report.ok, "{scenario} N={units}: {:?}", report.violation);
     assert!(report.min_clearance > 0.0);
-    // Starts at the scenario's start, in the start shape; ends within 0.3 m of the goal.
+    // Starts at the scenario's start, in the start shape.
     let first = plan.waypoints[0].xi();
     assert!((0..3).all(|k| (first[k] - sc.start[k]).abs() <= 1e-6));
     let start_shape = sc.start_shape(units).expect("start shape");
     for (a, b) in plan.waypoints[0].eta().iter().zip(start_shape.as_slice()) {
         assert!((a - *b as f64).abs() < 1e-6, "start shape differs");
     }
-    let last = plan.waypoints[plan.waypoints.len() - 1].xi();
-    let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
-    assert!(
-        d <= 0.3 + 1e-9,
-        "{scenario} N={units}: ends {d} m from the goal"
-    );
     let changes = plan.stats["shape_changes"]
         .as_u64()
         .expect("shape_changes in stats");

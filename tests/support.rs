@@ -73,3 +73,39 @@ pub fn arc(args: &[&str]) -> Result<(), aerial_chain::cli::CliError> {
 pub fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
 }
+
+/// Plans `scenario` for `units` with `arc plan`'s defaults into `dir`, checks the plan
+/// with the exact verifier (never the planner's own checks) and that its head ends
+/// within 0.3 m of the goal; returns the plan and the scenario.
+pub fn plan_verified(
+    scenario: &str,
+    units: u8,
+    dir: &Path,
+) -> (
+    aerial_chain::plan::Plan,
+    aerial_chain::map::scenarios::Scenario,
+) {
+    let out = dir.join(format!("{scenario}-{units}.json"));
+    let n = units.to_string();
+    arc(&[
+        "plan",
+        "--scenario",
+        scenario,
+        "--units",
+        &n,
+        "--out",
+        s(&out),
+    ])
+    .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
+    let plan = aerial_chain::plan::Plan::read(&out).expect("plan file reads back");
+    let sc = aerial_chain::map::scenarios::build(scenario).expect("scenario");
+    let report = aerial_chain::collision::verify_plan(&sc.grid, &plan);
+    assert!(report.ok, "{scenario} N={units}: {:?}", report.violation);
+    let last = plan.waypoints[plan.waypoints.len() - 1].xi();
+    let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
+    assert!(
+        d <= 0.3 + 1e-9,
+        "{scenario} N={units}: ends {d} m from the goal"
+    );
+    (plan, sc)
+}
