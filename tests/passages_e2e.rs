@@ -3,11 +3,10 @@
 
 use std::path::Path;
 
-use aerial_chain::map::grid::{Cell, Grid};
 use aerial_chain::map::passages::{witness, PassageSpec};
 use aerial_chain::map::scenarios;
 use aerial_chain::plan::Plan;
-use arc_tests::{arc, plan_verified, s};
+use arc_tests::{arc, plan_verified, s, sealed_rooms};
 
 /// Plans `scenario` with default flags, verifies exactly; returns the plan.
 fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
@@ -42,17 +41,7 @@ fn family_names_parse_and_build() {
 #[test]
 fn a_map_cut_in_two_exits_1_with_the_reason_whatever_max_growth_says() {
     let dir = tempfile::tempdir().unwrap();
-    let mut g = Grid::new(0.1, [0, 0, 0], [80, 40, 30], Cell::Free, true).unwrap();
-    let wall = |g: &mut Grid, lo: [f64; 3], hi: [f64; 3]| g.fill_box(lo, hi, Cell::Occupied);
-    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 4.0, 0.2]);
-    wall(&mut g, [0.0, 0.0, 2.8], [8.0, 4.0, 3.0]);
-    wall(&mut g, [0.0, 0.0, 0.0], [0.2, 4.0, 3.0]);
-    wall(&mut g, [7.8, 0.0, 0.0], [8.0, 4.0, 3.0]);
-    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 0.2, 3.0]);
-    wall(&mut g, [0.0, 3.8, 0.0], [8.0, 4.0, 3.0]);
-    wall(&mut g, [3.9, 0.0, 0.0], [4.1, 4.0, 3.0]);
-    let map = dir.path().join("cut.bt");
-    g.to_octree().unwrap().write_bt(&map).unwrap();
+    let map = sealed_rooms(dir.path());
     let out = dir.path().join("p.json");
     let e = arc(&[
         "plan",

@@ -2,13 +2,12 @@
 //! test of docs/model.md (`arc verify` and `verify_plan`), never by the planner's own
 //! conservative shortcuts; failures and bad input give the right exit codes.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use aerial_chain::collision::verify_plan;
-use aerial_chain::map::grid::{Cell, Grid};
 use aerial_chain::map::scenarios;
 use aerial_chain::plan::Plan;
-use arc_tests::{arc, plan_verified, s};
+use arc_tests::{arc, plan_verified, s, sealed_rooms};
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().expect("temporary directory")
@@ -106,22 +105,6 @@ fn same_seed_same_plan_byte_for_byte() {
         run("d.json", "8"),
         "another seed, another roadmap"
     );
-}
-
-/// A map of two sealed rooms: free inside, walls around and between.
-fn sealed_rooms(dir: &Path) -> PathBuf {
-    let mut g = Grid::new(0.1, [0, 0, 0], [80, 40, 30], Cell::Free, true).unwrap();
-    let wall = |g: &mut Grid, lo: [f64; 3], hi: [f64; 3]| g.fill_box(lo, hi, Cell::Occupied);
-    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 4.0, 0.2]);
-    wall(&mut g, [0.0, 0.0, 2.8], [8.0, 4.0, 3.0]);
-    wall(&mut g, [0.0, 0.0, 0.0], [0.2, 4.0, 3.0]);
-    wall(&mut g, [7.8, 0.0, 0.0], [8.0, 4.0, 3.0]);
-    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 0.2, 3.0]);
-    wall(&mut g, [0.0, 3.8, 0.0], [8.0, 4.0, 3.0]);
-    wall(&mut g, [3.9, 0.0, 0.0], [4.1, 4.0, 3.0]);
-    let path = dir.join("sealed.bt");
-    g.to_octree().unwrap().write_bt(&path).unwrap();
-    path
 }
 
 #[test]

@@ -109,3 +109,28 @@ pub fn plan_verified(
     );
     (plan, sc)
 }
+
+/// A map of two sealed rooms: free inside, walls around and between.
+pub fn sealed_rooms(dir: &Path) -> PathBuf {
+    let mut g = aerial_chain::map::grid::Grid::new(
+        0.1,
+        [0, 0, 0],
+        [80, 40, 30],
+        aerial_chain::map::grid::Cell::Free,
+        true,
+    )
+    .unwrap();
+    let wall = |g: &mut aerial_chain::map::grid::Grid, lo: [f64; 3], hi: [f64; 3]| {
+        g.fill_box(lo, hi, aerial_chain::map::grid::Cell::Occupied)
+    };
+    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 4.0, 0.2]);
+    wall(&mut g, [0.0, 0.0, 2.8], [8.0, 4.0, 3.0]);
+    wall(&mut g, [0.0, 0.0, 0.0], [0.2, 4.0, 3.0]);
+    wall(&mut g, [7.8, 0.0, 0.0], [8.0, 4.0, 3.0]);
+    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 0.2, 3.0]);
+    wall(&mut g, [0.0, 3.8, 0.0], [8.0, 4.0, 3.0]);
+    wall(&mut g, [3.9, 0.0, 0.0], [4.1, 4.0, 3.0]);
+    let path = dir.join("sealed.bt");
+    g.to_octree().unwrap().write_bt(&path).unwrap();
+    path
+}

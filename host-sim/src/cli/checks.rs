@@ -86,6 +86,17 @@ pub fn positive(flag: &str, v: f64) -> Result<(), CliError> {
     }
 }
 
+/// `--srs`: the number of random shapes, which the table indexes with 16 bits.
+pub fn srs(v: usize) -> Result<(), CliError> {
+    count(
+        "--srs",
+        v,
+        0,
+        u16::MAX as usize,
+        "the table's index is 16 bits",
+    )
+}
+
 /// A count within `lo..=hi`; `why` says where the upper limit comes from.
 pub fn count(flag: &str, v: usize, lo: usize, hi: usize, why: &str) -> Result<(), CliError> {
     if (lo..=hi).contains(&v) {

@@ -152,13 +152,7 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
     )?;
     checks::length("--clearance-min", a.clearance_min, false)?;
     checks::time_limit(a.time_limit)?;
-    checks::count(
-        "--srs",
-        a.srs,
-        0,
-        u16::MAX as usize,
-        "the table's index is 16 bits",
-    )?;
+    checks::srs(a.srs)?;
     checks::optional_picture("--picture", a.picture.as_ref())
 }
 

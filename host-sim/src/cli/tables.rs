@@ -74,13 +74,7 @@ fn build(a: BuildArgs) -> CliResult {
             .units
             .ok_or_else(|| CliError::input("--units is required"))?,
     )?;
-    checks::count(
-        "--srs",
-        a.srs,
-        0,
-        u16::MAX as usize,
-        "the table's index is 16 bits",
-    )?;
+    checks::srs(a.srs)?;
     if let Some(r) = a.r_s {
         checks::positive("--r-s", r as f64)?;
     }
