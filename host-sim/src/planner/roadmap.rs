@@ -200,45 +200,49 @@ impl Roadmap {
     /// Adds a query vertex (start or goal) joined to the sampled vertices within
     /// `r_T`; removed again by [`Self::clear_query`].
     pub fn add_query_vertex(&mut self, p: [f64; 3]) -> VertexId {
-        let id = self.points.len();
-        self.points.push(p);
-        self.clearance.push(f64::INFINITY);
-        self.edges.push(Vec::new());
-        let mut near = self
-            .tree
-            .within_unsorted::<SquaredEuclidean>(&p, self.r_t * self.r_t);
-        near.sort_by_key(|n| n.item);
-        for n in near {
-            let j = n.item as usize;
-            let length = n.distance.sqrt();
-            self.edges[id].push(Edge {
-                to: j,
-                length,
-                state: Cell::new(EdgeState::Unchecked),
-            });
-            self.edges[j].push(Edge {
-                to: id,
-                length,
-                state: Cell::new(EdgeState::Unchecked),
-            });
+        let id = self.push_vertex(p, f64::INFINITY);
+        for (j, length) in self.sampled_within_r_t(p) {
+            self.link(id, j, length, EdgeState::Unchecked);
         }
         // Query vertices see each other too (a start next to the goal).
         for q in self.sampled..id {
             let length = dist(self.points[q], p);
             if length <= self.r_t {
-                self.edges[id].push(Edge {
-                    to: q,
-                    length,
-                    state: Cell::new(EdgeState::Unchecked),
-                });
-                self.edges[q].push(Edge {
-                    to: id,
-                    length,
-                    state: Cell::new(EdgeState::Unchecked),
-                });
+                self.link(id, q, length, EdgeState::Unchecked);
             }
         }
         id
+    }
+
+    /// Appends a vertex at `p` with obstacle clearance `c` and no edges yet.
+    fn push_vertex(&mut self, p: [f64; 3], c: f64) -> VertexId {
+        let id = self.points.len();
+        self.points.push(p);
+        self.clearance.push(c);
+        self.edges.push(Vec::new());
+        id
+    }
+
+    /// The sampled vertices within `r_T` of `p`, by index, with their distances.
+    fn sampled_within_r_t(&self, p: [f64; 3]) -> Vec<(VertexId, f64)> {
+        let mut near = self
+            .tree
+            .within_unsorted::<SquaredEuclidean>(&p, self.r_t * self.r_t);
+        near.sort_by_key(|n| n.item);
+        near.iter()
+            .map(|n| (n.item as usize, n.distance.sqrt()))
+            .collect()
+    }
+
+    /// Joins `a` and `b` both ways by an edge of `length` in `state`.
+    fn link(&mut self, a: VertexId, b: VertexId, length: f64, state: EdgeState) {
+        for (x, y) in [(a, b), (b, a)] {
+            self.edges[x].push(Edge {
+                to: y,
+                length,
+                state: Cell::new(state),
+            });
+        }
     }
 
     /// Adds a head route (from the lattice search, [`super::lattice`]) between the query
@@ -258,26 +262,12 @@ impl Roadmap {
         let (w, r) = (self.clearance_weight, self.clearance_ref.max(1e-9));
         let mut ids = vec![from];
         for &p in inner {
-            let id = self.points.len();
             let c = ctx.clearance(p);
-            self.points.push(p);
-            self.clearance.push(c);
-            self.edges.push(Vec::new());
-            let mut near = self
-                .tree
-                .within_unsorted::<SquaredEuclidean>(&p, self.r_t * self.r_t);
-            near.sort_by_key(|n| n.item);
-            for n in near {
-                let j = n.item as usize;
+            let id = self.push_vertex(p, c);
+            for (j, d) in self.sampled_within_r_t(p) {
                 let cj = c.min(self.clearance[j]);
-                let length = n.distance.sqrt() * (1.0 + w * (1.0 - cj / r).max(0.0));
-                for (x, y) in [(id, j), (j, id)] {
-                    self.edges[x].push(Edge {
-                        to: y,
-                        length,
-                        state: Cell::new(EdgeState::Unchecked),
-                    });
-                }
+                let length = d * (1.0 + w * (1.0 - cj / r).max(0.0));
+                self.link(id, j, length, EdgeState::Unchecked);
             }
             ids.push(id);
         }
