@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use aerial_chain::bench::{self, ArcMode, Method, RunSpec};
 use aerial_chain::collision::verify_plan;
-use aerial_chain::map::scenarios;
 use aerial_chain::plan::Plan;
+use aerial_chain::problem::scenarios;
 use arc_tests::arc;
 
 /// A fresh scratch directory for one test.

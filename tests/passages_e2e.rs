@@ -3,9 +3,9 @@
 
 use std::path::Path;
 
-use aerial_chain::map::passages::{witness, PassageSpec};
-use aerial_chain::map::scenarios;
 use aerial_chain::plan::Plan;
+use aerial_chain::problem::passages::{witness, PassageSpec};
+use aerial_chain::problem::scenarios;
 use arc_tests::{arc, plan_verified, s, sealed_rooms};
 
 /// Plans `scenario` with default flags, verifies exactly; returns the plan.

@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use aerial_chain::collision::verify_plan;
-use aerial_chain::map::scenarios;
 use aerial_chain::plan::Plan;
+use aerial_chain::problem::scenarios;
 use arc_tests::{arc, plan_verified, s, sealed_rooms};
 
 fn tmp() -> tempfile::TempDir {

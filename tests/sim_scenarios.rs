@@ -141,7 +141,7 @@ fn bad_plans_are_input_errors() {
 fn a_plan_into_a_wall_fails_with_exit_1() {
     // A straight translation of the window scenario's start chain into the wall.
     let dir = tempfile::tempdir().expect("temporary directory");
-    let sc = aerial_chain::map::scenarios::build("window").unwrap();
+    let sc = aerial_chain::problem::scenarios::build("window").unwrap();
     let params = aerial_chain_core::ChainParams::new(4);
     let shape = sc.start_shape(4).unwrap();
     let start = sc.start;

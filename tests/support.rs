@@ -83,7 +83,7 @@ pub fn plan_verified(
     dir: &Path,
 ) -> (
     aerial_chain::plan::Plan,
-    aerial_chain::map::scenarios::Scenario,
+    aerial_chain::problem::scenarios::Scenario,
 ) {
     let out = dir.join(format!("{scenario}-{units}.json"));
     let n = units.to_string();
@@ -98,7 +98,7 @@ pub fn plan_verified(
     ])
     .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
     let plan = aerial_chain::plan::Plan::read(&out).expect("plan file reads back");
-    let sc = aerial_chain::map::scenarios::build(scenario).expect("scenario");
+    let sc = aerial_chain::problem::scenarios::build(scenario).expect("scenario");
     let report = aerial_chain::collision::verify_plan(&sc.grid, &plan);
     assert!(report.ok, "{scenario} N={units}: {:?}", report.violation);
     let last = plan.waypoints[plan.waypoints.len() - 1].xi();

@@ -7,7 +7,7 @@ use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use aerial_chain::map::distance::DistanceField;
 use aerial_chain::map::grid::Grid;
 use aerial_chain::map::octomap::OcTree;
-use aerial_chain::map::scenarios;
+use aerial_chain::problem::scenarios;
 use aerial_chain_core::ChainParams;
 
 #[test]

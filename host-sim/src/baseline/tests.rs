@@ -6,7 +6,7 @@ use aerial_chain_core::{ChainParams, Shape};
 use super::*;
 use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use crate::map::distance::DistanceField;
-use crate::map::scenarios;
+use crate::problem::scenarios;
 
 fn window_ctx(units: u8) -> (CollisionContext, scenarios::Scenario) {
     let sc = scenarios::build("window").unwrap();

@@ -35,8 +35,8 @@ use rayon::prelude::*;
 use crate::baseline::{self, FullStatePrm, PrmError, PrmSettings};
 use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use crate::map::distance::DistanceField;
-use crate::map::scenarios::{self, Scenario};
 use crate::planner::{motion, Mode, PlanError, Planner, Settings, Termination};
+use crate::problem::scenarios::{self, Scenario};
 use crate::tables::{ShapeTables, TableSettings};
 
 /// Which planner a run uses.
@@ -290,7 +290,7 @@ pub const WIDE_WINDOW: &str = "window-wide:";
 /// same centre), where a full-state PRM has a chance (see [`paper`]).
 pub fn build_scenario(name: &str) -> Result<Scenario, String> {
     let Some(w) = name.strip_prefix(WIDE_WINDOW) else {
-        return scenarios::build(name);
+        return scenarios::build(name).map_err(|e| e.to_string());
     };
     let w: f64 = w
         .parse()
@@ -347,7 +347,7 @@ pub fn context(env: &Env, units: u8) -> Result<CollisionContext, String> {
 pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, String> {
     Ok(Query {
         start: sc.start,
-        shape: sc.start_shape(units)?,
+        shape: sc.start_shape(units).map_err(|e| e.to_string())?,
         goal: sc.goal,
     })
 }

@@ -1,5 +1,5 @@
 //! `arc bench robust`: the ARCplanner with `arc plan`'s defaults on random instances of
-//! the hard-case family ([`crate::map::passages`]), N = 4..8.
+//! the hard-case family ([`crate::problem::passages`]), N = 4..8.
 //!
 //! Each instance is drawn from a seeded generator; it is kept only when its witness
 //! (follow-the-leader along the hand-made centre line, checked by the exact verifier,
@@ -10,7 +10,7 @@
 use rand::{Rng, SeedableRng};
 
 use super::{plot, run_all, ArcMode, Envs, Method, RunResult, RunSpec, Spread};
-use crate::map::passages::{witness, PassageSpec};
+use crate::problem::passages::{witness, PassageSpec};
 
 /// Options of the study.
 #[derive(Clone, Debug)]

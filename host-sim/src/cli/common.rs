@@ -12,8 +12,8 @@ use super::{checks, CliError};
 use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 use crate::map::octomap::OcTree;
-use crate::map::scenarios::{self, Scenario};
 use crate::plan::MapSource;
+use crate::problem::scenarios::{self, Scenario};
 
 /// Chain geometry options shared by every command that makes a chain.
 #[derive(Args, Debug, Clone)]

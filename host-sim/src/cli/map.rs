@@ -10,7 +10,7 @@ use super::{CliError, CliResult};
 use crate::map::grid::Grid;
 use crate::map::octomap::OcTree;
 use crate::map::picture::{map_figure, MapPictureOptions};
-use crate::map::scenarios::{self, Scenario};
+use crate::problem::scenarios::{self, Scenario};
 
 /// `arc map ...`
 #[derive(Subcommand, Debug)]

@@ -1,7 +1,5 @@
-//! Maps: OctoMap files, occupancy grids, distance fields and scenario generators.
+//! Maps: OctoMap files, occupancy grids and distance fields.
 pub mod distance;
 pub mod grid;
 pub mod octomap;
-pub mod passages;
 pub mod picture;
-pub mod scenarios;

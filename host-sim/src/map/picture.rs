@@ -6,7 +6,7 @@
 use crate::picture::{palette, Figure, Panel};
 
 use super::grid::{Cell, Grid};
-use super::scenarios::Scenario;
+use crate::problem::scenarios::Scenario;
 
 /// What to draw.
 #[derive(Clone, Debug, PartialEq)]
@@ -213,8 +213,8 @@ mod tests {
 
     #[test]
     fn pictures_of_every_scenario() {
-        for name in super::super::scenarios::NAMES {
-            let s = super::super::scenarios::build(name).unwrap();
+        for name in crate::problem::scenarios::NAMES {
+            let s = crate::problem::scenarios::build(name).unwrap();
             let opts = MapPictureOptions {
                 band: None,
                 slices: Vec::new(),

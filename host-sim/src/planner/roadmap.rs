@@ -493,7 +493,7 @@ mod tests {
 
     use super::*;
     use crate::map::distance::DistanceField;
-    use crate::map::scenarios;
+    use crate::problem::scenarios;
 
     fn window_roadmap() -> (CollisionContext, Roadmap, [f64; 3], [f64; 3]) {
         let sc = scenarios::build("window").expect("built-in scenario");

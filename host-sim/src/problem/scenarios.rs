@@ -28,7 +28,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use aerial_chain_core::{ChainParams, Shape};
 
-use super::grid::{Cell, Grid};
+use super::ProblemError;
+use crate::map::grid::{Cell, Grid};
+use crate::map::octomap::{MapFileError, OcTree};
 use crate::plan::{ChainSection, MapSection, MapSource, Plan, Waypoint};
 
 /// Resolution of every built-in scenario (m).
@@ -68,7 +70,7 @@ pub struct Scenario {
 
 /// A scenario by name: `window`, `maze`, `silos`, `corridor` (20 m) or `corridor:L`
 /// (`L` metres, 10 to 100).
-pub fn build(name: &str) -> Result<Scenario, String> {
+pub fn build(name: &str) -> Result<Scenario, ProblemError> {
     match name {
         "window" => Ok(window()),
         "maze" => Ok(maze()),
@@ -80,13 +82,10 @@ pub fn build(name: &str) -> Result<Scenario, String> {
             } else if let Some(len) = name.strip_prefix("corridor:") {
                 let l: f64 = len
                     .parse()
-                    .map_err(|_| format!("corridor length {len:?} is not a number"))?;
+                    .map_err(|_| ProblemError::CorridorLengthNotANumber(len.into()))?;
                 corridor(l)
             } else {
-                Err(format!(
-                    "unknown scenario {name:?}; known: {}, corridor:LENGTH, passage:KEY=VALUE,...",
-                    NAMES.join(", ")
-                ))
+                Err(ProblemError::UnknownScenario(name.into()))
             }
         }
     }
@@ -252,9 +251,9 @@ pub fn silos() -> Scenario {
 }
 
 /// A long corridor with doors at alternating sides, `length` metres (10 to 100).
-pub fn corridor(length: f64) -> Result<Scenario, String> {
+pub fn corridor(length: f64) -> Result<Scenario, ProblemError> {
     if !CORRIDOR_LENGTHS.contains(&length) {
-        return Err(format!("corridor length {length} m is outside 10..=100 m"));
+        return Err(ProblemError::CorridorLength(length));
     }
     // Whole voxels.
     let sx = (length / RESOLUTION).round() * RESOLUTION;
@@ -316,14 +315,19 @@ pub fn corridor(length: f64) -> Result<Scenario, String> {
 
 impl Scenario {
     /// The scenario's map as an OctoMap tree (every voxel in the box known; pruned).
-    pub fn octree(&self) -> Result<super::octomap::OcTree, super::octomap::MapFileError> {
-        super::octomap::OcTree::from_voxels(self.grid.resolution(), self.grid.known_voxels())
+    pub fn octree(&self) -> Result<OcTree, MapFileError> {
+        OcTree::from_voxels(self.grid.resolution(), self.grid.known_voxels())
     }
 
     /// The start shape: the straight line LI at the start yaw.
-    pub fn start_shape(&self, units: u8) -> Result<Shape, String> {
+    pub fn start_shape(&self, units: u8) -> Result<Shape, ProblemError> {
         if !(2..=aerial_chain_core::MAX_UNITS as u8).contains(&units) {
-            return Err(format!("units = {units} is outside 2..=16"));
+            return Err(ProblemError::OutOfRange {
+                name: "units",
+                value: units.into(),
+                lo: 2.0,
+                hi: aerial_chain_core::MAX_UNITS as f64,
+            });
         }
         Ok(Shape::line(units, self.start_yaw as f32))
     }
@@ -332,10 +336,10 @@ impl Scenario {
     /// route, `l` apart), alternating translations of the head by at most `step` metres
     /// and shape changes that put the units back on the route. Not optimal in any way;
     /// it shows that the scenario can be flown and gives the simulator something to fly.
-    pub fn route_plan(&self, params: &ChainParams, step: f64) -> Result<Plan, String> {
-        let params = params.validate().map_err(|e| format!("chain: {e}"))?;
+    pub fn route_plan(&self, params: &ChainParams, step: f64) -> Result<Plan, ProblemError> {
+        let params = params.validate().map_err(ProblemError::Chain)?;
         if !(step.is_finite() && step > 0.0) {
-            return Err(format!("step {step} must be a positive number"));
+            return Err(ProblemError::Step(step));
         }
         let n = params.n();
         let l = params.link_length as f64;
@@ -356,7 +360,7 @@ impl Scenario {
         if dist(self.route[0], self.start) > 1e-9
             || dist(*self.route.last().unwrap_or(&self.start), self.goal) > 1e-9
         {
-            return Err("the route must run from the start to the goal".into());
+            return Err(ProblemError::RouteEnds);
         }
         let route = Polyline::new(path);
         let s_start = n as f64 * l;
@@ -444,7 +448,7 @@ impl Polyline {
     }
 
     /// The shape whose units sit on the polyline, `l` apart (chord), head at `s`.
-    fn follow_shape(&self, s: f64, n: usize, l: f64) -> Result<Shape, String> {
+    fn follow_shape(&self, s: f64, n: usize, l: f64) -> Result<Shape, ProblemError> {
         let mut eta = vec![0f32; 2 * n - 1];
         let mut sk = s;
         let mut prev = self.point(s);
@@ -455,7 +459,7 @@ impl Polyline {
             loop {
                 hi -= 0.01;
                 if hi < 0.0 {
-                    return Err("the route's start is too short for the chain".into());
+                    return Err(ProblemError::RouteTooShort);
                 }
                 if dist(self.point(hi), prev) >= l {
                     break;
@@ -487,7 +491,7 @@ impl Polyline {
             prev = q;
             sk = hi;
         }
-        Shape::from_slice(n as u8, &eta).map_err(|e| format!("{e:?}"))
+        Shape::from_slice(n as u8, &eta).map_err(ProblemError::Shape)
     }
 }
 

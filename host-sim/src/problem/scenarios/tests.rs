@@ -28,7 +28,7 @@ fn names_build() {
     assert_eq!(build("corridor:35").unwrap().name, "corridor:35");
     assert!(build("corridor:5").is_err());
     assert!(build("corridor:x").is_err());
-    assert!(build("nope").unwrap_err().contains("window"));
+    assert!(build("nope").unwrap_err().to_string().contains("window"));
     assert!(corridor(100.0).is_ok() && corridor(100.5).is_err() && corridor(f64::NAN).is_err());
 }
 

@@ -23,9 +23,11 @@
 
 use aerial_chain_core::ChainParams;
 
-use super::grid::{Cell, Grid};
-use super::scenarios::Scenario;
+use super::ProblemError;
 use crate::collision::verify_plan;
+use crate::map::grid::{Cell, Grid};
+use crate::plan::Plan;
+use crate::problem::scenarios::Scenario;
 
 /// Parameters of one instance.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,18 +76,18 @@ const Z_C: f64 = 1.3;
 
 impl PassageSpec {
     /// Parses `KEY=VALUE,...` (see the module docs).
-    pub fn parse(text: &str) -> Result<Self, String> {
+    pub fn parse(text: &str) -> Result<Self, ProblemError> {
         let mut s = Self::default();
         let mut door_offset = 0.0;
         let mut door = None;
         for part in text.split(',').filter(|p| !p.trim().is_empty()) {
             let (k, v) = part
                 .split_once('=')
-                .ok_or_else(|| format!("{part:?}: expected KEY=VALUE"))?;
-            let v: f64 = v
-                .trim()
-                .parse()
-                .map_err(|_| format!("{part:?}: {v:?} is not a number"))?;
+                .ok_or_else(|| ProblemError::ExpectedKeyValue(part.into()))?;
+            let v: f64 = v.trim().parse().map_err(|_| ProblemError::NotANumber {
+                part: part.into(),
+                value: v.into(),
+            })?;
             match k.trim() {
                 "w" => s.w = v,
                 "angle" => s.angle_deg = v,
@@ -95,11 +97,7 @@ impl PassageSpec {
                 "door_offset" => door_offset = v,
                 "res" => s.res = v,
                 "sealed" => s.sealed = v != 0.0,
-                other => {
-                    return Err(format!(
-                    "unknown key {other:?}; known: w, angle, offset, wall, door, door_offset, res, sealed"
-                ))
-                }
+                other => return Err(ProblemError::UnknownKey(other.into())),
             }
         }
         s.door = door.map(|d| (d, door_offset));
@@ -108,12 +106,17 @@ impl PassageSpec {
     }
 
     /// Checks the ranges of the module docs.
-    pub fn check(&self) -> Result<(), String> {
-        let within = |name: &str, v: f64, lo: f64, hi: f64| {
-            if v.is_finite() && (lo..=hi).contains(&v) {
+    pub fn check(&self) -> Result<(), ProblemError> {
+        let within = |name: &'static str, value: f64, lo: f64, hi: f64| {
+            if value.is_finite() && (lo..=hi).contains(&value) {
                 Ok(())
             } else {
-                Err(format!("{name} = {v} is outside {lo}..={hi}"))
+                Err(ProblemError::OutOfRange {
+                    name,
+                    value,
+                    lo,
+                    hi,
+                })
             }
         };
         within("w", self.w, 0.4, 1.0)?;
@@ -166,7 +169,7 @@ impl PassageSpec {
     }
 
     /// The scenario.
-    pub fn build(&self) -> Result<Scenario, String> {
+    pub fn build(&self) -> Result<Scenario, ProblemError> {
         self.check()?;
         let r = self.res;
         let snap = |v: f64| (v / r).round() * r;
@@ -181,8 +184,7 @@ impl PassageSpec {
             None => WALL_X + t + 3.5,
         });
         let dims = [sx, ROOM_Y, ROOM_Z].map(|v| (v / r).round() as usize);
-        let mut g =
-            Grid::new(r, [0; 3], dims, Cell::Occupied, true).map_err(|e| format!("grid: {e}"))?;
+        let mut g = Grid::new(r, [0; 3], dims, Cell::Occupied, true)?;
         let e = 1e-6;
         let fill = |g: &mut Grid, lo: [f64; 3], hi: [f64; 3], c: Cell| {
             g.fill_box(
@@ -263,11 +265,11 @@ impl PassageSpec {
 /// The witness of an instance for a chain: the follow-the-leader plan along the
 /// scenario's centre line ([`Scenario::route_plan`], steps of a quarter voxel),
 /// checked by the EXACT verifier. `Err` says why there is none.
-pub fn witness(sc: &Scenario, params: &ChainParams) -> Result<crate::plan::Plan, String> {
+pub fn witness(sc: &Scenario, params: &ChainParams) -> Result<Plan, ProblemError> {
     let plan = sc.route_plan(params, sc.grid.resolution())?;
     let report = verify_plan(&sc.grid, &plan);
     if !report.ok {
-        return Err(format!("witness is invalid: {:?}", report.violation));
+        return Err(ProblemError::InvalidWitness(report.violation));
     }
     Ok(plan)
 }

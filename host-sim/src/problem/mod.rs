@@ -1,0 +1,75 @@
+//! Problems to plan for: the built-in scenarios (the paper's rooms and more) and the
+//! parametric family of hard cases (`passage:`), each a map with a start, a goal and a
+//! hand-made route that shows the problem can be solved.
+//!
+//! This layer sits above the map and collision layers (a scenario is a grid; a witness
+//! is checked by the exact verifier) and below planning.
+
+pub mod passages;
+pub mod scenarios;
+
+use crate::collision::verify::PlanViolation;
+
+/// Why a scenario cannot be built, or why its route gives no plan.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ProblemError {
+    /// A name that is no built-in scenario.
+    #[error(
+        "unknown scenario {0:?}; known: {known}, corridor:LENGTH, passage:KEY=VALUE,...",
+        known = scenarios::NAMES.join(", ")
+    )]
+    UnknownScenario(String),
+    /// `corridor:LENGTH` with a length that is no number.
+    #[error("corridor length {0:?} is not a number")]
+    CorridorLengthNotANumber(String),
+    /// A corridor length outside [`scenarios::CORRIDOR_LENGTHS`].
+    #[error("corridor length {0} m is outside 10..=100 m")]
+    CorridorLength(f64),
+    /// A `passage:` part without `=`.
+    #[error("{0:?}: expected KEY=VALUE")]
+    ExpectedKeyValue(String),
+    /// A `passage:` value that is no number.
+    #[error("{part:?}: {value:?} is not a number")]
+    NotANumber {
+        /// The whole `KEY=VALUE` part.
+        part: String,
+        /// The value as written.
+        value: String,
+    },
+    /// A `passage:` key that the family does not have.
+    #[error("unknown key {0:?}; known: w, angle, offset, wall, door, door_offset, res, sealed")]
+    UnknownKey(String),
+    /// A parameter outside its range.
+    #[error("{name} = {value} is outside {lo}..={hi}")]
+    OutOfRange {
+        /// The parameter.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// The smallest allowed value.
+        lo: f64,
+        /// The largest allowed value.
+        hi: f64,
+    },
+    /// Chain parameters that are not a valid chain.
+    #[error("chain: {0}")]
+    Chain(aerial_chain_core::ParamError),
+    /// A grid the map layer refuses.
+    #[error("grid: {0}")]
+    Grid(#[from] crate::map::grid::GridError),
+    /// A shape the chain model refuses.
+    #[error("{0:?}")]
+    Shape(aerial_chain_core::shape::ShapeError),
+    /// A route step that is not a positive number.
+    #[error("step {0} must be a positive number")]
+    Step(f64),
+    /// A route that does not run from the scenario's start to its goal.
+    #[error("the route must run from the start to the goal")]
+    RouteEnds,
+    /// A route whose start leaves no room for the chain behind the head.
+    #[error("the route's start is too short for the chain")]
+    RouteTooShort,
+    /// The follow-the-leader plan along the route fails the exact test.
+    #[error("witness is invalid: {0:?}")]
+    InvalidWitness(Option<PlanViolation>),
+}
