@@ -18,10 +18,11 @@ use aerial_chain_core::{ChainParams, MAX_UNITS};
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Serialize;
 
+use super::controller::ControlOutput;
 use super::controller::{ChainController, ControllerConfig};
 use super::dynamics::{Actuator, BodyState, ChainDynamics, DynamicsError, V3};
 use super::model::ChainModel;
-use super::reference::{Reference, ReferenceLimits};
+use super::reference::{RefPoint, Reference, ReferenceLimits};
 
 /// A disturbance force held on units for a while.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,6 +80,15 @@ impl Default for SimConfig {
 }
 
 impl SimConfig {
+    /// The sum of the gusts acting on unit `i` at time `t` (world, N).
+    fn gust_force(&self, i: usize, t: f64) -> V3 {
+        self.gusts
+            .iter()
+            .filter(|g| t >= g.start && t < g.start + g.duration && g.unit.is_none_or(|u| u == i))
+            .map(|g| g.force)
+            .sum()
+    }
+
     /// Checks the numbers.
     pub fn validate(&self) -> Result<(), String> {
         let pos = |v: f64| v.is_finite() && v > 0.0;
@@ -408,21 +418,54 @@ fn fly(
     model.validate().map_err(SimError::Config)?;
     let params = model.params;
     let n = model.units();
-    let l = model.link_length();
-    let reference = Reference::new(n, l, waypoints, &cfg.limits).map_err(SimError::Plan)?;
+    let reference =
+        Reference::new(n, model.link_length(), waypoints, &cfg.limits).map_err(SimError::Plan)?;
     let start = &waypoints[0];
-    let dt = 1.0 / cfg.rate;
     let mut dynamics = ChainDynamics::new(
         model,
         V3::new(start[0], start[1], start[2]),
         &start[3..],
-        dt,
+        1.0 / cfg.rate,
     )?;
-    let mut controller_probe =
-        ChainController::new(model, cfg.controller).map_err(SimError::Config)?;
-    // Start in trim: each unit tilted as the controller wants it at rest and its motors
-    // already producing what it asks (a chain hovering in its start configuration).
-    let first = controller_probe.step(0.0, &dynamics.unit_states(), &reference);
+    let mut controller = start_in_trim(model, cfg, &mut dynamics, &reference)?;
+    let goal = Goal::of(&reference, n);
+    let t_ref = reference.duration();
+    let steps = check_budget(n, t_ref, cfg)?;
+    progress.total.store(steps as u64, Ordering::Relaxed);
+
+    let wall = Instant::now();
+    let mut tally = Tally::new(&params, steps);
+    let end = run_steps(
+        &mut dynamics,
+        &mut controller,
+        &reference,
+        &goal,
+        cfg,
+        obstacles,
+        progress,
+        &mut tally,
+    );
+    let wall_seconds = wall.elapsed().as_secs_f64();
+    let report = tally.report(n, cfg, t_ref, end, controller.mpc_counts(), wall_seconds);
+    Ok(Flight {
+        params,
+        reference,
+        samples: tally.samples,
+        report,
+    })
+}
+
+/// Puts the chain in trim: each unit tilted as the controller wants it at rest and its
+/// motors already producing what it asks (a chain hovering in its start
+/// configuration). Returns a fresh controller to fly with.
+fn start_in_trim(
+    model: ChainModel,
+    cfg: &SimConfig,
+    dynamics: &mut ChainDynamics,
+    reference: &Reference,
+) -> Result<ChainController, SimError> {
+    let new_controller = || ChainController::new(model, cfg.controller).map_err(SimError::Config);
+    let first = new_controller()?.step(0.0, &dynamics.unit_states(), reference);
     for (i, f) in first.forces.iter().enumerate() {
         let r = desired_attitude(
             &Vec3::new(f.x as f32, f.y as f32, f.z as f32),
@@ -430,8 +473,7 @@ fn fly(
         );
         dynamics.set_unit_attitude(i, &r.map(|x| x as f64));
     }
-    let mut controller = ChainController::new(model, cfg.controller).map_err(SimError::Config)?;
-    let trim = controller.step(0.0, &dynamics.unit_states(), &reference);
+    let trim = new_controller()?.step(0.0, &dynamics.unit_states(), reference);
     let act: Vec<Actuator> = trim
         .commands
         .iter()
@@ -441,64 +483,188 @@ fn fly(
         })
         .collect();
     dynamics.set_actuators(&act);
-    controller = ChainController::new(model, cfg.controller).map_err(SimError::Config)?;
+    new_controller()
+}
 
-    let end_zeta = reference.end().to_vec();
-    let goal = V3::new(end_zeta[0], end_zeta[1], end_zeta[2]);
-    let goal_dirs: Vec<V3> = (0..n - 1)
-        .map(|k| super::dynamics::link_direction(end_zeta[4 + 2 * k], end_zeta[5 + 2 * k]))
-        .collect();
+/// Where the flight should end: the last waypoint's head and link directions.
+struct Goal {
+    head: V3,
+    link_dirs: Vec<V3>,
+}
+
+impl Goal {
+    fn of(reference: &Reference, n: usize) -> Self {
+        let end = reference.end();
+        Self {
+            head: V3::new(end[0], end[1], end[2]),
+            link_dirs: (0..n - 1)
+                .map(|k| super::dynamics::link_direction(end[4 + 2 * k], end[5 + 2 * k]))
+                .collect(),
+        }
+    }
+}
+
+/// How the stepping loop ended.
+struct LoopEnd {
+    completed: Option<f64>,
+    diverged: bool,
+}
+
+/// Steps physics and control until the chain has settled at the goal, diverged, or
+/// run out of time, recording every step into `tally`.
+#[allow(clippy::too_many_arguments)]
+fn run_steps(
+    dynamics: &mut ChainDynamics,
+    controller: &mut ChainController,
+    reference: &Reference,
+    goal: &Goal,
+    cfg: &SimConfig,
+    obstacles: Option<&dyn Obstacles>,
+    progress: &Progress,
+    tally: &mut Tally,
+) -> LoopEnd {
+    let dt = 1.0 / cfg.rate;
     let t_ref = reference.duration();
     let t_max = t_ref.max(cfg.min_time) + cfg.settle_time;
-    let steps = check_budget(n, t_ref, cfg)?;
-    progress.total.store(steps as u64, Ordering::Relaxed);
-    let theta_max = params.theta_max as f64;
-    let beta_max = params.beta_max as f64;
-
-    let wall = Instant::now();
-    let mut samples = Vec::with_capacity(steps);
-    let (mut head_sq, mut head_max, mut link_sq, mut link_max) = (0.0, 0.0f64, 0.0, 0.0f64);
-    let mut link_count = 0usize;
-    let mut limits = LimitExcursions::default();
-    let mut watch = ClearanceWatch::default();
-    let mut min_self_gap = f64::INFINITY;
     let mut at_goal_since: Option<f64> = None;
-    let mut completed: Option<f64> = None;
-    let mut diverged = false;
     let mut step = 0usize;
     loop {
         let t = step as f64 * dt;
         progress.done.store(step as u64, Ordering::Relaxed);
         let units = dynamics.unit_states();
-        let links = dynamics.link_states();
-        let out = controller.step(t, &units, &reference);
+        let out = controller.step(t, &units, reference);
         let r = reference.sample(t);
-        // Tracking errors.
+        let (e_head, at_goal) = tally.observe(
+            dt,
+            &units,
+            &r,
+            goal,
+            cfg.goal_tolerance,
+            cfg.angle_tolerance,
+        );
+        if let Some(obs) = obstacles {
+            tally
+                .watch
+                .observe(obs, units.iter().map(|u| u.p).collect(), t);
+        }
+        tally
+            .samples
+            .push(Sample::record(t, &units, &dynamics.link_states(), &r, &out));
+        if at_goal && t >= t_ref - cfg.settle_hold {
+            let since = *at_goal_since.get_or_insert(t);
+            if t >= t_ref.max(cfg.min_time) && t - since >= cfg.settle_hold {
+                return LoopEnd {
+                    completed: Some(since),
+                    diverged: false,
+                };
+            }
+        } else {
+            at_goal_since = None;
+        }
+        let finite = units.iter().all(|u| u.p.iter().all(|v| v.is_finite()));
+        if e_head > cfg.divergence || !finite {
+            return LoopEnd {
+                completed: None,
+                diverged: true,
+            };
+        }
+        if t >= t_max {
+            return LoopEnd {
+                completed: None,
+                diverged: false,
+            };
+        }
+        for i in 0..units.len() {
+            dynamics.set_external_force(i, cfg.gust_force(i, t));
+        }
+        if !dynamics.step(&out.commands) {
+            return LoopEnd {
+                completed: None,
+                diverged: true,
+            };
+        }
+        step += 1;
+    }
+}
+
+/// What the loop accumulates: tracking errors, limit excursions, self and map
+/// clearance, and the recorded samples.
+struct Tally {
+    params: ChainParams,
+    samples: Vec<Sample>,
+    head_sq: f64,
+    head_max: f64,
+    link_sq: f64,
+    link_max: f64,
+    link_count: usize,
+    limits: LimitExcursions,
+    watch: ClearanceWatch,
+    min_self_gap: f64,
+}
+
+impl Tally {
+    fn new(params: &ChainParams, steps: usize) -> Self {
+        Self {
+            params: *params,
+            samples: Vec::with_capacity(steps),
+            head_sq: 0.0,
+            head_max: 0.0,
+            link_sq: 0.0,
+            link_max: 0.0,
+            link_count: 0,
+            limits: LimitExcursions::default(),
+            watch: ClearanceWatch::default(),
+            min_self_gap: f64::INFINITY,
+        }
+    }
+
+    /// Tracking errors, limits and self-contact of one step; returns the head's
+    /// tracking error and whether the chain is at the goal.
+    #[allow(clippy::too_many_arguments)]
+    fn observe(
+        &mut self,
+        dt: f64,
+        units: &[BodyState],
+        r: &RefPoint,
+        goal: &Goal,
+        goal_tolerance: f64,
+        angle_tolerance: f64,
+    ) -> (f64, bool) {
+        let n = units.len();
         let e_head = (units[0].p - r.p).norm();
-        head_sq += e_head * e_head;
-        head_max = head_max.max(e_head);
+        self.head_sq += e_head * e_head;
+        self.head_max = self.head_max.max(e_head);
         let dirs: Vec<V3> = (0..n - 1)
             .map(|k| (units[k].p - units[k + 1].p).normalize())
             .collect();
-        let mut at_goal = (units[0].p - goal).norm() <= cfg.goal_tolerance;
+        let mut at_goal = (units[0].p - goal.head).norm() <= goal_tolerance;
         for k in 0..n - 1 {
             let lr = &r.links[k];
             let e = angle_between(&dirs[k], &super::dynamics::link_direction(lr.pitch, lr.yaw));
-            link_sq += e * e;
-            link_count += 1;
-            link_max = link_max.max(e);
-            at_goal &= angle_between(&dirs[k], &goal_dirs[k]) <= cfg.angle_tolerance;
+            self.link_sq += e * e;
+            self.link_count += 1;
+            self.link_max = self.link_max.max(e);
+            at_goal &= angle_between(&dirs[k], &goal.link_dirs[k]) <= angle_tolerance;
         }
-        // Limits of the flown chain.
+        self.observe_limits(&dirs, dt);
+        self.observe_self_gap(units);
+        (e_head, at_goal)
+    }
+
+    /// Pitch and bend beyond the chain's limits.
+    fn observe_limits(&mut self, dirs: &[V3], dt: f64) {
+        let theta_max = self.params.theta_max as f64;
+        let beta_max = self.params.beta_max as f64;
+        let limits = &mut self.limits;
         let mut beyond = false;
-        for k in 0..n - 1 {
+        for k in 0..dirs.len() {
             let pitch = (-dirs[k].z).clamp(-1.0, 1.0).asin();
             let ex = pitch.abs() - theta_max;
             if ex > 0.0 {
                 beyond = true;
                 limits.max_pitch_excess_deg = limits.max_pitch_excess_deg.max(ex.to_degrees());
             }
-            if k + 1 < n - 1 {
+            if k + 1 < dirs.len() {
                 let ex = angle_between(&dirs[k], &dirs[k + 1]) - beta_max;
                 if ex > 0.0 {
                     beyond = true;
@@ -509,25 +675,82 @@ fn fly(
         if beyond {
             limits.time_beyond += dt;
         }
-        // Self-contact of the flown chain (core's exact pair test, relative positions).
+    }
+
+    /// Self-contact of the flown chain (core's exact pair test, relative positions).
+    fn observe_self_gap(&mut self, units: &[BodyState]) {
         let mut pts: Points = [Vector3::zeros(); MAX_UNITS];
         for (i, u) in units.iter().enumerate() {
             let d = u.p - units[0].p;
             pts[i] = Vector3::new(d.x as f32, d.y as f32, d.z as f32);
         }
-        visit_pairs(&params, n, &pts, |_, _, gap| {
-            min_self_gap = min_self_gap.min(gap as f64);
+        let min_self_gap = &mut self.min_self_gap;
+        visit_pairs(&self.params, units.len(), &pts, |_, _, gap| {
+            *min_self_gap = min_self_gap.min(gap as f64);
             true
         });
-        // Clearance to the map, whenever it could be a new minimum or a contact.
-        if let Some(obs) = obstacles {
-            watch.observe(obs, units.iter().map(|u| u.p).collect(), t);
+    }
+
+    fn report(
+        &self,
+        n: usize,
+        cfg: &SimConfig,
+        t_ref: f64,
+        end: LoopEnd,
+        (mpc_solves, mpc_failures): (usize, usize),
+        wall_seconds: f64,
+    ) -> FlightReport {
+        let count = self.samples.len().max(1) as f64;
+        let simulated_time = self.samples.last().map_or(0.0, |s| s.t);
+        let min_clear = self.watch.min.as_ref();
+        FlightReport {
+            units: n,
+            rate_hz: cfg.rate,
+            planned_duration: t_ref,
+            time_to_complete: end.completed,
+            reached_goal: end.completed.is_some(),
+            simulated_time,
+            head_rms: (self.head_sq / count).sqrt(),
+            head_max: self.head_max,
+            link_rms_deg: (self.link_sq / self.link_count.max(1) as f64)
+                .sqrt()
+                .to_degrees(),
+            link_max_deg: self.link_max.to_degrees(),
+            min_clearance: min_clear.map(|m| m.0),
+            min_clearance_at: min_clear.map(|m| m.1.clone()),
+            min_clearance_time: min_clear.map(|m| m.2),
+            contact: min_clear.is_some_and(|m| m.0 <= 0.0),
+            min_self_gap: self.min_self_gap,
+            self_contact: self.min_self_gap <= 0.0,
+            limits: self.limits,
+            mpc_solves,
+            mpc_failures,
+            diverged: end.diverged,
+            wall_seconds,
+            realtime_factor: if wall_seconds > 0.0 {
+                simulated_time / wall_seconds
+            } else {
+                f64::INFINITY
+            },
         }
-        samples.push(Sample {
+    }
+}
+
+impl Sample {
+    /// The record of one step.
+    fn record(
+        t: f64,
+        units: &[BodyState],
+        links: &[BodyState],
+        r: &RefPoint,
+        out: &ControlOutput,
+    ) -> Self {
+        let v32 = |v: &V3| [v.x as f32, v.y as f32, v.z as f32];
+        Self {
             t,
             units: units.iter().map(BodySample::new).collect(),
             links: links.iter().map(BodySample::new).collect(),
-            head_ref: [r.p.x as f32, r.p.y as f32, r.p.z as f32],
+            head_ref: v32(&r.p),
             links_ref: r
                 .links
                 .iter()
@@ -544,85 +767,7 @@ fn fly(
                 .iter()
                 .map(|a| [a[0] as f32, a[1] as f32, a[2] as f32])
                 .collect(),
-            head_accel: [
-                out.head_accel.x as f32,
-                out.head_accel.y as f32,
-                out.head_accel.z as f32,
-            ],
-        });
-        // Arrival.
-        if at_goal && t >= t_ref - cfg.settle_hold {
-            let since = *at_goal_since.get_or_insert(t);
-            if t >= t_ref.max(cfg.min_time) && t - since >= cfg.settle_hold {
-                completed = Some(since);
-                break;
-            }
-        } else {
-            at_goal_since = None;
+            head_accel: v32(&out.head_accel),
         }
-        if e_head > cfg.divergence || !units.iter().all(|u| u.p.iter().all(|v| v.is_finite())) {
-            diverged = true;
-            break;
-        }
-        if t >= t_max {
-            break;
-        }
-        // Gusts.
-        for i in 0..n {
-            let f: V3 = cfg
-                .gusts
-                .iter()
-                .filter(|g| {
-                    t >= g.start && t < g.start + g.duration && g.unit.is_none_or(|u| u == i)
-                })
-                .map(|g| g.force)
-                .sum();
-            dynamics.set_external_force(i, f);
-        }
-        if !dynamics.step(&out.commands) {
-            diverged = true;
-            break;
-        }
-        step += 1;
     }
-    let wall_seconds = wall.elapsed().as_secs_f64();
-    let count = samples.len().max(1) as f64;
-    let simulated_time = samples.last().map_or(0.0, |s| s.t);
-    let (solves, failures) = controller.mpc_counts();
-    let min_clear = watch.min;
-    let contact = min_clear.as_ref().is_some_and(|m| m.0 <= 0.0);
-    let report = FlightReport {
-        units: n,
-        rate_hz: cfg.rate,
-        planned_duration: t_ref,
-        time_to_complete: completed,
-        reached_goal: completed.is_some(),
-        simulated_time,
-        head_rms: (head_sq / count).sqrt(),
-        head_max,
-        link_rms_deg: (link_sq / link_count.max(1) as f64).sqrt().to_degrees(),
-        link_max_deg: link_max.to_degrees(),
-        min_clearance: min_clear.as_ref().map(|m| m.0),
-        min_clearance_at: min_clear.as_ref().map(|m| m.1.clone()),
-        min_clearance_time: min_clear.as_ref().map(|m| m.2),
-        contact,
-        min_self_gap,
-        self_contact: min_self_gap <= 0.0,
-        limits,
-        mpc_solves: solves,
-        mpc_failures: failures,
-        diverged,
-        wall_seconds,
-        realtime_factor: if wall_seconds > 0.0 {
-            simulated_time / wall_seconds
-        } else {
-            f64::INFINITY
-        },
-    };
-    Ok(Flight {
-        params,
-        reference,
-        samples,
-        report,
-    })
 }
