@@ -26,10 +26,11 @@ use aerial_chain_core::control::{
 };
 use nalgebra::{DMatrix, DVector};
 
-use super::dynamics::{BodyState, UnitCommand, M3, V3};
+use super::dynamics::{BodyState, UnitCommand, V3};
 use super::model::ChainModel;
 use super::mpc::{HeadMpc, MpcConfig, MpcError, MpcRef};
-use super::reference::Reference;
+use super::reference::{RefPoint, Reference};
+use super::SettingsError;
 
 /// Tuning of the control stack.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,7 +76,7 @@ impl Default for ControllerConfig {
 
 impl ControllerConfig {
     /// Checks the numbers.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         self.mpc.validate()?;
         let pos = |v: f64| v.is_finite() && v > 0.0;
         if !(pos(self.mpc_period)
@@ -83,16 +84,22 @@ impl ControllerConfig {
             && pos(self.link_damping)
             && pos(self.link_max_angular_accel))
         {
-            return Err("controller periods, link bandwidth, damping and acceleration limit must be positive".into());
+            return Err(SettingsError::Rule("controller periods, link bandwidth, damping and acceleration limit must be positive"));
         }
         if !(self.unit_bandwidth.iter().all(|&w| pos(w)) && pos(self.unit_damping)) {
-            return Err("unit attitude bandwidths and damping must be positive".into());
+            return Err(SettingsError::Rule(
+                "unit attitude bandwidths and damping must be positive",
+            ));
         }
         if !(self.tilt_max > 0.0 && self.tilt_max < 1.4) {
-            return Err("tilt limit must lie in (0, 80) degrees".into());
+            return Err(SettingsError::Rule(
+                "tilt limit must lie in (0, 80) degrees",
+            ));
         }
         if !(self.disturbance_gain.is_finite() && self.disturbance_gain >= 0.0) {
-            return Err("disturbance observer gain must be non-negative".into());
+            return Err(SettingsError::Rule(
+                "disturbance observer gain must be non-negative",
+            ));
         }
         Ok(())
     }
@@ -183,22 +190,6 @@ fn twist_free_rates(
     (w, dw)
 }
 
-fn f32v(v: &V3) -> Vec3 {
-    Vec3::new(v.x as f32, v.y as f32, v.z as f32)
-}
-
-fn f64v(v: &Vec3) -> V3 {
-    V3::new(v.x as f64, v.y as f64, v.z as f64)
-}
-
-fn f32m(m: &M3) -> Mat3 {
-    m.map(|x| x as f32)
-}
-
-fn f64m(m: &Mat3) -> M3 {
-    m.map(|x| x as f64)
-}
-
 /// The control stack of one chain.
 pub struct ChainController {
     cfg: ControllerConfig,
@@ -218,10 +209,10 @@ pub struct ChainController {
 
 impl ChainController {
     /// The stack for `model` tuned by `cfg`.
-    pub fn new(model: ChainModel, cfg: ControllerConfig) -> Result<Self, String> {
-        cfg.validate()?;
-        model.validate()?;
-        let mpc = HeadMpc::new(cfg.mpc).map_err(|e: MpcError| e.to_string())?;
+    pub fn new(model: ChainModel, cfg: ControllerConfig) -> Result<Self, MpcError> {
+        cfg.validate().map_err(MpcError::Config)?;
+        model.validate().map_err(MpcError::Config)?;
+        let mpc = HeadMpc::new(cfg.mpc)?;
         let ui = model.unit.inertia;
         let jd = Vec3::new(ui[0] as f32, ui[1] as f32, ui[2] as f32);
         let w = cfg.unit_bandwidth;
@@ -282,11 +273,40 @@ impl ChainController {
 
     /// One control step at time `t` for the measured unit states `units`.
     pub fn step(&mut self, t: f64, units: &[BodyState], reference: &Reference) -> ControlOutput {
-        let n = self.model.units();
-        let g = self.model.gravity;
         let r = reference.sample(t);
         let head = units[0];
-        // Disturbance observer on the head: measured acceleration vs commanded.
+        self.observe_disturbance(t, &head);
+        self.last_head_v = Some((t, head.v));
+        // 1. Head MPC.
+        self.update_head_mpc(t, &head, &r, reference);
+        let head_accel = self.mpc_accel - self.disturbance;
+        self.last_head_accel = head_accel;
+        // 2. Link controllers -> angular accelerations (world), and measured links.
+        let (meas, alpha) = self.control_links(units, &r);
+        // 3. Mixer: unit accelerations, then inverse dynamics.
+        let l = self.model.link_length();
+        let mut acc = Vec::with_capacity(units.len());
+        acc.push(head_accel);
+        for (k, m) in meas.iter().enumerate() {
+            let ddd = alpha[k].cross(&m.d) + m.omega.cross(&m.omega.cross(&m.d));
+            let next = acc[k] - l * ddd;
+            acc.push(next);
+        }
+        let forces = self.mix(&acc, &meas, &alpha);
+        // 4. Each unit: tilt limit, thrust, attitude.
+        let (commands, limited, attitude_cmd) = self.command_units(units, &forces, r.head_yaw);
+        ControlOutput {
+            commands,
+            head_accel,
+            forces: limited,
+            attitude_cmd,
+            link_angles: meas.iter().map(|m| (m.pitch, m.yaw)).collect(),
+            mpc_ok: self.mpc_ok,
+        }
+    }
+
+    /// Disturbance observer on the head: measured acceleration vs commanded.
+    fn observe_disturbance(&mut self, t: f64, head: &BodyState) {
         if let Some((t_prev, v_prev)) = self.last_head_v {
             let dt = t - t_prev;
             if dt > 0.0 {
@@ -305,8 +325,11 @@ impl ChainController {
                 });
             }
         }
-        self.last_head_v = Some((t, head.v));
-        // 1. Head MPC.
+    }
+
+    /// Re-solves the head MPC when its period is up; a saturated PD law on the
+    /// reference stands in when the solver fails.
+    fn update_head_mpc(&mut self, t: f64, head: &BodyState, r: &RefPoint, reference: &Reference) {
         if t >= self.next_mpc {
             self.next_mpc = t + self.cfg.mpc_period;
             let h = self.cfg.mpc.step;
@@ -344,9 +367,12 @@ impl ChainController {
                 }
             }
         }
-        let head_accel = self.mpc_accel - self.disturbance;
-        self.last_head_accel = head_accel;
-        // 2. Link controllers -> angular accelerations (world), and measured links.
+    }
+
+    /// The link controllers: each link's measured angles and the angular acceleration
+    /// (world) its controller asks for, across the link.
+    fn control_links(&self, units: &[BodyState], r: &RefPoint) -> (Vec<LinkMeasure>, Vec<V3>) {
+        let n = units.len();
         let mut meas = Vec::with_capacity(n - 1);
         let mut alpha = Vec::with_capacity(n - 1);
         for k in 0..n - 1 {
@@ -365,31 +391,32 @@ impl ChainController {
             let out = self.link_ctl.control(
                 &AttitudeState {
                     r: r_meas,
-                    w: f32v(&w_meas),
+                    w: w_meas.cast::<f32>(),
                 },
                 &AttitudeSetpoint {
                     r_d,
-                    w_d: f32v(&w_d),
-                    dw_d: f32v(&dw_d),
+                    w_d: w_d.cast::<f32>(),
+                    dw_d: dw_d.cast::<f32>(),
                 },
             );
-            let a_world = f64m(&r_meas) * f64v(&out.moment);
+            let a_world = r_meas.cast::<f64>() * out.moment.cast::<f64>();
             // Only the part across the link acts.
             alpha.push(a_world - m.d * m.d.dot(&a_world));
             meas.push(m);
         }
-        // 3. Mixer: unit accelerations, then inverse dynamics.
-        let l = self.model.link_length();
-        let mut acc = Vec::with_capacity(n);
-        acc.push(head_accel);
-        for k in 0..n - 1 {
-            let m = &meas[k];
-            let ddd = alpha[k].cross(&m.d) + m.omega.cross(&m.omega.cross(&m.d));
-            let next = acc[k] - l * ddd;
-            acc.push(next);
-        }
-        let forces = self.mix(&acc, &meas, &alpha);
-        // 4. Each unit: tilt limit, thrust, attitude.
+        (meas, alpha)
+    }
+
+    /// Each unit's force within the tilt limit, its thrust and its attitude loop's
+    /// moment; returns the commands, the limited forces and the attitude commands.
+    fn command_units(
+        &mut self,
+        units: &[BodyState],
+        forces: &[V3],
+        head_yaw: f64,
+    ) -> (Vec<UnitCommand>, Vec<V3>, Vec<[f64; 3]>) {
+        let n = units.len();
+        let g = self.model.gravity;
         let unit = self.model.unit;
         let tan = self.cfg.tilt_max.tan();
         let mut commands = Vec::with_capacity(n);
@@ -411,11 +438,11 @@ impl ChainController {
             let s = &units[i];
             let b3 = s.r.column(2).into_owned();
             let thrust = f.dot(&b3).clamp(unit.thrust_min, unit.thrust_max);
-            let r_d = desired_attitude(&f32v(&f), r.head_yaw as f32);
+            let r_d = desired_attitude(&f.cast::<f32>(), head_yaw as f32);
             let out = self.unit_ctl.control(
                 &AttitudeState {
-                    r: f32m(&s.r),
-                    w: f32v(&s.w_body()),
+                    r: s.r.cast::<f32>(),
+                    w: s.w_body().cast::<f32>(),
                 },
                 &AttitudeSetpoint::hold(r_d),
             );
@@ -423,18 +450,11 @@ impl ChainController {
             attitude_cmd.push([rpy[0] as f64, rpy[1] as f64, rpy[2] as f64]);
             commands.push(UnitCommand {
                 thrust,
-                moment: f64v(&out.moment),
+                moment: out.moment.cast::<f64>(),
             });
             limited.push(f);
         }
-        ControlOutput {
-            commands,
-            head_accel,
-            forces: limited,
-            attitude_cmd,
-            link_angles: meas.iter().map(|m| (m.pitch, m.yaw)).collect(),
-            mpc_ok: self.mpc_ok,
-        }
+        (commands, limited, attitude_cmd)
     }
 
     /// Inverse dynamics: the unit forces that give the unit accelerations `acc`

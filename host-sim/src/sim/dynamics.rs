@@ -30,8 +30,8 @@ use aerial_chain_core::control::{step_attitude, AttitudeState, Mat3, Vec3};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rapier3d::glamx::{Mat3 as GMat3, Quat as GQuat, Vec3 as GVec3};
 use rapier3d::prelude::{
-    MassProperties, MultibodyJointHandle, PhysicsWorld, Pose, RigidBodyBuilder, RigidBodyHandle,
-    SphericalJointBuilder,
+    MassProperties, MultibodyJointHandle, PhysicsWorld, Pose, RigidBody, RigidBodyBuilder,
+    RigidBodyHandle, SphericalJointBuilder,
 };
 
 use super::model::ChainModel;
@@ -84,10 +84,21 @@ pub struct Actuator {
 pub enum DynamicsError {
     /// The model's numbers are not physical.
     #[error("chain model: {0}")]
-    Model(String),
+    Model(super::SettingsError),
     /// The start configuration does not fit the chain.
-    #[error("start configuration: {0}")]
-    Start(String),
+    #[error("start configuration: shape has {got} angles, expected {expected}")]
+    ShapeLength {
+        /// Angles given.
+        got: usize,
+        /// Angles of a shape of this chain (`2N - 1`).
+        expected: usize,
+    },
+    /// The start configuration has a number that is not finite.
+    #[error("start configuration: non-finite number")]
+    NotFinite,
+    /// A physics time step outside (0, 0.01] s.
+    #[error("start configuration: time step {0} s must lie in (0, 0.01]")]
+    TimeStep(f64),
     /// rapier refused a joint.
     #[error("the physics engine refused joint {0}")]
     Joint(usize),
@@ -158,23 +169,166 @@ pub fn yaw_rotation(yaw: f64) -> M3 {
     M3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
-fn g3(v: &V3) -> GVec3 {
+// rapier works in glam's f32 types; these four are the only conversions between them
+// and the nalgebra f64 types the rest of the simulation uses.
+
+/// A vector for rapier.
+fn to_glam(v: &V3) -> GVec3 {
     GVec3::new(v.x as f32, v.y as f32, v.z as f32)
 }
 
-fn n3(v: GVec3) -> V3 {
+/// A vector from rapier.
+fn from_glam(v: GVec3) -> V3 {
     V3::new(v.x as f64, v.y as f64, v.z as f64)
 }
 
-fn gquat(r: &M3) -> GQuat {
+/// A rotation matrix for rapier.
+fn to_glam_rotation(r: &M3) -> GQuat {
     // Via nalgebra's robust matrix-to-quaternion conversion, then to glam.
     let q = UnitQuaternion::from_matrix(r);
     GQuat::from_xyzw(q.i as f32, q.j as f32, q.k as f32, q.w as f32).normalize()
 }
 
-fn nrot(q: &GQuat) -> M3 {
+/// A rotation matrix from rapier.
+fn from_glam_rotation(q: &GQuat) -> M3 {
     let m = GMat3::from_quat(*q);
-    M3::from_columns(&[n3(m.x_axis), n3(m.y_axis), n3(m.z_axis)])
+    M3::from_columns(&[
+        from_glam(m.x_axis),
+        from_glam(m.y_axis),
+        from_glam(m.z_axis),
+    ])
+}
+
+/// A dynamic body at `pos` turned by `rot` with mass properties `mprops`.
+fn free_body(pos: &V3, rot: GQuat, mprops: MassProperties) -> RigidBody {
+    RigidBodyBuilder::dynamic()
+        .translation(to_glam(pos))
+        .rotation(rot.to_scaled_axis())
+        .additional_mass_properties(mprops)
+        .can_sleep(false)
+        .build()
+}
+
+/// The full formulation's bodies: units and links as bodies of their own, joined by
+/// spherical joints at the unit centres. Returns units, links and joints.
+fn build_full(
+    world: &mut PhysicsWorld,
+    model: &ChainModel,
+    p: &[V3],
+    r_unit: &M3,
+    link_rot: &[M3],
+) -> Result<
+    (
+        Vec<RigidBodyHandle>,
+        Vec<RigidBodyHandle>,
+        Vec<MultibodyJointHandle>,
+    ),
+    DynamicsError,
+> {
+    let n = p.len();
+    let l = model.link_length();
+    let half = (0.5 * l) as f32;
+    let ui = model.unit.inertia;
+    let (mut units, mut links, mut joints) = (Vec::new(), Vec::with_capacity(n - 1), Vec::new());
+    let unit_mass = MassProperties::new(
+        GVec3::ZERO,
+        model.unit.mass as f32,
+        GVec3::new(ui[0] as f32, ui[1] as f32, ui[2] as f32),
+    );
+    let li = model.link.inertia(l);
+    let link_mass = MassProperties::new(
+        GVec3::ZERO,
+        model.link.mass as f32,
+        GVec3::new(li[0] as f32, li[1] as f32, li[2] as f32),
+    );
+    for q in p {
+        units.push(
+            world
+                .bodies
+                .insert(free_body(q, to_glam_rotation(r_unit), unit_mass)),
+        );
+    }
+    for k in 0..n - 1 {
+        let mid = 0.5 * (p[k] + p[k + 1]);
+        links.push(
+            world
+                .bodies
+                .insert(free_body(&mid, to_glam_rotation(&link_rot[k]), link_mass)),
+        );
+    }
+    // The joints' reference frames are chosen so that zero joint coordinates
+    // are the start configuration (a multibody places its children from its
+    // joint coordinates, not from the bodies' initial poses).
+    for k in 0..n - 1 {
+        let front = SphericalJointBuilder::new()
+            .local_frame1(Pose::from_parts(
+                GVec3::ZERO,
+                to_glam_rotation(&(r_unit.transpose() * link_rot[k])),
+            ))
+            .local_frame2(Pose::from_parts(
+                GVec3::new(half, 0.0, 0.0),
+                GQuat::IDENTITY,
+            ));
+        let h = world
+            .multibody_joints
+            .insert(units[k], links[k], front, true)
+            .ok_or(DynamicsError::Joint(2 * k))?;
+        joints.push(h);
+        let back = SphericalJointBuilder::new()
+            .local_frame1(Pose::from_parts(
+                GVec3::new(-half, 0.0, 0.0),
+                to_glam_rotation(&(link_rot[k].transpose() * r_unit)),
+            ))
+            .local_frame2(Pose::from_parts(GVec3::ZERO, GQuat::IDENTITY));
+        let h = world
+            .multibody_joints
+            .insert(links[k], units[k + 1], back, true)
+            .ok_or(DynamicsError::Joint(2 * k + 1))?;
+        joints.push(h);
+    }
+    Ok((units, links, joints))
+}
+
+/// The lumped formulation's bodies: links carrying the units' masses, joined at the
+/// unit centres. Returns links, joints and each link's centre of mass on its axis.
+fn build_lumped(
+    world: &mut PhysicsWorld,
+    model: &ChainModel,
+    p: &[V3],
+    link_rot: &[M3],
+) -> Result<(Vec<RigidBodyHandle>, Vec<MultibodyJointHandle>, Vec<f64>), DynamicsError> {
+    let n = p.len();
+    let half = (0.5 * model.link_length()) as f32;
+    let (mut links, mut joints, mut link_com) =
+        (Vec::with_capacity(n - 1), Vec::new(), vec![0.0; n - 1]);
+    for k in 0..n - 1 {
+        let (mp, xc) = lumped_mass(model, k == 0);
+        link_com[k] = xc;
+        let mid = 0.5 * (p[k] + p[k + 1]);
+        links.push(
+            world
+                .bodies
+                .insert(free_body(&mid, to_glam_rotation(&link_rot[k]), mp)),
+        );
+    }
+    for k in 1..n - 1 {
+        // Link k-1's back end is link k's front end (unit k's centre).
+        let joint = SphericalJointBuilder::new()
+            .local_frame1(Pose::from_parts(
+                GVec3::new(-half, 0.0, 0.0),
+                to_glam_rotation(&(link_rot[k - 1].transpose() * link_rot[k])),
+            ))
+            .local_frame2(Pose::from_parts(
+                GVec3::new(half, 0.0, 0.0),
+                GQuat::IDENTITY,
+            ));
+        let h = world
+            .multibody_joints
+            .insert(links[k - 1], links[k], joint, true)
+            .ok_or(DynamicsError::Joint(k))?;
+        joints.push(h);
+    }
+    Ok((links, joints, link_com))
 }
 
 /// Mass properties of link `k`'s body in the lumped formulation: the tube, the unit at
@@ -217,19 +371,16 @@ impl ChainDynamics {
         model.validate().map_err(DynamicsError::Model)?;
         let n = model.units();
         if eta.len() != 2 * n - 1 {
-            return Err(DynamicsError::Start(format!(
-                "shape has {} angles, expected {}",
-                eta.len(),
-                2 * n - 1
-            )));
+            return Err(DynamicsError::ShapeLength {
+                got: eta.len(),
+                expected: 2 * n - 1,
+            });
         }
         if !head.iter().chain(eta.iter()).all(|v| v.is_finite()) {
-            return Err(DynamicsError::Start("non-finite number".into()));
+            return Err(DynamicsError::NotFinite);
         }
         if !(dt.is_finite() && dt > 0.0 && dt <= 0.01) {
-            return Err(DynamicsError::Start(format!(
-                "time step {dt} s must lie in (0, 0.01]"
-            )));
+            return Err(DynamicsError::TimeStep(dt));
         }
         let l = model.link_length();
         let mut world = PhysicsWorld::new();
@@ -242,101 +393,18 @@ impl ChainDynamics {
         let ui = model.unit.inertia;
         let unit_inertia =
             Mat3::from_diagonal(&Vec3::new(ui[0] as f32, ui[1] as f32, ui[2] as f32));
-        let body = |pos: &V3, rot: GQuat, mprops: MassProperties| {
-            RigidBodyBuilder::dynamic()
-                .translation(g3(pos))
-                .rotation(rot.to_scaled_axis())
-                .additional_mass_properties(mprops)
-                .can_sleep(false)
-                .build()
-        };
-        let half = (0.5 * l) as f32;
         let link_rot: Vec<M3> = (0..n - 1)
             .map(|k| link_rotation(eta[1 + 2 * k], eta[2 + 2 * k]))
             .collect();
-        let mut units = Vec::new();
-        let mut links = Vec::with_capacity(n - 1);
-        let mut joints = Vec::new();
-        let mut link_com = vec![0.0; n - 1];
+        let (mut units, links, joints, mut link_com);
+        units = Vec::new();
+        link_com = vec![0.0; n - 1];
         match formulation {
             Formulation::Full => {
-                let unit_mass = MassProperties::new(
-                    GVec3::ZERO,
-                    model.unit.mass as f32,
-                    GVec3::new(ui[0] as f32, ui[1] as f32, ui[2] as f32),
-                );
-                let li = model.link.inertia(l);
-                let link_mass = MassProperties::new(
-                    GVec3::ZERO,
-                    model.link.mass as f32,
-                    GVec3::new(li[0] as f32, li[1] as f32, li[2] as f32),
-                );
-                for q in &p {
-                    units.push(world.bodies.insert(body(q, gquat(&r_unit), unit_mass)));
-                }
-                for k in 0..n - 1 {
-                    let mid = 0.5 * (p[k] + p[k + 1]);
-                    links.push(
-                        world
-                            .bodies
-                            .insert(body(&mid, gquat(&link_rot[k]), link_mass)),
-                    );
-                }
-                // The joints' reference frames are chosen so that zero joint coordinates
-                // are the start configuration (a multibody places its children from its
-                // joint coordinates, not from the bodies' initial poses).
-                for k in 0..n - 1 {
-                    let front = SphericalJointBuilder::new()
-                        .local_frame1(Pose::from_parts(
-                            GVec3::ZERO,
-                            gquat(&(r_unit.transpose() * link_rot[k])),
-                        ))
-                        .local_frame2(Pose::from_parts(
-                            GVec3::new(half, 0.0, 0.0),
-                            GQuat::IDENTITY,
-                        ));
-                    let h = world
-                        .multibody_joints
-                        .insert(units[k], links[k], front, true)
-                        .ok_or(DynamicsError::Joint(2 * k))?;
-                    joints.push(h);
-                    let back = SphericalJointBuilder::new()
-                        .local_frame1(Pose::from_parts(
-                            GVec3::new(-half, 0.0, 0.0),
-                            gquat(&(link_rot[k].transpose() * r_unit)),
-                        ))
-                        .local_frame2(Pose::from_parts(GVec3::ZERO, GQuat::IDENTITY));
-                    let h = world
-                        .multibody_joints
-                        .insert(links[k], units[k + 1], back, true)
-                        .ok_or(DynamicsError::Joint(2 * k + 1))?;
-                    joints.push(h);
-                }
+                (units, links, joints) = build_full(&mut world, &model, &p, &r_unit, &link_rot)?;
             }
             Formulation::Lumped => {
-                for k in 0..n - 1 {
-                    let (mp, xc) = lumped_mass(&model, k == 0);
-                    link_com[k] = xc;
-                    let mid = 0.5 * (p[k] + p[k + 1]);
-                    links.push(world.bodies.insert(body(&mid, gquat(&link_rot[k]), mp)));
-                }
-                for k in 1..n - 1 {
-                    // Link k-1's back end is link k's front end (unit k's centre).
-                    let joint = SphericalJointBuilder::new()
-                        .local_frame1(Pose::from_parts(
-                            GVec3::new(-half, 0.0, 0.0),
-                            gquat(&(link_rot[k - 1].transpose() * link_rot[k])),
-                        ))
-                        .local_frame2(Pose::from_parts(
-                            GVec3::new(half, 0.0, 0.0),
-                            GQuat::IDENTITY,
-                        ));
-                    let h = world
-                        .multibody_joints
-                        .insert(links[k - 1], links[k], joint, true)
-                        .ok_or(DynamicsError::Joint(k))?;
-                    joints.push(h);
-                }
+                (links, joints, link_com) = build_lumped(&mut world, &model, &p, &link_rot)?;
             }
         }
         // rapier gives every multibody angular degree of freedom a default damping of
@@ -451,8 +519,8 @@ impl ChainDynamics {
                 let r = M3::from_fn(|r, c| a.r[(r, c)] as f64);
                 let w_body = V3::new(a.w.x as f64, a.w.y as f64, a.w.z as f64);
                 BodyState {
-                    p: n3(pt),
-                    v: n3(b.velocity_at_point(pt)),
+                    p: from_glam(pt),
+                    v: from_glam(b.velocity_at_point(pt)),
                     r,
                     w: r * w_body,
                 }
@@ -479,10 +547,10 @@ impl ChainDynamics {
         let b = &self.world.bodies[h];
         let origin = b.translation();
         BodyState {
-            p: n3(origin),
-            v: n3(b.velocity_at_point(origin)),
-            r: nrot(b.rotation()),
-            w: n3(b.angvel()),
+            p: from_glam(origin),
+            v: from_glam(b.velocity_at_point(origin)),
+            r: from_glam_rotation(b.rotation()),
+            w: from_glam(b.angvel()),
         }
     }
 
@@ -516,13 +584,13 @@ impl ChainDynamics {
                 for (i, &h) in self.units.iter().enumerate() {
                     let a = self.actuators[i];
                     let b = &mut self.world.bodies[h];
-                    let r = nrot(b.rotation());
+                    let r = from_glam_rotation(b.rotation());
                     let force = r * V3::new(0.0, 0.0, a.thrust) + self.external[i];
                     let torque = r * a.moment;
                     b.reset_forces(false);
                     b.reset_torques(false);
-                    b.add_force(g3(&force), false);
-                    b.add_torque(g3(&torque), false);
+                    b.add_force(to_glam(&force), false);
+                    b.add_torque(to_glam(&torque), false);
                 }
             }
             Formulation::Lumped => {
@@ -548,7 +616,7 @@ impl ChainDynamics {
                         0.0,
                         0.0,
                     ));
-                    let f = g3(&force);
+                    let f = to_glam(&force);
                     b.add_force(f, false);
                     b.add_torque(arm.cross(f), false);
                     let m = Vec3::new(a.moment.x as f32, a.moment.y as f32, a.moment.z as f32);

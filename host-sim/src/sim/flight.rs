@@ -22,7 +22,8 @@ use super::controller::ControlOutput;
 use super::controller::{ChainController, ControllerConfig};
 use super::dynamics::{Actuator, BodyState, ChainDynamics, DynamicsError, V3};
 use super::model::ChainModel;
-use super::reference::{RefPoint, Reference, ReferenceLimits};
+use super::reference::{RefPoint, Reference, ReferenceError, ReferenceLimits};
+use super::SettingsError;
 
 /// A disturbance force held on units for a while.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,10 +91,10 @@ impl SimConfig {
     }
 
     /// Checks the numbers.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         let pos = |v: f64| v.is_finite() && v > 0.0;
         if !(self.rate.is_finite() && (500.0..=20_000.0).contains(&self.rate)) {
-            return Err(format!("rate {} Hz must lie in [500, 20000]", self.rate));
+            return Err(SettingsError::Rate(self.rate));
         }
         if !(pos(self.settle_time)
             && pos(self.settle_hold)
@@ -101,18 +102,20 @@ impl SimConfig {
             && pos(self.angle_tolerance)
             && pos(self.divergence))
         {
-            return Err(
-                "settle times, tolerances and the divergence bound must be positive".into(),
-            );
+            return Err(SettingsError::Rule(
+                "settle times, tolerances and the divergence bound must be positive",
+            ));
         }
         if !(self.min_time.is_finite() && (0.0..=3600.0).contains(&self.min_time)) {
-            return Err("minimum flight time must lie in [0, 3600] s".into());
+            return Err(SettingsError::Rule(
+                "minimum flight time must lie in [0, 3600] s",
+            ));
         }
         for g in &self.gusts {
             if !(g.start.is_finite() && pos(g.duration) && g.force.iter().all(|v| v.is_finite())) {
-                return Err(
-                    "gusts need a finite start, a positive duration and a finite force".into(),
-                );
+                return Err(SettingsError::Rule(
+                    "gusts need a finite start, a positive duration and a finite force",
+                ));
             }
         }
         self.controller.validate()?;
@@ -342,10 +345,13 @@ pub struct Flight {
 pub enum SimError {
     /// The configuration is invalid.
     #[error("simulation settings: {0}")]
-    Config(String),
+    Config(#[from] SettingsError),
     /// The plan cannot be flown (edge kinds, sizes).
     #[error("plan: {0}")]
-    Plan(String),
+    Plan(#[from] ReferenceError),
+    /// The control stack cannot be built.
+    #[error(transparent)]
+    Controller(#[from] super::mpc::MpcError),
     /// The flight would record more than [`MAX_RECORDED_BYTES`].
     #[error("{0}")]
     Budget(String),
@@ -414,12 +420,11 @@ fn fly(
     obstacles: Option<&dyn Obstacles>,
     progress: &Progress,
 ) -> Result<Flight, SimError> {
-    cfg.validate().map_err(SimError::Config)?;
-    model.validate().map_err(SimError::Config)?;
+    cfg.validate()?;
+    model.validate()?;
     let params = model.params;
     let n = model.units();
-    let reference =
-        Reference::new(n, model.link_length(), waypoints, &cfg.limits).map_err(SimError::Plan)?;
+    let reference = Reference::new(n, model.link_length(), waypoints, &cfg.limits)?;
     let start = &waypoints[0];
     let mut dynamics = ChainDynamics::new(
         model,
@@ -464,7 +469,7 @@ fn start_in_trim(
     dynamics: &mut ChainDynamics,
     reference: &Reference,
 ) -> Result<ChainController, SimError> {
-    let new_controller = || ChainController::new(model, cfg.controller).map_err(SimError::Config);
+    let new_controller = || ChainController::new(model, cfg.controller);
     let first = new_controller()?.step(0.0, &dynamics.unit_states(), reference);
     for (i, f) in first.forces.iter().enumerate() {
         let r = desired_attitude(
@@ -483,7 +488,7 @@ fn start_in_trim(
         })
         .collect();
     dynamics.set_actuators(&act);
-    new_controller()
+    Ok(new_controller()?)
 }
 
 /// Where the flight should end: the last waypoint's head and link directions.

@@ -19,6 +19,27 @@ pub mod mpc;
 pub mod plot;
 pub mod reference;
 
+/// Simulation settings (controller, MPC, limits, model, run) outside their limits.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SettingsError {
+    /// A rule on the settings that does not hold; the text states the rule.
+    #[error("{0}")]
+    Rule(&'static str),
+    /// A physics and control rate outside its range.
+    #[error("rate {0} Hz must lie in [500, 20000]")]
+    Rate(f64),
+    /// Units too weak to hover with their share of the links.
+    #[error(
+        "unit thrust_max {thrust_max} N cannot lift a unit and a link ({hover:.2} N) with margin"
+    )]
+    ThrustMargin {
+        /// The unit's largest thrust (N).
+        thrust_max: f64,
+        /// The weight of a unit and a link (N).
+        hover: f64,
+    },
+}
+
 pub use controller::{ChainController, ControllerConfig};
 pub use dynamics::{BodyState, ChainDynamics, V3};
 pub use flight::{simulate, Flight, FlightReport, Gust, Obstacles, SimConfig, SimError};

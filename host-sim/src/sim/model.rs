@@ -6,6 +6,8 @@
 
 use aerial_chain_core::ChainParams;
 
+use super::SettingsError;
+
 /// Standard gravity (m/s^2).
 pub const GRAVITY: f64 = 9.81;
 
@@ -111,35 +113,43 @@ impl ChainModel {
     }
 
     /// Checks that every number is finite and physical.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         let u = &self.unit;
         let pos = |v: f64| v.is_finite() && v > 0.0;
         if !pos(u.mass) || !u.inertia.iter().all(|&j| pos(j)) {
-            return Err("unit mass and inertia must be positive".into());
+            return Err(SettingsError::Rule(
+                "unit mass and inertia must be positive",
+            ));
         }
         if !(u.thrust_min.is_finite()
             && u.thrust_min >= 0.0
             && pos(u.thrust_max)
             && u.thrust_max > u.thrust_min)
         {
-            return Err("unit thrust limits must satisfy 0 <= min < max".into());
+            return Err(SettingsError::Rule(
+                "unit thrust limits must satisfy 0 <= min < max",
+            ));
         }
         if !u.max_moment.iter().all(|&m| pos(m)) || !pos(u.motor_time_constant) {
-            return Err("unit moment limits and motor time constant must be positive".into());
+            return Err(SettingsError::Rule(
+                "unit moment limits and motor time constant must be positive",
+            ));
         }
         if !pos(self.link.mass) || !pos(self.link.min_axial_inertia) {
-            return Err("link mass and axial inertia must be positive".into());
+            return Err(SettingsError::Rule(
+                "link mass and axial inertia must be positive",
+            ));
         }
         if !pos(self.gravity) {
-            return Err("gravity must be positive".into());
+            return Err(SettingsError::Rule("gravity must be positive"));
         }
         // Every unit must be able to hover with its share of the links.
         let hover = (u.mass + self.link.mass) * self.gravity;
         if u.thrust_max < 1.2 * hover {
-            return Err(format!(
-                "unit thrust_max {} N cannot lift a unit and a link ({hover:.2} N) with margin",
-                u.thrust_max
-            ));
+            return Err(SettingsError::ThrustMargin {
+                thrust_max: u.thrust_max,
+                hover,
+            });
         }
         Ok(())
     }

@@ -24,6 +24,7 @@ use clarabel::solver::{
 
 use super::dynamics::V3;
 use super::model::GRAVITY;
+use super::SettingsError;
 
 /// Tuning and limits of the head MPC.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,11 +73,13 @@ impl Default for MpcConfig {
 
 impl MpcConfig {
     /// Checks the numbers.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         let pos = |v: f64| v.is_finite() && v > 0.0;
         let nonneg = |v: f64| v.is_finite() && v >= 0.0;
         if !(1..=200).contains(&self.horizon) || !pos(self.step) {
-            return Err("MPC horizon must be 1..=200 steps of positive length".into());
+            return Err(SettingsError::Rule(
+                "MPC horizon must be 1..=200 steps of positive length",
+            ));
         }
         if !(nonneg(self.q_pos)
             && nonneg(self.q_vel)
@@ -84,20 +87,28 @@ impl MpcConfig {
             && pos(self.r_acc)
             && nonneg(self.r_jerk))
         {
-            return Err("MPC weights must be non-negative (r_acc positive)".into());
+            return Err(SettingsError::Rule(
+                "MPC weights must be non-negative (r_acc positive)",
+            ));
         }
         if !(pos(self.a_xy_max)
             && self.a_z_min.is_finite()
             && self.a_z_min < 0.0
             && pos(self.a_z_max))
         {
-            return Err("MPC acceleration limits must bracket zero".into());
+            return Err(SettingsError::Rule(
+                "MPC acceleration limits must bracket zero",
+            ));
         }
         if self.a_z_min <= -GRAVITY {
-            return Err("MPC a_z_min must be above -g (the rotors cannot pull down)".into());
+            return Err(SettingsError::Rule(
+                "MPC a_z_min must be above -g (the rotors cannot pull down)",
+            ));
         }
         if !(self.tilt_max > 0.0 && self.tilt_max < 1.4) {
-            return Err("MPC tilt limit must lie in (0, 80) degrees".into());
+            return Err(SettingsError::Rule(
+                "MPC tilt limit must lie in (0, 80) degrees",
+            ));
         }
         Ok(())
     }
@@ -130,7 +141,7 @@ pub struct MpcSolution {
 pub enum MpcError {
     /// The configuration is invalid.
     #[error("MPC configuration: {0}")]
-    Config(String),
+    Config(SettingsError),
     /// Inputs of the wrong length or not finite.
     #[error("MPC input: {0}")]
     Input(String),

@@ -13,6 +13,7 @@
 use std::f64::consts::PI;
 
 use super::dynamics::{unit_positions, V3};
+use super::SettingsError;
 
 /// docs/model.md: "stays" means equal within this (angles compared after wrapping).
 pub const STAY_TOLERANCE: f64 = 1e-9;
@@ -29,6 +30,34 @@ pub fn wrap(a: f64) -> f64 {
     } else {
         w
     }
+}
+
+/// Why a plan's waypoints cannot be timed into a reference.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ReferenceError {
+    /// The timing limits are invalid.
+    #[error(transparent)]
+    Limits(#[from] SettingsError),
+    /// No waypoints at all.
+    #[error("the plan has no waypoints")]
+    NoWaypoints,
+    /// A waypoint of the wrong length or with a number that is not finite.
+    #[error("waypoint {index} is not {dim} finite numbers")]
+    Waypoint {
+        /// Its index.
+        index: usize,
+        /// The length a configuration of this chain has.
+        dim: usize,
+    },
+    /// An edge that moves the head and changes the shape at once.
+    #[error(
+        "edge {from} -> {to} changes both the head position and the shape (docs/model.md allows one kind per edge)",
+        to = from + 1
+    )]
+    MixedEdge {
+        /// The index of the edge's first waypoint.
+        from: usize,
+    },
 }
 
 /// The limits every edge is timed within.
@@ -60,17 +89,21 @@ impl Default for ReferenceLimits {
 
 impl ReferenceLimits {
     /// Checks that every limit is finite and positive (the hold may be zero).
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         let pos = |v: f64| v.is_finite() && v > 0.0;
         if !(pos(self.speed)
             && pos(self.accel)
             && pos(self.angular_rate)
             && pos(self.angular_accel))
         {
-            return Err("speed, acceleration and angular limits must be positive".into());
+            return Err(SettingsError::Rule(
+                "speed, acceleration and angular limits must be positive",
+            ));
         }
         if !(self.start_hold.is_finite() && self.start_hold >= 0.0) {
-            return Err("start hold must be a non-negative number of seconds".into());
+            return Err(SettingsError::Rule(
+                "start hold must be a non-negative number of seconds",
+            ));
         }
         Ok(())
     }
@@ -229,15 +262,15 @@ impl Reference {
         link_length: f64,
         waypoints: &[Vec<f64>],
         limits: &ReferenceLimits,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ReferenceError> {
         limits.validate()?;
         let dim = 2 * units + 2;
         if waypoints.is_empty() {
-            return Err("the plan has no waypoints".into());
+            return Err(ReferenceError::NoWaypoints);
         }
         for (i, w) in waypoints.iter().enumerate() {
             if w.len() != dim || w.iter().any(|v| !v.is_finite()) {
-                return Err(format!("waypoint {i} is not {dim} finite numbers"));
+                return Err(ReferenceError::Waypoint { index: i, dim });
             }
         }
         let mut segments = Vec::new();
@@ -272,12 +305,7 @@ impl Reference {
             let moves_head = delta[..3].iter().any(|d| d.abs() > STAY_TOLERANCE);
             let moves_shape = delta[3..].iter().any(|d| d.abs() > STAY_TOLERANCE);
             let (kind, scaling) = match (moves_head, moves_shape) {
-                (true, true) => {
-                    return Err(format!(
-                        "edge {i} -> {} changes both the head position and the shape (docs/model.md allows one kind per edge)",
-                        i + 1
-                    ))
-                }
+                (true, true) => return Err(ReferenceError::MixedEdge { from: i }),
                 (false, false) => {
                     delta.iter_mut().for_each(|d| *d = 0.0);
                     (SegmentKind::Hold, Scaling::default())
