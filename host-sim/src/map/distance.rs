@@ -290,6 +290,32 @@ impl DistanceField {
         }
     }
 
+    /// Coordinate `x` along axis `a` in voxels from the grid's lower face (`x / r - origin`),
+    /// or `None` where the clearance is 0: `x` is NaN, or outside the grid while unknown
+    /// space is occupied.
+    #[inline]
+    fn grid_coordinate(&self, x: f64, a: usize) -> Option<f64> {
+        let q = x / self.grid.resolution();
+        if q.is_nan() {
+            return None;
+        }
+        let rel = q - self.grid.origin()[a] as f64;
+        // For the integer bound `dims`, `rel` and `rel.floor()` fall on the same side, so
+        // the fine and the coarse query agree on what is outside.
+        if (rel < 0.0 || rel >= self.grid.dims()[a] as f64) && self.grid.unknown_is_occupied() {
+            return None;
+        }
+        Some(rel)
+    }
+
+    /// Squared distance along axis `a` from coordinate `x` to the centre of the voxel with
+    /// local index `li` (m^2).
+    #[inline]
+    fn centre_gap_sq(&self, x: f64, li: f64, a: usize) -> f64 {
+        let c = (self.grid.origin()[a] as f64 + li + 0.5) * self.grid.resolution();
+        (x - c) * (x - c)
+    }
+
     /// A PROVEN lower bound on the Euclidean distance from `p` to the nearest obstacle
     /// cube (m), `>= 0`; `f64::INFINITY` when the map has no obstacle. NaN input gives 0.
     ///
@@ -299,29 +325,20 @@ impl DistanceField {
     /// facing a flat wall, where a single centre would lose up to `r sqrt(3) / 2`.
     #[inline]
     pub fn clearance(&self, p: [f64; 3]) -> f64 {
-        let g = &self.grid;
-        let r = g.resolution();
-        let origin = g.origin();
-        let dims = g.dims();
+        let dims = self.grid.dims();
         let mut idx = [[0usize; 2]; 3];
         let mut d2 = [[0f64; 2]; 3];
         for a in 0..3 {
-            let q = p[a] / r;
-            if q.is_nan() {
+            let Some(rel) = self.grid_coordinate(p[a], a) else {
                 return 0.0;
-            }
-            let rel = q - origin[a] as f64;
-            if (rel < 0.0 || rel >= dims[a] as f64) && g.unknown_is_occupied() {
-                return 0.0;
-            }
+            };
             // Centres bracketing p: local indices floor(rel - 0.5) and + 1, clamped.
             let lo = (rel - 0.5).floor();
             let max = (dims[a] - 1) as f64;
             for (j, v) in [lo, lo + 1.0].into_iter().enumerate() {
                 let li = v.clamp(0.0, max);
                 idx[a][j] = li as usize;
-                let c = (origin[a] as f64 + li + 0.5) * r;
-                d2[a][j] = (p[a] - c) * (p[a] - c);
+                d2[a][j] = self.centre_gap_sq(p[a], li, a);
             }
         }
         let (sx, sxy) = (1, dims[0]);
@@ -348,25 +365,17 @@ impl DistanceField {
     /// [`Self::clearance`] when it is not enough.
     #[inline]
     pub fn clearance_coarse(&self, p: [f64; 3]) -> f64 {
-        let g = &self.grid;
-        let r = g.resolution();
-        let origin = g.origin();
-        let dims = g.dims();
+        let dims = self.grid.dims();
         let mut l = [0usize; 3];
         let mut d2 = 0.0;
         for a in 0..3 {
-            let q = p[a] / r;
-            if q.is_nan() {
+            let Some(rel) = self.grid_coordinate(p[a], a) else {
                 return 0.0;
-            }
-            let rel = (q - origin[a] as f64).floor();
-            if (rel < 0.0 || rel >= dims[a] as f64) && g.unknown_is_occupied() {
-                return 0.0;
-            }
+            };
+            let rel = rel.floor();
             let li = rel.clamp(0.0, (dims[a] - 1) as f64);
             l[a] = li as usize;
-            let c = (origin[a] as f64 + li + 0.5) * r;
-            d2 += (p[a] - c) * (p[a] - c);
+            d2 += self.centre_gap_sq(p[a], li, a);
         }
         let v = self.lb[l[0] + dims[0] * (l[1] + dims[1] * l[2])] as f64;
         (v - d2.sqrt() - ROUND_EPS).max(0.0)

@@ -11,8 +11,6 @@
 //! is the user's choice ([`Grid::unknown_is_occupied`], `--unknown-free` sets it false);
 //! the grid keeps the three states so either choice can be made later.
 
-use std::fmt;
-
 /// Largest number of voxels a grid may hold (400 M: 400 MB of cells, 1.6 GB of distance
 /// field). Larger maps are refused with [`GridError::TooLarge`] rather than exhausting memory.
 pub const MAX_CELLS: usize = 400_000_000;
@@ -40,37 +38,36 @@ impl Cell {
 }
 
 /// Why a grid cannot be built.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum GridError {
     /// The resolution is not a finite positive number.
+    #[error("resolution {0} is not a positive number")]
     Resolution(f64),
     /// The map has no known voxel, so it has no bounding box.
+    #[error("the map has no known (occupied or free) voxel")]
     Empty,
     /// The bounds are not finite or are inverted.
+    #[error("bounds {0:?} .. {1:?} are not a finite box")]
     Bounds([f64; 3], [f64; 3]),
     /// The bounding box holds more than [`MAX_CELLS`] voxels at this resolution.
+    #[error(
+        "the bounding box needs {} x {} x {} voxels, more than {MAX_CELLS}",
+        .dims[0], .dims[1], .dims[2]
+    )]
     TooLarge {
         /// Voxels per axis that the box would need.
         dims: [u64; 3],
     },
 }
 
-impl fmt::Display for GridError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            GridError::Resolution(r) => write!(f, "resolution {r} is not a positive number"),
-            GridError::Empty => f.write_str("the map has no known (occupied or free) voxel"),
-            GridError::Bounds(lo, hi) => write!(f, "bounds {lo:?} .. {hi:?} are not a finite box"),
-            GridError::TooLarge { dims } => write!(
-                f,
-                "the bounding box needs {} x {} x {} voxels, more than {MAX_CELLS}",
-                dims[0], dims[1], dims[2]
-            ),
-        }
+/// `Ok` when `resolution` is a finite positive voxel edge.
+fn check_resolution(resolution: f64) -> Result<(), GridError> {
+    if resolution.is_finite() && resolution > 0.0 {
+        Ok(())
+    } else {
+        Err(GridError::Resolution(resolution))
     }
 }
-
-impl std::error::Error for GridError {}
 
 /// Per-state voxel counts of a grid (inside its bounds).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -104,9 +101,7 @@ impl Grid {
         fill: Cell,
         unknown_is_occupied: bool,
     ) -> Result<Grid, GridError> {
-        if !(resolution.is_finite() && resolution > 0.0) {
-            return Err(GridError::Resolution(resolution));
-        }
+        check_resolution(resolution)?;
         let total = dims
             .iter()
             .try_fold(1usize, |acc, &d| acc.checked_mul(d))
@@ -146,9 +141,7 @@ impl Grid {
         leaves: impl IntoIterator<Item = ([f64; 3], f64, bool)>,
         unknown_is_occupied: bool,
     ) -> Result<Grid, GridError> {
-        if !(resolution.is_finite() && resolution > 0.0) {
-            return Err(GridError::Resolution(resolution));
-        }
+        check_resolution(resolution)?;
         if (0..3).any(|a| !(lo[a].is_finite() && hi[a].is_finite() && lo[a] < hi[a])) {
             return Err(GridError::Bounds(lo, hi));
         }
@@ -507,6 +500,26 @@ mod tests {
             Grid::from_leaves(0.1, [0.0; 3], [f64::NAN, 1.0, 1.0], Vec::new(), true),
             Err(GridError::Bounds(..))
         ));
+    }
+
+    #[test]
+    fn error_messages_say_what_is_wrong() {
+        assert_eq!(
+            GridError::Resolution(-1.5).to_string(),
+            "resolution -1.5 is not a positive number"
+        );
+        assert_eq!(
+            GridError::Empty.to_string(),
+            "the map has no known (occupied or free) voxel"
+        );
+        assert_eq!(
+            GridError::Bounds([0.0; 3], [1.0, 2.0, f64::NAN]).to_string(),
+            "bounds [0.0, 0.0, 0.0] .. [1.0, 2.0, NaN] are not a finite box"
+        );
+        assert_eq!(
+            GridError::TooLarge { dims: [1, 2, 3] }.to_string(),
+            format!("the bounding box needs 1 x 2 x 3 voxels, more than {MAX_CELLS}")
+        );
     }
 
     #[test]
