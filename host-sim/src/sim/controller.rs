@@ -506,6 +506,7 @@ impl ChainController {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::dynamics::M3;
     use aerial_chain_core::ChainParams;
 
     fn state(p: V3) -> BodyState {
