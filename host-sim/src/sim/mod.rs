@@ -10,6 +10,7 @@
 //! - [`clearance`]: the exact clearance of the flown chain to a map;
 //! - [`plot`]: SVG plots of a flight.
 
+mod bodies;
 pub mod clearance;
 pub mod controller;
 pub mod dynamics;
