@@ -1,6 +1,9 @@
 //! Chart axes: a named data range, linear or logarithmic, and where its ticks go
 //! and how they read.
 
+/// Labelled ticks of an axis: `(value, label)`.
+pub(crate) type Ticks = Vec<(f64, String)>;
+
 /// One axis of a chart: its name and the data range it shows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Axis {
@@ -77,7 +80,7 @@ impl Axis {
     }
 
     /// Labelled ticks for an axis drawn `pixels` long: `(value, label)`.
-    pub(crate) fn ticks(&self, pixels: f64) -> Vec<(f64, String)> {
+    pub(crate) fn ticks(&self, pixels: f64) -> Ticks {
         if self.log {
             return decades(self.min, self.max);
         }
@@ -126,7 +129,7 @@ pub(crate) fn nice_step(raw: f64) -> f64 {
 }
 
 /// Multiples of `step` within `lo..=hi`, labelled with as many decimals as `step` needs.
-pub(crate) fn labelled(lo: f64, hi: f64, step: f64) -> Vec<(f64, String)> {
+pub(crate) fn labelled(lo: f64, hi: f64, step: f64) -> Ticks {
     let first = (lo / step).ceil() as i64;
     let last = (hi / step).floor() as i64;
     let decimals = (-step.log10().floor()).max(0.0) as usize;
@@ -140,10 +143,10 @@ pub(crate) fn labelled(lo: f64, hi: f64, step: f64) -> Vec<(f64, String)> {
 
 /// Powers of ten within `lo..=hi`, and 2 and 5 times them too when that would be
 /// fewer than three labels.
-fn decades(lo: f64, hi: f64) -> Vec<(f64, String)> {
+fn decades(lo: f64, hi: f64) -> Ticks {
     let (a, b) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
     let within = |v: &(f64, String)| v.0 >= lo * (1.0 - 1e-9) && v.0 <= hi * (1.0 + 1e-9);
-    let with = |multiples: &[u32]| -> Vec<(f64, String)> {
+    let with = |multiples: &[u32]| -> Ticks {
         (a..=b)
             .flat_map(|e| multiples.iter().map(move |&m| log_tick(m, e)))
             .filter(within)

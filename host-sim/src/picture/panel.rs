@@ -10,7 +10,7 @@ use svg::node::element::{
     Circle, ClipPath, Definitions, Group, Line, Polygon, Polyline, Rectangle,
 };
 
-use super::axis::Axis;
+use super::axis::{Axis, Ticks};
 use super::style::{palette, size, stroke, text, text_width, Colour};
 
 /// Room around the plot area for the title, tick labels and axis names (px).
@@ -339,7 +339,7 @@ impl Panel {
     }
 
     /// Labelled ticks on both axes: a map panel uses one step for both.
-    fn tick_lists(&self) -> (Vec<(f64, String)>, Vec<(f64, String)>) {
+    fn tick_lists(&self) -> (Ticks, Ticks) {
         if self.equal {
             let extent = (self.x.max - self.x.min).max(self.y.max - self.y.min);
             let step = super::axis::nice_step(extent / 6.0);
