@@ -357,15 +357,7 @@ impl Panel {
         let (ix, iy, _, ih) = self.inner();
         let (xs, ys) = self.tick_lists();
         let mut g = Group::new();
-        let tick = |x1: f64, y1: f64, x2: f64, y2: f64| {
-            Line::new()
-                .set("x1", x1)
-                .set("y1", y1)
-                .set("x2", x2)
-                .set("y2", y2)
-                .set("stroke", palette::INK)
-                .set("stroke-width", stroke::HAIR)
-        };
+        let tick = |x1, y1, x2, y2| hairline((x1, y1), (x2, y2), palette::INK);
         let bottom = iy + ih;
         for (v, label) in xs {
             let (u, _) = self.map(v, self.y.min);
@@ -400,15 +392,7 @@ impl Panel {
     fn grid(&self) -> Group {
         let (ix, iy, iw, ih) = self.inner();
         let (xs, ys) = self.tick_lists();
-        let line = |x1: f64, y1: f64, x2: f64, y2: f64| {
-            Line::new()
-                .set("x1", x1)
-                .set("y1", y1)
-                .set("x2", x2)
-                .set("y2", y2)
-                .set("stroke", palette::GRID)
-                .set("stroke-width", stroke::HAIR)
-        };
+        let line = |x1, y1, x2, y2| hairline((x1, y1), (x2, y2), palette::GRID);
         let mut g = Group::new();
         for (v, _) in xs {
             let (u, _) = self.map(v, self.y.min);
@@ -496,6 +480,17 @@ pub(crate) fn swatch(x: f64, y: f64, colour: Colour, label: &str) -> Group {
             palette::INK,
             "start",
         ))
+}
+
+/// A hairline between pixel positions `a` and `b`: ticks and grid lines.
+fn hairline(a: (f64, f64), b: (f64, f64), colour: Colour) -> Line {
+    Line::new()
+        .set("x1", a.0)
+        .set("y1", a.1)
+        .set("x2", b.0)
+        .set("y2", b.1)
+        .set("stroke", colour)
+        .set("stroke-width", stroke::HAIR)
 }
 
 /// Width and height of the plot area of a panel of pixel rectangle `px`.
