@@ -180,16 +180,6 @@ pub fn draw(grid: &Grid, plan: &Plan, title: &str, goal: Option<[f64; 3]>) -> Fi
 const FOLLOW_DRAWN: usize = 4;
 
 fn chain(p: &mut Panel, body: &[[f64; 3]], u: usize, v: usize, r: f64, c: Colour) {
-    for w in body.windows(2) {
-        p.line((w[0][u], w[0][v]), (w[1][u], w[1][v]), palette::INK, 1.2);
-    }
-    for (i, q) in body.iter().enumerate() {
-        p.circle(
-            (q[u], q[v]),
-            r,
-            c,
-            if i == 0 { palette::INK } else { c },
-            0.45,
-        );
-    }
+    let projected: Vec<(f64, f64)> = body.iter().map(|q| (q[u], q[v])).collect();
+    p.chain(&projected, r, c);
 }

@@ -1,6 +1,7 @@
-//! Line charts of the scaling study (plotters, SVG; PNG through the project's rasteriser).
+//! Charts of the benchmark studies (time and success against a size), drawn with
+//! the project's [`crate::picture`] figures so they look like the other pictures.
 
-use plotters::prelude::*;
+use crate::picture::{stroke, Axis, Colour, Figure, Panel};
 
 use super::Summary;
 
@@ -9,12 +10,12 @@ pub struct Curve {
     /// Legend label.
     pub label: String,
     /// Colour.
-    pub colour: RGBColor,
+    pub colour: Colour,
     /// Points.
     pub points: Vec<(f64, f64, f64, f64)>,
 }
 
-/// One chart of the figure.
+/// One chart of the figure; its x values are counts or sizes (ticks at whole numbers).
 pub struct Chart {
     /// Title.
     pub title: String,
@@ -30,113 +31,63 @@ pub struct Chart {
     pub curves: Vec<Curve>,
 }
 
-fn x_range(charts: &Chart) -> (f64, f64) {
-    let xs = charts
+/// Radius of a data point's marker (px).
+const MARKER: f64 = 3.0;
+
+fn x_range(chart: &Chart) -> (f64, f64) {
+    let xs = chart
         .curves
         .iter()
         .flat_map(|c| c.points.iter().map(|p| p.0));
-    let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-        (a.min(x), b.max(x))
-    });
-    if lo.is_finite() && hi > lo {
-        let pad = 0.04 * (hi - lo);
-        (lo - pad, hi + pad)
-    } else if lo.is_finite() {
-        (lo - 1.0, lo + 1.0)
-    } else {
-        (0.0, 1.0)
-    }
-}
-
-fn draw_one<DB: DrawingBackend>(
-    area: &DrawingArea<DB, plotters::coord::Shift>,
-    c: &Chart,
-) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plot: {e}");
-    let (x0, x1) = x_range(c);
-    let mut b = ChartBuilder::on(area);
-    b.caption(&c.title, ("sans-serif", 18))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60);
-    let ok = |p: &(f64, f64, f64, f64)| p.1.is_finite() && (!c.log_y || p.1 > 0.0);
-    macro_rules! body {
-        ($chart:expr) => {{
-            let mut ch = $chart;
-            let whole = |x: &f64| format!("{x:.0}");
-            ch.configure_mesh()
-                .light_line_style(WHITE)
-                .x_label_formatter(&whole)
-                .x_desc(c.x_label.as_str())
-                .y_desc(c.y_label.as_str())
-                .draw()
-                .map_err(err)?;
-            for cu in &c.curves {
-                let col = cu.colour;
-                let pts: Vec<(f64, f64)> = cu
-                    .points
-                    .iter()
-                    .filter(|p| ok(p))
-                    .map(|p| (p.0, p.1))
-                    .collect();
-                ch.draw_series(LineSeries::new(pts.clone(), col.stroke_width(2)))
-                    .map_err(err)?
-                    .label(cu.label.as_str())
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
-                    });
-                ch.draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.filled())))
-                    .map_err(err)?;
-                // Interquartile range as vertical bars.
-                ch.draw_series(
-                    cu.points
-                        .iter()
-                        .filter(|p| ok(p) && p.2.is_finite() && p.3.is_finite())
-                        .filter(|p| !c.log_y || p.2 > 0.0)
-                        .map(|p| {
-                            PathElement::new(vec![(p.0, p.2), (p.0, p.3)], col.stroke_width(1))
-                        }),
-                )
-                .map_err(err)?;
-            }
-            ch.configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::UpperLeft)
-                .draw()
-                .map_err(err)?;
-        }};
-    }
-    if c.log_y {
-        body!(b
-            .build_cartesian_2d(x0..x1, (c.y_range.0..c.y_range.1).log_scale())
-            .map_err(err)?);
-    } else {
-        body!(b
-            .build_cartesian_2d(x0..x1, c.y_range.0..c.y_range.1)
-            .map_err(err)?);
-    }
-    Ok(())
-}
-
-/// A grid of charts (`rows` x `cols`, row-major) as an SVG document.
-pub fn svg(charts: &[Chart], rows: usize, cols: usize, size: (u32, u32)) -> Result<String, String> {
-    let mut buf = String::new();
-    {
-        let root = SVGBackend::with_string(&mut buf, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| format!("plot: {e}"))?;
-        let areas = root.split_evenly((rows.max(1), cols.max(1)));
-        for (a, c) in areas.iter().zip(charts) {
-            draw_one(a, c)?;
+    match crate::picture::axis::finite_range(xs) {
+        Some((lo, hi)) if hi > lo => {
+            let pad = 0.04 * (hi - lo);
+            (lo - pad, hi + pad)
         }
-        root.present().map_err(|e| format!("plot: {e}"))?;
+        Some((lo, _)) => (lo - 1.0, lo + 1.0),
+        None => (0.0, 1.0),
     }
-    // The rasteriser maps the generic "sans-serif" to Arial, which may be missing: name
-    // the fonts the project's pictures use first.
-    Ok(buf.replace(
-        "font-family=\"sans-serif\"",
-        "font-family=\"DejaVu Sans, Arial, sans-serif\"",
-    ))
+}
+
+/// `chart` drawn in the figure's pixel rectangle `cell`: each curve as a line
+/// through its medians with a marker at each, and its interquartile range as a
+/// vertical bar.
+fn panel(cell: (f64, f64, f64, f64), chart: &Chart) -> Panel {
+    let x = Axis::linear(&chart.x_label, x_range(chart)).whole();
+    let y = if chart.log_y {
+        Axis::log(&chart.y_label, chart.y_range)
+    } else {
+        Axis::linear(&chart.y_label, chart.y_range)
+    };
+    let shown = |v: f64| v.is_finite() && (!chart.log_y || v > 0.0);
+    let mut p = Panel::chart(cell, x, y, &chart.title);
+    for curve in &chart.curves {
+        let points: Vec<&(f64, f64, f64, f64)> =
+            curve.points.iter().filter(|q| shown(q.1)).collect();
+        for q in points
+            .iter()
+            .filter(|q| shown(q.2) && shown(q.3) && q.2 != q.3)
+        {
+            p.line((q.0, q.2), (q.0, q.3), curve.colour, stroke::HAIR);
+        }
+        let medians: Vec<(f64, f64)> = points.iter().map(|q| (q.0, q.1)).collect();
+        p.polyline(&medians, curve.colour, stroke::DATA, false);
+        for &m in &medians {
+            p.marker(m, MARKER, curve.colour);
+        }
+        p.key(curve.colour, &curve.label);
+    }
+    p
+}
+
+/// A grid of charts (`rows` x `cols`, row-major) as an SVG document of `size` pixels.
+pub fn svg(charts: &[Chart], rows: usize, cols: usize, size: (u32, u32)) -> String {
+    let (w, h) = (size.0 as f64, size.1 as f64);
+    let mut fig = Figure::new(w, h, "");
+    for (cell, chart) in fig.cells(rows, cols, 0.0, h).into_iter().zip(charts) {
+        fig.add(panel(cell, chart));
+    }
+    fig.to_svg()
 }
 
 /// `(x, median, q1, q3)` of the successful runs' query times (ms) of `sums`, by `x`.
@@ -177,6 +128,7 @@ pub fn success_pct(sums: &[&Summary], x: impl Fn(&Summary) -> f64) -> Vec<(f64, 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::picture::palette;
 
     #[test]
     fn draws_an_svg_even_with_gaps() {
@@ -189,7 +141,7 @@ mod tests {
                 y_range: (0.1, 1e5),
                 curves: vec![Curve {
                     label: "a".into(),
-                    colour: BLUE,
+                    colour: palette::PATH,
                     points: vec![
                         (3.0, 10.0, 5.0, 20.0),
                         (4.0, f64::NAN, f64::NAN, f64::NAN),
@@ -206,9 +158,10 @@ mod tests {
                 curves: vec![],
             },
         ];
-        let s = svg(&charts, 1, 2, (800, 400)).unwrap();
+        let s = svg(&charts, 1, 2, (800, 400));
         assert!(s.starts_with("<svg"));
         assert!(s.contains("</svg>"));
         assert!(s.contains("DejaVu Sans") && !s.contains("font-family=\"sans-serif\""));
+        assert!(!s.contains("NaN"), "gaps are skipped, not drawn");
     }
 }

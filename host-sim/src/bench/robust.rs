@@ -163,7 +163,7 @@ pub fn markdown(results: &[RunResult], redrawn: usize, meta: &str) -> String {
 }
 
 /// The figure: sorted roadmap and planning times of the solved instances.
-pub fn figure(results: &[RunResult]) -> Result<String, String> {
+pub fn figure(results: &[RunResult]) -> String {
     let sorted = |f: &dyn Fn(&RunResult) -> f64| -> Vec<(f64, f64, f64, f64)> {
         let mut v: Vec<f64> = results
             .iter()
@@ -180,12 +180,12 @@ pub fn figure(results: &[RunResult]) -> Result<String, String> {
     let curves = vec![
         plot::Curve {
             label: "planning (query)".into(),
-            colour: plotters::style::RGBColor(200, 60, 40),
+            colour: crate::picture::palette::SRS,
             points: sorted(&|r| r.planning_s),
         },
         plot::Curve {
             label: "roadmap".into(),
-            colour: plotters::style::RGBColor(40, 90, 200),
+            colour: crate::picture::palette::PATH,
             points: sorted(&|r| r.roadmap_s),
         },
     ];

@@ -13,8 +13,8 @@
 
 use std::fmt::Write as _;
 
+use crate::picture::{palette, Colour};
 use aerial_chain_core::lsc::library;
-use plotters::style::RGBColor;
 
 use super::plot::{self, Chart, Curve};
 use super::{fitting_query, ArcMode, Envs, Method, Query, RunSpec, Summary};
@@ -227,12 +227,12 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
     s
 }
 
-const BLUE: RGBColor = RGBColor(31, 119, 180);
-const ORANGE: RGBColor = RGBColor(255, 127, 14);
-const GREEN: RGBColor = RGBColor(44, 160, 44);
+const BLUE: Colour = palette::PATH;
+const ORANGE: Colour = palette::GOAL;
+const GREEN: Colour = palette::LSC;
 
 /// The figure: time and success against N (left) and against corridor length (right).
-pub fn figure(sums: &[Summary], corridor_units: u8) -> Result<String, String> {
+pub fn figure(sums: &[Summary], corridor_units: u8) -> String {
     let by_n: Vec<&Summary> = sums.iter().filter(|g| g.study == "scale-units").collect();
     let by_l: Vec<&Summary> = sums.iter().filter(|g| g.study == "scale-map").collect();
     let n = |g: &Summary| g.units as f64;

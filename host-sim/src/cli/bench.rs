@@ -377,8 +377,8 @@ fn run_scale(a: ScaleArgs) -> CliResult {
             t.elapsed().as_secs_f64()
         ),
     );
-    let svg = scale::figure(&sums, o.corridor_units).map_err(CliError::failed)?;
-    let png = crate::picture::rasterise(&svg).map_err(CliError::failed)?;
+    let svg = scale::figure(&sums, o.corridor_units);
+    let png = crate::picture::rasterise(&svg).map_err(|e| CliError::failed(e.to_string()))?;
     let dir = &a.study.out_dir;
     let files = [
         write(dir, "scale_runs.csv", bench::runs_csv(&results).as_bytes())?,
@@ -458,7 +458,7 @@ fn run_robust(a: RobustArgs) -> CliResult {
             t.elapsed().as_secs_f64()
         ),
     );
-    let svg = robust::figure(&results).map_err(CliError::failed)?;
+    let svg = robust::figure(&results);
     let dir = &a.out_dir;
     let files = [
         write(dir, "robust_runs.csv", bench::runs_csv(&results).as_bytes())?,

@@ -244,7 +244,8 @@ fn picture(a: PictureArgs) -> CliResult {
         title,
     };
     let fig = map_figure(&grid, sc.as_ref(), &opts);
-    fig.save(&a.out).map_err(CliError::input)?;
+    fig.save(&a.out)
+        .map_err(|e| CliError::input(e.to_string()))?;
     println!("wrote {}", a.out.display());
     Ok(())
 }

@@ -308,7 +308,7 @@ pub fn run(a: PlanArgs) -> CliResult {
             Some(goal),
         )
         .save(pic)
-        .map_err(CliError::input)?;
+        .map_err(|e| CliError::input(e.to_string()))?;
         report.line(format_args!("  picture: {}", pic.display()));
     }
     Ok(())

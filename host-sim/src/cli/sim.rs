@@ -248,8 +248,8 @@ pub fn run(a: SimArgs) -> CliResult {
         let band = params.unit_radius as f64;
         let obs = footprint(&loaded.grid, lo - band, hi + band);
         let title = format!("arc sim: {plan_name} on {}", a.map.name());
-        let svg = flight_svg(&flight, &obs, &title).map_err(CliError::failed)?;
-        crate::picture::save_svg(&svg, path).map_err(CliError::input)?;
+        let svg = flight_svg(&flight, &obs, &title);
+        crate::picture::save_svg(&svg, path).map_err(|e| CliError::input(e.to_string()))?;
         say(format_args!("  wrote {}", path.display()));
     }
     if let Some(why) = looser {

@@ -251,7 +251,8 @@ pub fn run_shapes(a: ShapesArgs) -> CliResult {
             &format!("{} left out: {why}", kind.name()),
         );
     }
-    fig.save(&a.out).map_err(CliError::input)?;
+    fig.save(&a.out)
+        .map_err(|e| CliError::input(e.to_string()))?;
     println!("{}: {} shapes drawn", a.out.display(), lib.entries.len());
     Ok(())
 }

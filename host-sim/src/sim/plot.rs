@@ -1,264 +1,209 @@
-//! SVG plots of a flight (plotters, SVG backend only): head position against its
-//! reference over time, link pitch and yaw against their references, and the flown
-//! chain seen from above over the map's obstacles.
+//! The picture of a flight, drawn with the project's [`crate::picture`] figures:
+//! head position against its reference over time, link pitch and yaw against
+//! their references, and the flown chain seen from above over the map's obstacles.
 
-use plotters::coord::types::RangedCoordf64;
-use plotters::prelude::*;
+use crate::picture::{palette, stroke, Axis, Figure, Panel};
 
-use super::flight::Flight;
+use super::flight::{Flight, Sample};
 
 /// At most this many points per time series (the flight is decimated evenly).
 const MAX_POINTS: usize = 1500;
 
-/// Font families, as the project's other pictures use them (resvg finds DejaVu).
-const FONT: &str = "DejaVu Sans, Arial, sans-serif";
+/// How many snapshots of the chain the top view shows, besides the last.
+const SNAPSHOTS: usize = 12;
+
+/// Size of the flight picture (px).
+const WIDTH: f64 = 1200.0;
+const HEIGHT: f64 = 900.0;
+
+/// Room for the figure's title above the panels (px).
+const TITLE_H: f64 = 28.0;
 
 /// An obstacle footprint seen from above: `[x0, y0, x1, y1]` (m).
 pub type Footprint = [f64; 4];
 
-fn err<E: std::fmt::Display>(e: E) -> String {
-    format!("plot: {e}")
-}
+/// Colours of the head's x, y and z.
+const AXIS_COLOURS: [&str; 3] = [palette::SRS, palette::LSC, palette::PATH];
 
-fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in values.filter(|v| v.is_finite()) {
-        lo = lo.min(v);
-        hi = hi.max(v);
-    }
-    if !lo.is_finite() {
-        return (-1.0, 1.0);
-    }
-    let pad = ((hi - lo) * 0.08).max(0.05);
-    (lo - pad, hi + pad)
-}
-
-const AXIS: [RGBColor; 3] = [
-    RGBColor(200, 40, 40),
-    RGBColor(30, 140, 40),
-    RGBColor(40, 70, 200),
-];
-
-/// The charts here: time or metres on both axes.
-type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
-
-/// A chart on `area` in the project's style: caption, margins, fonts, mesh, axis names.
-fn chart<'a, DB: DrawingBackend>(
-    area: &'a DrawingArea<DB, plotters::coord::Shift>,
-    caption: &str,
-    (x, y): (std::ops::Range<f64>, std::ops::Range<f64>),
-    (x_desc, y_desc): (&str, &str),
-) -> Result<Chart<'a, DB>, String> {
-    let mut c = ChartBuilder::on(area)
-        .caption(caption, (FONT, 16))
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(50)
-        .build_cartesian_2d(x, y)
-        .map_err(err)?;
-    c.configure_mesh()
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 13))
-        .x_desc(x_desc)
-        .y_desc(y_desc)
-        .draw()
-        .map_err(err)?;
-    Ok(c)
-}
-
-/// The legend box of `c`'s labelled series.
-fn legend<'a, DB: DrawingBackend + 'a>(c: &mut Chart<'a, DB>) -> Result<(), String> {
-    c.configure_series_labels()
-        .label_font((FONT, 12))
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)
-}
-
-fn link_color(k: usize) -> RGBColor {
-    const P: [RGBColor; 8] = [
-        RGBColor(31, 119, 180),
-        RGBColor(255, 127, 14),
-        RGBColor(44, 160, 44),
-        RGBColor(214, 39, 40),
-        RGBColor(148, 103, 189),
-        RGBColor(140, 86, 75),
-        RGBColor(227, 119, 194),
-        RGBColor(23, 190, 207),
-    ];
-    P[k % P.len()]
-}
+/// The other units' flown paths in the top view: the head's colour, lighter.
+const TRAIL: &str = "#9ec5e8";
 
 /// The flight as an SVG document (1200 x 900): four panels. `obstacles` are drawn
 /// in the top view; `title` heads the picture.
-pub fn flight_svg(flight: &Flight, obstacles: &[Footprint], title: &str) -> Result<String, String> {
-    let mut out = String::new();
-    {
-        let root = SVGBackend::with_string(&mut out, (1200, 900)).into_drawing_area();
-        root.fill(&WHITE).map_err(err)?;
-        let root = root.titled(title, (FONT, 22)).map_err(err)?;
-        let panels = root.split_evenly((2, 2));
-        let step = (flight.samples.len() / MAX_POINTS).max(1);
-        let samples: Vec<_> = flight.samples.iter().step_by(step).collect();
-        let t_end = samples.last().map_or(1.0, |s| s.t).max(1e-3);
-        let n_links = flight.params.n() - 1;
+pub fn flight_svg(flight: &Flight, obstacles: &[Footprint], title: &str) -> String {
+    let step = (flight.samples.len() / MAX_POINTS).max(1);
+    let samples: Vec<&Sample> = flight.samples.iter().step_by(step).collect();
+    let mut fig = Figure::new(WIDTH, HEIGHT, title);
+    let cells = fig.cells(2, 2, TITLE_H, HEIGHT);
+    fig.add(head_panel(cells[0], &samples));
+    let n_links = flight.params.n().saturating_sub(1);
+    fig.add(link_panel(cells[1], &samples, 0, "link pitch", n_links));
+    fig.add(link_panel(cells[2], &samples, 1, "link yaw", n_links));
+    fig.add(top_view(cells[3], flight, &samples, obstacles));
+    fig.to_svg()
+}
 
-        // (a) Head position against the reference.
-        let (lo, hi) = range(samples.iter().flat_map(|s| {
-            (0..3).flat_map(move |i| [s.units[0].p[i] as f64, s.head_ref[i] as f64])
-        }));
-        let mut c = chart(
-            &panels[0],
-            "head position (solid) and reference (thin black)",
-            (0.0..t_end, lo..hi),
-            ("t (s)", "m"),
-        )?;
-        for (i, name) in ["x", "y", "z"].iter().enumerate() {
-            c.draw_series(LineSeries::new(
-                samples.iter().map(|s| (s.t, s.head_ref[i] as f64)),
-                BLACK.stroke_width(1),
-            ))
-            .map_err(err)?;
-            c.draw_series(LineSeries::new(
-                samples.iter().map(|s| (s.t, s.units[0].p[i] as f64)),
-                AXIS[i].stroke_width(2),
-            ))
-            .map_err(err)?
-            .label(*name)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 16, y)], AXIS[i].stroke_width(2))
-            });
-        }
-        legend(&mut c)?;
+/// The time axis of `samples`.
+fn time_axis(samples: &[&Sample]) -> Axis {
+    let t_end = samples.last().map_or(1.0, |s| s.t).max(1e-3);
+    Axis::linear("t (s)", (0.0, t_end))
+}
 
-        // (b), (c) Link pitch and yaw against their references (degrees).
-        for (panel, which, name) in [(1usize, 0usize, "link pitch"), (2, 1, "link yaw")] {
-            let (lo, hi) = range(samples.iter().flat_map(|s| {
-                s.links_meas
-                    .iter()
-                    .chain(s.links_ref.iter())
-                    .map(move |a| (a[which] as f64).to_degrees())
-            }));
-            let mut c = chart(
-                &panels[panel],
-                &format!("{name} (solid) and reference (thin black), deg"),
-                (0.0..t_end, lo..hi),
-                ("t (s)", "deg"),
-            )?;
-            for k in 0..n_links {
-                c.draw_series(LineSeries::new(
-                    samples
-                        .iter()
-                        .map(|s| (s.t, (s.links_ref[k][which] as f64).to_degrees())),
-                    BLACK.stroke_width(1),
-                ))
-                .map_err(err)?;
-                let col = link_color(k);
-                c.draw_series(LineSeries::new(
-                    samples
-                        .iter()
-                        .map(|s| (s.t, (s.links_meas[k][which] as f64).to_degrees())),
-                    col.stroke_width(2),
-                ))
-                .map_err(err)?
-                .label(format!("link {}", k + 1))
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2))
-                });
-            }
-            legend(&mut c)?;
-        }
-
-        // (d) Top view: obstacles, the reference head path, the flown units' paths and
-        // snapshots of the chain.
-        let xs = samples
+/// (a) Head position against the reference.
+fn head_panel(cell: (f64, f64, f64, f64), samples: &[&Sample]) -> Panel {
+    let y = Axis::around(
+        "position (m)",
+        samples
             .iter()
-            .flat_map(|s| s.units.iter().map(|u| u.p[0] as f64));
-        let ys = samples
+            .flat_map(|s| (0..3).flat_map(move |i| [s.units[0].p[i] as f64, s.head_ref[i] as f64])),
+    );
+    let mut p = Panel::chart(
+        cell,
+        time_axis(samples),
+        y,
+        "head position (solid) and reference (dashed)",
+    );
+    for (i, name) in ["x", "y", "z"].iter().enumerate() {
+        let flown: Vec<(f64, f64)> = samples
             .iter()
-            .flat_map(|s| s.units.iter().map(|u| u.p[1] as f64));
-        let (mut x0, mut x1) = range(xs);
-        let (mut y0, mut y1) = range(ys);
-        // Equal scales: grow the shorter side.
-        let (w, h) = (x1 - x0, y1 - y0);
-        if w > h {
-            let g = 0.5 * (w - h);
-            y0 -= g;
-            y1 += g;
-        } else {
-            let g = 0.5 * (h - w);
-            x0 -= g;
-            x1 += g;
-        }
-        let mut c = chart(
-            &panels[3],
-            "flown chain, top view (grey: obstacles in the flight's height band)",
-            (x0..x1, y0..y1),
-            ("x (m)", "y (m)"),
-        )?;
-        let visible = obstacles
-            .iter()
-            .filter(|o| o[2] >= x0 && o[0] <= x1 && o[3] >= y0 && o[1] <= y1);
-        c.draw_series(visible.map(|o| {
-            Rectangle::new(
-                [(o[0].max(x0), o[1].max(y0)), (o[2].min(x1), o[3].min(y1))],
-                RGBColor(170, 170, 170).filled(),
-            )
-        }))
-        .map_err(err)?;
-        c.draw_series(LineSeries::new(
-            samples
-                .iter()
-                .map(|s| (s.head_ref[0] as f64, s.head_ref[1] as f64)),
-            BLACK.stroke_width(1),
-        ))
-        .map_err(err)?;
-        for i in (1..flight.params.n()).rev() {
-            c.draw_series(LineSeries::new(
-                samples
-                    .iter()
-                    .map(|s| (s.units[i].p[0] as f64, s.units[i].p[1] as f64)),
-                RGBColor(120, 160, 220).stroke_width(1),
-            ))
-            .map_err(err)?;
-        }
-        c.draw_series(LineSeries::new(
-            samples
-                .iter()
-                .map(|s| (s.units[0].p[0] as f64, s.units[0].p[1] as f64)),
-            AXIS[0].stroke_width(2),
-        ))
-        .map_err(err)?;
-        let snapshots = 12usize;
-        let every = (flight.samples.len() / snapshots).max(1);
-        for s in flight
-            .samples
-            .iter()
-            .step_by(every)
-            .chain(flight.samples.last())
-        {
-            let pts: Vec<(f64, f64)> = s
-                .units
-                .iter()
-                .map(|u| (u.p[0] as f64, u.p[1] as f64))
-                .collect();
-            c.draw_series(std::iter::once(PathElement::new(
-                pts.clone(),
-                RGBColor(20, 20, 20).stroke_width(2),
-            )))
-            .map_err(err)?;
-            c.draw_series(pts.iter().enumerate().map(|(i, &p)| {
-                let col = if i == 0 {
-                    AXIS[0]
-                } else {
-                    RGBColor(20, 20, 20)
-                };
-                Circle::new(p, 3, col.filled())
-            }))
-            .map_err(err)?;
-        }
-        root.present().map_err(err)?;
+            .map(|s| (s.t, s.units[0].p[i] as f64))
+            .collect();
+        p.polyline(&flown, AXIS_COLOURS[i], stroke::DATA, false);
+        p.key(AXIS_COLOURS[i], name);
     }
-    Ok(out)
+    // The reference goes over the flown curves: it stays visible where they agree.
+    for i in 0..3 {
+        let reference: Vec<(f64, f64)> = samples
+            .iter()
+            .map(|s| (s.t, s.head_ref[i] as f64))
+            .collect();
+        p.polyline(&reference, palette::INK, stroke::HAIR, true);
+    }
+    p.key(palette::INK, "reference");
+    p
+}
+
+/// (b), (c) Link pitch (`which` 0) or yaw (1) against their references, in degrees.
+fn link_panel(
+    cell: (f64, f64, f64, f64),
+    samples: &[&Sample],
+    which: usize,
+    name: &str,
+    n_links: usize,
+) -> Panel {
+    let y = Axis::around(
+        "angle (deg)",
+        samples.iter().flat_map(|s| {
+            s.links_meas
+                .iter()
+                .chain(s.links_ref.iter())
+                .map(move |a| (a[which] as f64).to_degrees())
+        }),
+    );
+    let mut p = Panel::chart(
+        cell,
+        time_axis(samples),
+        y,
+        &format!("{name} (solid) and reference (dashed)"),
+    );
+    let series = |k: usize, of: fn(&Sample) -> &Vec<[f32; 2]>| -> Vec<(f64, f64)> {
+        samples
+            .iter()
+            .map(|s| (s.t, (of(s)[k][which] as f64).to_degrees()))
+            .collect()
+    };
+    for k in 0..n_links {
+        let colour = palette::series(k);
+        p.polyline(&series(k, |s| &s.links_meas), colour, stroke::DATA, false);
+        p.key(colour, &format!("link {}", k + 1));
+    }
+    for k in 0..n_links {
+        p.polyline(
+            &series(k, |s| &s.links_ref),
+            palette::INK,
+            stroke::HAIR,
+            true,
+        );
+    }
+    p.key(palette::INK, "reference");
+    p
+}
+
+/// (d) Top view: obstacles, the reference head path, the flown units' paths and
+/// snapshots of the chain, drawn as the plan pictures draw chains.
+fn top_view(
+    cell: (f64, f64, f64, f64),
+    flight: &Flight,
+    samples: &[&Sample],
+    obstacles: &[Footprint],
+) -> Panel {
+    let ru = flight.params.unit_radius as f64;
+    let at = |s: &Sample, i: usize| (s.units[i].p[0] as f64, s.units[i].p[1] as f64);
+    let xs = crate::picture::axis::finite_range(
+        samples
+            .iter()
+            .flat_map(|s| s.units.iter().map(|u| u.p[0] as f64)),
+    );
+    let ys = crate::picture::axis::finite_range(
+        samples
+            .iter()
+            .flat_map(|s| s.units.iter().map(|u| u.p[1] as f64)),
+    );
+    let ((x0, x1), (y0, y1)) = (xs.unwrap_or((-1.0, 1.0)), ys.unwrap_or((-1.0, 1.0)));
+    let pad = 2.0 * ru + 0.1;
+    let mut p = Panel::new(
+        cell,
+        (x0 - pad, y0 - pad),
+        (x1 + pad, y1 + pad),
+        "flown chain, top view (obstacles in the flight's height band)",
+        ("x (m)", "y (m)"),
+    );
+    for o in obstacles {
+        p.rect((o[0], o[1]), (o[2], o[3]), palette::OBSTACLE, 0.6);
+    }
+    let reference: Vec<(f64, f64)> = samples
+        .iter()
+        .map(|s| (s.head_ref[0] as f64, s.head_ref[1] as f64))
+        .collect();
+    p.polyline(&reference, palette::INK, stroke::HAIR, true);
+    for i in (1..flight.params.n()).rev() {
+        let trail: Vec<(f64, f64)> = samples.iter().map(|s| at(s, i)).collect();
+        p.polyline(&trail, TRAIL, stroke::HAIR, false);
+    }
+    let head: Vec<(f64, f64)> = samples.iter().map(|s| at(s, 0)).collect();
+    p.polyline(&head, palette::PATH, stroke::DATA, false);
+    let every = (flight.samples.len() / SNAPSHOTS).max(1);
+    let snapshots: Vec<&Sample> = flight
+        .samples
+        .iter()
+        .step_by(every)
+        .chain(flight.samples.last())
+        .collect();
+    // The chain on the way as a thin line with small dots, so a dozen snapshots
+    // of a long chain stay readable; at the start and the end, units at full size.
+    let last = snapshots.len().saturating_sub(1);
+    for (k, s) in snapshots.iter().enumerate() {
+        let body: Vec<(f64, f64)> = (0..s.units.len()).map(|i| at(s, i)).collect();
+        if k == 0 || k == last {
+            let colour = if k == 0 {
+                palette::START
+            } else {
+                palette::GOAL
+            };
+            p.chain(&body, ru, colour);
+        } else {
+            p.polyline(&body, palette::FOLLOW, stroke::THIN, false);
+            for (i, &q) in body.iter().enumerate() {
+                p.marker(q, if i == 0 { 3.5 } else { 2.5 }, palette::FOLLOW);
+            }
+        }
+    }
+    p.key(palette::PATH, "head, flown");
+    p.key(TRAIL, "other units, flown");
+    p.key(palette::INK, "head reference");
+    p.key(palette::START, "chain at start");
+    p.key(palette::FOLLOW, "on the way");
+    p.key(palette::GOAL, "at the end");
+    p.key(palette::OBSTACLE, "obstacle");
+    p
 }
