@@ -41,8 +41,6 @@ pub mod metric;
 #[cfg(test)]
 mod tests;
 
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 use std::time::{Duration, Instant};
 
 use aerial_chain_core::{ChainParams, Shape};
@@ -52,6 +50,7 @@ use serde_json::json;
 
 use crate::collision::CollisionContext;
 use crate::plan::{Plan, Timing};
+use crate::planner::graph::{Edge, EdgeState, LazyGraph, LazyOutcome};
 use crate::planner::Termination;
 use metric::{embed, embedding_dim, Neighbours};
 
@@ -199,27 +198,13 @@ pub enum PrmError {
     },
 }
 
-/// Lazy state of a directed edge.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum EdgeState {
-    Unchecked,
-    Free,
-    Blocked,
-}
-
-#[derive(Clone, Debug)]
-struct Adj {
-    to: u32,
-    cost: f64,
-    state: EdgeState,
-}
-
 /// The roadmap: vertices, their embeddings and neighbour lists.
 struct Graph {
     xi: Vec<[f64; 3]>,
     shapes: Vec<Shape>,
     index: Neighbours,
-    adj: Vec<Vec<Adj>>,
+    /// Directed: an edge's validity depends on its direction.
+    adj: LazyGraph,
     goal_samples: usize,
     tries: u64,
     capped: bool,
@@ -375,14 +360,11 @@ impl FullStatePrm {
                 v.sort_by_key(|x| x.0);
                 v.dedup_by_key(|x| x.0);
                 v.into_iter()
-                    .map(|(to, cost)| Adj {
-                        to,
-                        cost,
-                        state: EdgeState::Unchecked,
-                    })
+                    .map(|(to, cost)| Edge::new(to as usize, cost, EdgeState::Unknown))
                     .collect()
             })
             .collect();
+        let adj = LazyGraph::new(adj, false);
         self.graph = Some(Graph {
             xi,
             shapes,
@@ -445,7 +427,7 @@ impl FullStatePrm {
             sample_tries: graph.tries,
             build_capped: graph.capped,
             k: graph.k,
-            graph_edges: graph.adj.iter().map(Vec::len).sum::<usize>() / 2,
+            graph_edges: edge_count(&graph.adj),
             ..Default::default()
         };
         self.graph = Some(graph);
@@ -477,7 +459,7 @@ impl FullStatePrm {
                 sample_tries: g.tries,
                 build_capped: g.capped,
                 k: g.k,
-                graph_edges: g.adj.iter().map(Vec::len).sum::<usize>() / 2,
+                graph_edges: edge_count(&g.adj),
                 ..Default::default()
             },
         }
@@ -492,28 +474,6 @@ struct Query<'a> {
     stop: Termination,
     collision: Duration,
     stats: PrmStats,
-}
-
-/// Open-list entry, lowest `f` first, ties by vertex id.
-#[derive(PartialEq)]
-struct Open {
-    f: f64,
-    g: f64,
-    v: u32,
-}
-
-impl Eq for Open {}
-
-impl Ord for Open {
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.f.total_cmp(&self.f).then_with(|| o.v.cmp(&self.v))
-    }
-}
-
-impl PartialOrd for Open {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
 }
 
 impl Query<'_> {
@@ -539,20 +499,16 @@ impl Query<'_> {
         let mut e = Vec::new();
         embed(params, start, &start_shape, &mut e);
         let k = self.graph.k;
-        let out: Vec<Adj> = self
+        let out: Vec<Edge> = self
             .graph
             .index
             .nearest(&e, k)
             .into_iter()
-            .map(|(to, cost)| Adj {
-                to,
-                cost,
-                state: EdgeState::Unchecked,
-            })
+            .map(|(to, cost)| Edge::new(to as usize, cost, EdgeState::Unknown))
             .collect();
         self.graph.xi.push(start);
         self.graph.shapes.push(start_shape);
-        self.graph.adj.push(out);
+        self.graph.adj.push_vertex(out);
         let result = self.search(n, goal, tol).map(|path| {
             let mut steps = vec![first];
             for w in path.windows(2) {
@@ -575,140 +531,61 @@ impl Query<'_> {
         });
         self.graph.xi.truncate(n);
         self.graph.shapes.truncate(n);
-        self.graph.adj.truncate(n);
+        self.graph.adj.truncate(n, false);
         let (steps, path_edges) = result?;
         self.stats.path_edges = path_edges;
         self.stats.collision_s = self.collision.as_secs_f64();
         Ok((steps, self.stats))
     }
 
-    /// Lazy PRM: A* over the edges not known blocked, then check the path's edges
-    /// from the start; block the first bad one and search again.
+    /// Lazy PRM ([`LazyGraph::lazy_prm`]): A* over the edges not known blocked, then
+    /// check the path's edges from the start; block the first bad one and search again.
     fn search(&mut self, from: usize, goal: [f64; 3], tol: f64) -> Result<Vec<usize>, PrmError> {
-        let n = self.graph.xi.len();
-        let is_goal: Vec<bool> = self
-            .graph
+        let g = &*self.graph;
+        let n = g.xi.len();
+        let is_goal: Vec<bool> = g
             .xi
             .iter()
             .enumerate()
             .map(|(i, p)| i != from && dist3(*p, goal) <= tol)
             .collect();
         let sampled = n - 1;
-        loop {
-            if self
-                .stop
-                .time_limit
-                .is_some_and(|t| self.began.elapsed() > t)
-            {
-                return Err(PrmError::TimeLimit {
-                    iterations: self.stats.iterations,
-                });
+        let (ctx, stop, began) = (self.ctx, self.stop, self.began);
+        let (stats, collision) = (&mut self.stats, &mut self.collision);
+        // Moving along `a -> b`: change shape at `xi_a`, then translate.
+        let check = |a: usize, b: usize| {
+            let t = Instant::now();
+            let (xa, xb) = (g.xi[a], g.xi[b]);
+            let (sa, sb) = (g.shapes[a], g.shapes[b]);
+            let free = (sa == sb || ctx.check_shape_change(xa, &sa, &sb).is_ok())
+                && (xa == xb || ctx.check_translation(xa, xb, &sb).is_ok());
+            *collision += t.elapsed();
+            stats.edges_checked += 1;
+            if !free {
+                stats.edges_blocked += 1;
             }
-            self.stats.iterations += 1;
-            let Some(path) = self.astar(from, goal, tol, &is_goal) else {
-                return Err(PrmError::NoPath {
-                    vertices: sampled,
-                    iterations: self.stats.iterations,
-                });
-            };
-            let mut all_free = true;
-            for w in path.windows(2) {
-                if !self.edge_free(w[0], w[1]) {
-                    all_free = false;
-                    break;
-                }
-                if self
-                    .stop
-                    .time_limit
-                    .is_some_and(|t| self.began.elapsed() > t)
-                {
-                    return Err(PrmError::TimeLimit {
-                        iterations: self.stats.iterations,
-                    });
-                }
-            }
-            if all_free {
-                return Ok(path);
-            }
-        }
-    }
-
-    /// A* from `from` to any goal vertex over edges not known to be blocked.
-    fn astar(&self, from: usize, goal: [f64; 3], tol: f64, is_goal: &[bool]) -> Option<Vec<usize>> {
-        let g = &*self.graph;
-        let n = g.xi.len();
+            free
+        };
         let h = |v: usize| (dist3(g.xi[v], goal) - tol).max(0.0);
-        let mut best = vec![f64::INFINITY; n];
-        let mut parent = vec![u32::MAX; n];
-        let mut closed = vec![false; n];
-        let mut open = BinaryHeap::new();
-        best[from] = 0.0;
-        open.push(Open {
-            f: h(from),
-            g: 0.0,
-            v: from as u32,
-        });
-        while let Some(Open { g: gv, v, .. }) = open.pop() {
-            let v = v as usize;
-            if closed[v] {
-                continue;
-            }
-            closed[v] = true;
-            if is_goal[v] {
-                let mut path = vec![v];
-                while parent[path[path.len() - 1]] != u32::MAX {
-                    path.push(parent[path[path.len() - 1]] as usize);
-                }
-                path.reverse();
-                return Some(path);
-            }
-            for e in &g.adj[v] {
-                let u = e.to as usize;
-                if closed[u] || e.state == EdgeState::Blocked {
-                    continue;
-                }
-                let ng = gv + e.cost;
-                if ng < best[u] {
-                    best[u] = ng;
-                    parent[u] = v as u32;
-                    open.push(Open {
-                        f: ng + h(u),
-                        g: ng,
-                        v: u as u32,
-                    });
-                }
-            }
+        let stopped = || stop.time_limit.is_some_and(|t| began.elapsed() > t);
+        let (outcome, iterations) = g.adj.lazy_prm(from, &is_goal, h, check, stopped);
+        self.stats.iterations += iterations;
+        match outcome {
+            LazyOutcome::Found(path) => Ok(path),
+            LazyOutcome::NoPath => Err(PrmError::NoPath {
+                vertices: sampled,
+                iterations: self.stats.iterations,
+            }),
+            LazyOutcome::Stopped => Err(PrmError::TimeLimit {
+                iterations: self.stats.iterations,
+            }),
         }
-        None
     }
+}
 
-    /// Checks (once) the directed edge `a -> b`: change shape at `xi_a`, then translate.
-    fn edge_free(&mut self, a: usize, b: usize) -> bool {
-        let Some(slot) = self.graph.adj[a].iter().position(|e| e.to as usize == b) else {
-            return false;
-        };
-        match self.graph.adj[a][slot].state {
-            EdgeState::Free => return true,
-            EdgeState::Blocked => return false,
-            EdgeState::Unchecked => {}
-        }
-        let t = Instant::now();
-        let (xa, xb) = (self.graph.xi[a], self.graph.xi[b]);
-        let (sa, sb) = (self.graph.shapes[a], self.graph.shapes[b]);
-        let free = (sa == sb || self.ctx.check_shape_change(xa, &sa, &sb).is_ok())
-            && (xa == xb || self.ctx.check_translation(xa, xb, &sb).is_ok());
-        self.collision += t.elapsed();
-        self.stats.edges_checked += 1;
-        if !free {
-            self.stats.edges_blocked += 1;
-        }
-        self.graph.adj[a][slot].state = if free {
-            EdgeState::Free
-        } else {
-            EdgeState::Blocked
-        };
-        free
-    }
+/// Undirected edges of a roadmap whose edges are kept both ways.
+fn edge_count(g: &LazyGraph) -> usize {
+    (0..g.len()).map(|v| g.edges(v).len()).sum::<usize>() / 2
 }
 
 /// The plan file (`arc-plan/1`) for an answer of the full-state PRM.

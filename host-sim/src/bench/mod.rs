@@ -340,7 +340,7 @@ pub fn context(env: &Env, units: u8) -> Result<CollisionContext, String> {
     let params = ChainParams::new(units)
         .validate()
         .map_err(|e| format!("N = {units}: {e}"))?;
-    CollisionContext::new(env.field.clone(), params, DEFAULT_CLEARANCE)
+    CollisionContext::new(env.field.clone(), params, DEFAULT_CLEARANCE).map_err(|e| e.to_string())
 }
 
 /// The scenario's own query for `units`: its start, LI at its start yaw, its goal.

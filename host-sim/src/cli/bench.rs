@@ -484,7 +484,8 @@ fn run_prm(a: PrmArgs) -> CliResult {
     let grid = loaded.grid.clone();
     let source = loaded.source.clone();
     let (field, _) = loaded.into_field();
-    let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;
+    let ctx = CollisionContext::new(field, params, a.clearance)
+        .map_err(|e| CliError::input(e.to_string()))?;
     let settings = PrmSettings {
         vertices: a.vertices,
         k: a.k,

@@ -207,7 +207,8 @@ pub fn run(a: PlanArgs) -> CliResult {
     let (resolution, unknown_occ) = (loaded.grid.resolution(), loaded.grid.unknown_is_occupied());
     let source = loaded.source.clone();
     let (field, _) = loaded.into_field();
-    let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;
+    let ctx = CollisionContext::new(field, params, a.clearance)
+        .map_err(|e| CliError::input(e.to_string()))?;
     let settings = Settings {
         vertices: a.vertices,
         r_t: a.r_t,

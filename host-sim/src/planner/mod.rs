@@ -15,6 +15,7 @@
 
 pub mod candidates;
 pub mod follow;
+pub mod graph;
 pub mod lattice;
 pub mod motion;
 pub mod refine;
