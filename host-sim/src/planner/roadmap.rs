@@ -120,8 +120,7 @@ impl Roadmap {
             .map(|(i, mut near)| {
                 near.sort_unstable();
                 near.dedup();
-                let edge =
-                    |j: usize| Edge::new(j, dist(points[i], points[j]), EdgeState::Unknown);
+                let edge = |j: usize| Edge::new(j, dist(points[i], points[j]), EdgeState::Unknown);
                 near.into_iter().map(edge).collect()
             })
             .collect();
