@@ -384,19 +384,41 @@ pub fn path_to(parent: &[VertexId], v: VertexId) -> Vec<VertexId> {
     path
 }
 
-/// Open-list entry: vertex `v` reached from `via` at cost `g`; lowest `f` first,
-/// ties broken by vertex id, then by `via`, for determinism.
-#[derive(PartialEq)]
-struct Open {
-    f: f64,
-    g: f64,
-    v: VertexId,
-    via: VertexId,
+/// A path cost the open lists can order: compared by IEEE total order.
+pub trait Cost: Copy + PartialEq {
+    /// [`f64::total_cmp`] for the type.
+    fn total_cmp(&self, other: &Self) -> Ordering;
 }
 
-impl Eq for Open {}
+impl Cost for f64 {
+    fn total_cmp(&self, other: &Self) -> Ordering {
+        f64::total_cmp(self, other)
+    }
+}
 
-impl Ord for Open {
+impl Cost for f32 {
+    fn total_cmp(&self, other: &Self) -> Ordering {
+        f32::total_cmp(self, other)
+    }
+}
+
+/// Open-list entry: vertex `v` reached from `via` at cost `g`, ordered by `f`; lowest
+/// `f` first, ties broken by vertex id, then by `via`, for determinism.
+#[derive(PartialEq)]
+pub struct Open<C: Cost = f64> {
+    /// The key: cost so far plus the heuristic.
+    pub f: C,
+    /// Cost so far.
+    pub g: C,
+    /// The vertex reached.
+    pub v: VertexId,
+    /// The vertex it was reached from (`usize::MAX` for a source).
+    pub via: VertexId,
+}
+
+impl<C: Cost> Eq for Open<C> {}
+
+impl<C: Cost> Ord for Open<C> {
     fn cmp(&self, o: &Self) -> Ordering {
         o.f.total_cmp(&self.f)
             .then_with(|| o.v.cmp(&self.v))
@@ -404,7 +426,7 @@ impl Ord for Open {
     }
 }
 
-impl PartialOrd for Open {
+impl<C: Cost> PartialOrd for Open<C> {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
         Some(self.cmp(o))
     }
