@@ -1,3 +1,6 @@
+//! Tests of the full-state PRM: an easy query solved and verified, bad settings and
+//! queries refused, a too sparse roadmap failing cleanly, the time limit honoured.
+
 use std::sync::Arc;
 use std::time::Duration;
 

@@ -47,7 +47,7 @@ pub struct Stats {
     pub srs_uses: usize,
     /// Follow-the-leader shapes used (one per short step).
     pub follow_uses: usize,
-    /// Shape changes that refinement made smaller ([`refine`]).
+    /// Shape changes that refinement made smaller ([`super::refine`]).
     pub shrunk: usize,
     /// SRSConnect calls.
     pub srs_connects: usize,

@@ -6,7 +6,7 @@
 //! planner's check decides it [`EdgeState::Valid`] or [`EdgeState::Invalid`], and the
 //! verdict is kept for later searches and later queries on the same roadmap
 //! (multi-query). Where validity does not depend on the direction (the head's sphere
-//! on a segment), one check settles both directions ([`LazyGraph::symmetric`]).
+//! on a segment), one check settles both directions (a symmetric [`LazyGraph`]).
 //!
 //! The searches:
 //! - [`LazyGraph::lazy_astar`], Lazy Weighted A* (Cohen, Phillips, Likhachev 2014):
