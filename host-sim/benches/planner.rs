@@ -12,7 +12,7 @@ use std::time::Duration;
 use aerial_chain::baseline::{FullStatePrm, PrmSettings};
 use aerial_chain::collision::{CollisionContext, DEFAULT_CLEARANCE};
 use aerial_chain::map::distance::DistanceField;
-use aerial_chain::planner::{Planner, Settings, Termination};
+use aerial_chain::planner::{ArcPlanner, Planner, Query, Settings, Termination};
 use aerial_chain::problem::scenarios::{self, Scenario};
 use aerial_chain::tables::{ShapeTables, TableSettings};
 use aerial_chain_core::{ChainParams, Shape};
@@ -29,34 +29,35 @@ fn window(units: u8) -> (Scenario, CollisionContext, ShapeTables) {
     (sc, ctx, tables)
 }
 
-fn planner(ctx: &CollisionContext, tables: &ShapeTables) -> Planner {
-    Planner::new(ctx.clone(), tables.clone(), Settings::default()).expect("same chain")
+fn planner(ctx: &CollisionContext, tables: &ShapeTables) -> ArcPlanner {
+    ArcPlanner::new(ctx.clone(), tables.clone(), Settings::default()).expect("same chain")
 }
 
 fn roadmap_and_query(c: &mut Criterion) {
     let (sc, ctx, tables) = window(5);
     let mut g = c.benchmark_group("planner");
     g.sample_size(10).measurement_time(Duration::from_secs(5));
+    let shape = sc.start_shape(5).expect("N = 5");
+    let query = Query::new(sc.start, shape, sc.goal);
     g.bench_function("roadmap_build/window_1500", |b| {
         b.iter_batched(
             || planner(&ctx, &tables),
             |mut p| {
-                p.setup();
+                p.setup(&query, Termination::default());
                 p
             },
             BatchSize::LargeInput,
         )
     });
-    let shape = sc.start_shape(5).expect("N = 5");
     g.bench_function("solve/window_n5", |b| {
         b.iter_batched(
             || {
                 let mut p = planner(&ctx, &tables);
-                p.setup();
+                p.setup(&query, Termination::default());
                 p
             },
             |mut p| {
-                let r = p.solve(sc.start, shape, sc.goal, Termination::default());
+                let r = p.solve(&query, Termination::default());
                 black_box(r.is_ok())
             },
             BatchSize::LargeInput,
@@ -66,7 +67,7 @@ fn roadmap_and_query(c: &mut Criterion) {
         b.iter_batched(
             || FullStatePrm::new(ctx.clone(), PrmSettings::default()).expect("settings"),
             |mut p| {
-                p.setup(sc.goal, None);
+                p.setup(&query, Termination::default());
                 p
             },
             BatchSize::LargeInput,

@@ -1,11 +1,16 @@
+//! Tests of the full-state PRM: an easy query solved and verified, bad settings and
+//! queries refused, a too sparse roadmap failing cleanly, the time limit honoured.
+
 use std::sync::Arc;
 use std::time::Duration;
 
 use aerial_chain_core::{ChainParams, Shape};
 
+use super::search::dist3;
 use super::*;
 use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use crate::map::distance::DistanceField;
+use crate::planner::motion::to_plan;
 use crate::problem::scenarios;
 
 fn window_ctx(units: u8) -> (CollisionContext, scenarios::Scenario) {
@@ -37,7 +42,7 @@ fn easy(
     let stop = Termination {
         time_limit: Some(Duration::from_secs(60)),
     };
-    (prm.solve(start, shape, goal, stop), ctx, sc)
+    (prm.solve(&Query::new(start, shape, goal), stop), ctx, sc)
 }
 
 #[test]
@@ -110,11 +115,6 @@ fn bad_input_is_an_error_not_a_panic() {
         ..Default::default()
     };
     assert!(FullStatePrm::new(ctx.clone(), bad_k).is_err());
-    let bad_tol = PrmSettings {
-        goal_tol: f64::NAN,
-        ..Default::default()
-    };
-    assert!(FullStatePrm::new(ctx.clone(), bad_tol).is_err());
     let mut prm = FullStatePrm::new(
         ctx,
         PrmSettings {
@@ -126,23 +126,35 @@ fn bad_input_is_an_error_not_a_panic() {
     let stop = Termination::default();
     let yaw = sc.start_yaw as f32;
     // Another chain's shape.
-    let r = prm.solve(sc.start, Shape::line(5, yaw), sc.goal, stop);
+    let r = prm.solve(&Query::new(sc.start, Shape::line(5, yaw), sc.goal), stop);
     assert!(matches!(r, Err(PrmError::StartInvalid(_))));
     // Start inside the wall.
-    let r = prm.solve([4.1, 1.0, 1.5], Shape::line(3, yaw), sc.goal, stop);
+    let r = prm.solve(
+        &Query::new([4.1, 1.0, 1.5], Shape::line(3, yaw), sc.goal),
+        stop,
+    );
     assert!(matches!(r, Err(PrmError::StartInvalid(_))));
     // Goal outside the map, or not finite.
     let s = Shape::line(3, yaw);
     assert!(matches!(
-        prm.solve(sc.start, s, [100.0, 0.0, 0.0], stop),
+        prm.solve(&Query::new(sc.start, s, [100.0, 0.0, 0.0]), stop),
         Err(PrmError::GoalInvalid(_))
     ));
     assert!(matches!(
-        prm.solve(sc.start, s, [f64::NAN, 0.0, 0.0], stop),
+        prm.solve(&Query::new(sc.start, s, [f64::NAN, 0.0, 0.0]), stop),
+        Err(PrmError::GoalInvalid(_))
+    ));
+    // A goal tolerance that is not a number.
+    let bad_tol = Query {
+        goal_tol: f64::NAN,
+        ..Query::new(sc.start, s, sc.goal)
+    };
+    assert!(matches!(
+        prm.solve(&bad_tol, stop),
         Err(PrmError::GoalInvalid(_))
     ));
     // A start within the goal tolerance is solved by itself.
-    let sol = prm.solve(sc.start, s, sc.start, stop).unwrap();
+    let sol = prm.solve(&Query::new(sc.start, s, sc.start), stop).unwrap();
     assert_eq!(sol.steps.len(), 1);
 }
 
@@ -158,7 +170,10 @@ fn too_sparse_roadmap_fails_cleanly() {
     )
     .unwrap();
     let shape = sc.start_shape(5).unwrap();
-    let r = prm.solve(sc.start, shape, sc.goal, Termination::default());
+    let r = prm.solve(
+        &Query::new(sc.start, shape, sc.goal),
+        Termination::default(),
+    );
     assert!(matches!(r, Err(PrmError::NoPath { .. })), "{r:?}");
 }
 
@@ -179,7 +194,7 @@ fn time_limit_caps_build_and_query() {
         time_limit: Some(Duration::from_millis(100)),
     };
     let t = std::time::Instant::now();
-    let r = prm.solve(sc.start, shape, sc.goal, stop);
+    let r = prm.solve(&Query::new(sc.start, shape, sc.goal), stop);
     assert!(r.is_err());
     assert!(prm.roadmap_stats().build_capped);
     assert!(prm.roadmap_stats().vertices < 1_000_000);

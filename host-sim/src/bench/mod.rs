@@ -29,13 +29,15 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use aerial_chain_core::lsc::{library, LscKind};
-use aerial_chain_core::{ChainParams, Shape};
+use aerial_chain_core::ChainParams;
 use rayon::prelude::*;
 
-use crate::baseline::{self, FullStatePrm, PrmError, PrmSettings};
+use crate::baseline::{FullStatePrm, PrmError, PrmSettings};
 use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use crate::map::distance::DistanceField;
-use crate::planner::{motion, Mode, PlanError, Planner, Settings, Termination};
+use crate::planner::{
+    motion, ArcPlanner, Failure, Mode, Planner, Settings, Solution, SolutionStats, Termination,
+};
 use crate::problem::scenarios::{self, Scenario};
 use crate::tables::{ShapeTables, TableSettings};
 
@@ -103,16 +105,8 @@ impl Method {
     }
 }
 
-/// Start and goal of a query.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Query {
-    /// Head start position (m).
-    pub start: [f64; 3],
-    /// Start shape.
-    pub shape: Shape,
-    /// Head goal (m).
-    pub goal: [f64; 3],
-}
+/// Start and goal of a query (at the default goal tolerance).
+pub use crate::planner::Query;
 
 /// One benchmark run.
 #[derive(Clone, Debug, PartialEq)]
@@ -340,16 +334,16 @@ pub fn context(env: &Env, units: u8) -> Result<CollisionContext, String> {
     let params = ChainParams::new(units)
         .validate()
         .map_err(|e| format!("N = {units}: {e}"))?;
-    CollisionContext::new(env.field.clone(), params, DEFAULT_CLEARANCE)
+    CollisionContext::new(env.field.clone(), params, DEFAULT_CLEARANCE).map_err(|e| e.to_string())
 }
 
 /// The scenario's own query for `units`: its start, LI at its start yaw, its goal.
 pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, String> {
-    Ok(Query {
-        start: sc.start,
-        shape: sc.start_shape(units).map_err(|e| e.to_string())?,
-        goal: sc.goal,
-    })
+    Ok(Query::new(
+        sc.start,
+        sc.start_shape(units).map_err(|e| e.to_string())?,
+        sc.goal,
+    ))
 }
 
 /// A query for a chain that may not fit at the scenario's start as a straight line
@@ -397,11 +391,7 @@ pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, Str
                     .shape
                     .rotated(aerial_chain_core::angle::diff(e.shape.head_yaw(), yaw));
                 if ctx.check_config(p, &shape).is_ok() {
-                    return Ok(Query {
-                        start: p,
-                        shape,
-                        goal: sc.goal,
-                    });
+                    return Ok(Query::new(p, shape, sc.goal));
                 }
             }
         }
@@ -410,28 +400,6 @@ pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, Str
         "no library shape of N = {} fits within 1.5 m of {}'s start",
         params.units, sc.name
     ))
-}
-
-fn plan_error_outcome(e: &PlanError) -> &'static str {
-    match e {
-        PlanError::TimeLimit { .. } => "time_limit",
-        PlanError::NoShape { .. } => "no_shape",
-        PlanError::Unreachable { .. } => "unreachable",
-        PlanError::Separated { .. } => "separated",
-        PlanError::StartInvalid(_) => "start_invalid",
-        PlanError::GoalInvalid(_) => "goal_invalid",
-        PlanError::TablesMismatch { .. } => "error",
-    }
-}
-
-fn prm_error_outcome(e: &PrmError) -> &'static str {
-    match e {
-        PrmError::TimeLimit { .. } => "time_limit",
-        PrmError::NoPath { .. } => "no_path",
-        PrmError::StartInvalid(_) => "start_invalid",
-        PrmError::GoalInvalid(_) => "goal_invalid",
-        PrmError::BadSettings(_) => "error",
-    }
 }
 
 /// Runs one spec.
@@ -466,6 +434,43 @@ pub fn run_one(envs: &Envs, spec: &RunSpec) -> RunResult {
     }
 }
 
+/// Sets up and solves `q` with `planner` (the setup under `setup_stop`, the query
+/// under `stop`), timing both; a solution is written as a plan and verified. The
+/// result's planner-specific counters are left to the caller.
+fn run_planner<P: Planner>(
+    env: &Env,
+    spec: &RunSpec,
+    planner: &mut P,
+    q: &Query,
+    (setup_stop, stop): (Termination, Termination),
+) -> (RunResult, Result<Solution<P::Stats>, P::Error>) {
+    let params = *planner.context().params();
+    let ((), roadmap_s, roadmap_cpu_s) = timed(|| planner.setup(q, setup_stop));
+    let (res, planning_s, planning_cpu_s) = timed(|| planner.solve(q, stop));
+    let mut r = RunResult::failed(spec, "solved", String::new());
+    r.roadmap_s = roadmap_s;
+    r.planning_s = planning_s;
+    r.roadmap_cpu_s = roadmap_cpu_s;
+    r.planning_cpu_s = planning_cpu_s;
+    match &res {
+        Err(e) => {
+            r.outcome = e.outcome().into();
+            r.message = e.to_string();
+        }
+        Ok(sol) => {
+            let t = sol.stats.timing();
+            r.success = true;
+            r.collision_s = Some(t.collision_s);
+            r.search_s = Some((t.planning_s - t.collision_s).max(0.0));
+            let g = &env.scenario.grid;
+            let plan = motion::to_plan(sol, &params, g.resolution(), g.unknown_is_occupied());
+            r.waypoints = Some(plan.waypoints.len());
+            r.verified = Some(verify_plan(g, &plan).ok);
+        }
+    }
+    (r, res)
+}
+
 fn run_arc(
     env: &Env,
     ctx: CollisionContext,
@@ -497,40 +502,24 @@ fn run_arc(
         seed: spec.seed,
         ..Default::default()
     };
-    let mut planner = match Planner::new(ctx, tables, settings) {
+    let mut planner = match ArcPlanner::new(ctx, tables, settings) {
         Ok(p) => p,
         Err(e) => return RunResult::failed(spec, "error", e.to_string()),
     };
-    let ((), roadmap_s, roadmap_cpu_s) = timed(|| planner.setup());
-    let (res, planning_s, planning_cpu_s) = timed(|| planner.solve(q.start, q.shape, q.goal, stop));
-    let mut r = RunResult::failed(spec, "solved", String::new());
+    // The head roadmap is built without a time limit: it is shared by queries, and the
+    // limit is the query's (the PRM's roadmap is per goal, so its build is capped).
+    let stops = (Termination::default(), stop);
+    let (mut r, res) = run_planner(env, spec, &mut planner, &q, stops);
     r.tables_s = tables_s;
-    r.roadmap_s = roadmap_s;
-    r.planning_s = planning_s;
-    r.roadmap_cpu_s = roadmap_cpu_s;
-    r.planning_cpu_s = planning_cpu_s;
     r.roadmap_vertices = spec.vertices;
-    match res {
-        Err(e) => {
-            r.outcome = plan_error_outcome(&e).into();
-            r.message = e.to_string();
-        }
-        Ok(sol) => {
-            let s = &sol.stats;
-            r.success = true;
-            r.roadmap_vertices = s.roadmap_vertices;
-            r.collision_s = Some(s.collision_s);
-            r.search_s = Some((s.planning_s - s.collision_s).max(0.0));
-            r.shape_changes = Some(s.shape_changes);
-            r.edges = Some(s.edges);
-            r.replans = Some(s.replans);
-            r.srs_connects = Some(s.srs_connects);
-            r.collision_checks = Some(s.collision_checks);
-            let g = &env.scenario.grid;
-            let plan = motion::to_plan(&sol, &params, g.resolution(), g.unknown_is_occupied());
-            r.waypoints = Some(plan.waypoints.len());
-            r.verified = Some(verify_plan(g, &plan).ok);
-        }
+    if let Ok(sol) = res {
+        let s = &sol.stats;
+        r.roadmap_vertices = s.roadmap_vertices;
+        r.shape_changes = Some(s.shape_changes);
+        r.edges = Some(s.edges);
+        r.replans = Some(s.replans);
+        r.srs_connects = Some(s.srs_connects);
+        r.collision_checks = Some(s.collision_checks);
     }
     r
 }
@@ -542,7 +531,6 @@ fn run_prm(
     q: Query,
     stop: Termination,
 ) -> RunResult {
-    let params = *ctx.params();
     let settings = PrmSettings {
         vertices: spec.vertices,
         seed: spec.seed,
@@ -552,37 +540,21 @@ fn run_prm(
         Ok(p) => p,
         Err(e) => return RunResult::failed(spec, "error", e.to_string()),
     };
-    let ((), roadmap_s, roadmap_cpu_s) = timed(|| prm.setup(q.goal, stop.time_limit));
-    let (res, planning_s, planning_cpu_s) = timed(|| prm.solve(q.start, q.shape, q.goal, stop));
+    let (mut r, res) = run_planner(env, spec, &mut prm, &q, (stop, stop));
     let rs = prm.roadmap_stats();
-    let mut r = RunResult::failed(spec, "solved", String::new());
-    r.roadmap_s = roadmap_s;
-    r.planning_s = planning_s;
-    r.roadmap_cpu_s = roadmap_cpu_s;
-    r.planning_cpu_s = planning_cpu_s;
     r.roadmap_vertices = rs.vertices;
     r.build_capped = rs.build_capped;
     match res {
-        Err(e) => {
-            r.outcome = prm_error_outcome(&e).into();
-            r.message = e.to_string();
-            if let PrmError::NoPath { iterations, .. } | PrmError::TimeLimit { iterations } = e {
-                r.iterations = Some(iterations);
-            }
+        Err(PrmError::NoPath { iterations, .. } | PrmError::TimeLimit { iterations }) => {
+            r.iterations = Some(iterations);
         }
+        Err(_) => {}
         Ok(sol) => {
             let s = &sol.stats;
-            r.success = true;
-            r.collision_s = Some(s.collision_s);
-            r.search_s = Some((s.planning_s - s.collision_s).max(0.0));
             r.shape_changes = Some(s.shape_changes);
             r.edges = Some(s.path_edges);
             r.iterations = Some(s.iterations);
             r.collision_checks = Some(s.collision_checks);
-            let g = &env.scenario.grid;
-            let plan = baseline::to_plan(&sol, &params, g.resolution(), g.unknown_is_occupied());
-            r.waypoints = Some(plan.waypoints.len());
-            r.verified = Some(verify_plan(g, &plan).ok);
         }
     }
     r
@@ -1042,7 +1014,7 @@ mod tests {
         for n in [3u8, 12, 16] {
             let ctx = context(&env, n).unwrap();
             let q = fitting_query(&env.scenario, &ctx).unwrap();
-            assert!(ctx.check_config(q.start, &q.shape).is_ok());
+            assert!(ctx.check_config(q.start, &q.start_shape).is_ok());
         }
         // A short chain keeps the scenario's own start.
         let ctx = context(&env, 4).unwrap();

@@ -112,8 +112,9 @@ pub fn specs(o: &ScaleOptions) -> Result<(Vec<RunSpec>, Vec<StartChoice>), Strin
             .entries
             .iter()
             .find(|e| {
-                let d = aerial_chain_core::angle::diff(e.shape.head_yaw(), q.shape.head_yaw());
-                e.shape.rotated(d).max_angle_diff(&q.shape) < 1e-5
+                let d =
+                    aerial_chain_core::angle::diff(e.shape.head_yaw(), q.start_shape.head_yaw());
+                e.shape.rotated(d).max_angle_diff(&q.start_shape) < 1e-5
             })
             .map_or("?", |e| e.kind.name());
         starts.push((n, q, name.to_string()));
@@ -194,7 +195,7 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
             st.map_or("-".into(), |x| format!(
                 "{}, {:.0}",
                 x.2,
-                (x.1.shape.head_yaw() as f64).to_degrees()
+                (x.1.start_shape.head_yaw() as f64).to_degrees()
             )),
             g.outcome_cells(),
             g.time_limited

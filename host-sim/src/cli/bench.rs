@@ -6,12 +6,12 @@ use std::time::{Duration, Instant};
 use clap::{Args, Subcommand};
 
 use super::checks;
-use super::common::{ChainArgs, MapArgs, Query, QueryArgs, Report};
+use super::common::{ChainArgs, MapArgs, QueryArgs, Report};
 use super::{CliError, CliResult};
-use crate::baseline::{self, FullStatePrm, PrmError, PrmSettings};
+use crate::baseline::{FullStatePrm, PrmError, PrmSettings};
 use crate::bench::{self, paper, robust, scale};
 use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
-use crate::planner::Termination;
+use crate::planner::{motion, Planner, Termination};
 
 /// `arc bench ...`
 #[derive(Subcommand, Debug)]
@@ -475,26 +475,23 @@ fn run_robust(a: RobustArgs) -> CliResult {
 fn run_prm(a: PrmArgs) -> CliResult {
     let time_limit = check_prm(&a)?;
     let loaded = a.map.load()?;
-    let Query {
-        params,
-        start,
-        shape,
-        goal,
-    } = a.query.resolve(&a.chain, loaded.scenario.as_ref())?;
+    let (params, query) = a
+        .query
+        .resolve(&a.chain, loaded.scenario.as_ref(), a.goal_tol)?;
     let grid = loaded.grid.clone();
     let source = loaded.source.clone();
     let (field, _) = loaded.into_field();
-    let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;
+    let ctx = CollisionContext::new(field, params, a.clearance)
+        .map_err(|e| CliError::input(e.to_string()))?;
     let settings = PrmSettings {
         vertices: a.vertices,
         k: a.k,
         goal_samples: a.goal_samples,
         seed: a.seed,
-        goal_tol: a.goal_tol,
     };
     let mut prm = FullStatePrm::new(ctx, settings).map_err(|e| CliError::input(e.to_string()))?;
     let stop = Termination { time_limit };
-    let sol = prm.solve(start, shape, goal, stop).map_err(|e| match e {
+    let sol = prm.solve(&query, stop).map_err(|e| match e {
         PrmError::BadSettings(_) | PrmError::StartInvalid(_) | PrmError::GoalInvalid(_) => {
             CliError::input(e.to_string())
         }
@@ -513,7 +510,7 @@ fn run_prm(a: PrmArgs) -> CliResult {
             ))
         }
     })?;
-    let mut plan = baseline::to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
+    let mut plan = motion::to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
     plan.map.source = source;
     let report = verify_plan(&grid, &plan);
     plan.write(&a.out)

@@ -13,6 +13,7 @@ use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 use crate::map::octomap::OcTree;
 use crate::plan::MapSource;
+use crate::planner::Query;
 use crate::problem::scenarios::{self, Scenario};
 
 /// Chain geometry options shared by every command that makes a chain.
@@ -229,21 +230,15 @@ pub struct QueryArgs {
     pub goal: Option<[f64; 3]>,
 }
 
-/// A resolved query: the chain, the start configuration and the goal.
-pub struct Query {
-    /// The chain (validated).
-    pub params: ChainParams,
-    /// Head start position (m).
-    pub start: [f64; 3],
-    /// Start shape.
-    pub shape: Shape,
-    /// Head goal position (m).
-    pub goal: [f64; 3],
-}
-
 impl QueryArgs {
-    /// The query, with the scenario's chain size, start, yaw and goal where not given.
-    pub fn resolve(&self, chain: &ChainArgs, sc: Option<&Scenario>) -> Result<Query, CliError> {
+    /// The chain (validated) and the query to within `goal_tol` of the goal, with the
+    /// scenario's chain size, start, yaw and goal where not given.
+    pub fn resolve(
+        &self,
+        chain: &ChainArgs,
+        sc: Option<&Scenario>,
+        goal_tol: f64,
+    ) -> Result<(ChainParams, Query), CliError> {
         let units = chain
             .units
             .or(sc.map(|s| s.default_units))
@@ -273,12 +268,13 @@ impl QueryArgs {
             .or(sc.map(|s| s.start_yaw))
             .unwrap_or(0.0);
         let shape = start_shape(&params, &self.start_shape, yaw as f32)?;
-        Ok(Query {
-            params,
+        let query = Query {
             start,
-            shape,
+            start_shape: shape,
             goal,
-        })
+            goal_tol,
+        };
+        Ok((params, query))
     }
 }
 

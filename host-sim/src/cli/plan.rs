@@ -8,11 +8,13 @@ use aerial_chain_core::ChainParams;
 use clap::Args;
 
 use super::checks;
-use super::common::{ChainArgs, MapArgs, Query, QueryArgs, Report};
+use super::common::{ChainArgs, MapArgs, QueryArgs, Report};
 use super::{CliError, CliResult};
 use crate::collision::{CollisionContext, DEFAULT_CLEARANCE};
 use crate::planner::refine::{Quality, Refinement};
-use crate::planner::{motion, Mode, PlanError, Planner, Preference, Settings, Termination};
+use crate::planner::{
+    motion, ArcPlanner, Mode, PlanError, Planner, Preference, Settings, Termination,
+};
 use crate::tables::{ShapeTables, TableSettings};
 
 /// `arc plan`
@@ -197,17 +199,15 @@ pub fn run(a: PlanArgs) -> CliResult {
     // covers what follows it (docs/promises.md).
     let setup = Instant::now();
     let loaded = a.map.load()?;
-    let Query {
-        params,
-        start,
-        shape,
-        goal,
-    } = a.query.resolve(&a.chain, loaded.scenario.as_ref())?;
+    let (params, query) = a
+        .query
+        .resolve(&a.chain, loaded.scenario.as_ref(), a.goal_tol)?;
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
     let (resolution, unknown_occ) = (loaded.grid.resolution(), loaded.grid.unknown_is_occupied());
     let source = loaded.source.clone();
     let (field, _) = loaded.into_field();
-    let ctx = CollisionContext::new(field, params, a.clearance).map_err(CliError::input)?;
+    let ctx = CollisionContext::new(field, params, a.clearance)
+        .map_err(|e| CliError::input(e.to_string()))?;
     let settings = Settings {
         vertices: a.vertices,
         r_t: a.r_t,
@@ -220,31 +220,28 @@ pub fn run(a: PlanArgs) -> CliResult {
         max_replans: a.max_replans,
         max_growth: a.max_growth,
         clearance_weight: a.clearance_weight,
-        goal_tol: a.goal_tol,
         follow_step: a.follow_step,
         clearance_min: a.clearance_min,
         head_lattice: a.head_lattice,
     };
     let mut planner =
-        Planner::new(ctx, tables, settings).map_err(|e| CliError::input(e.to_string()))?;
+        ArcPlanner::new(ctx, tables, settings).map_err(|e| CliError::input(e.to_string()))?;
     let setup_s = setup.elapsed().as_secs_f64();
     let stop = Termination {
         time_limit: checks::time_limit(a.time_limit)?,
     };
     let began = Instant::now();
-    let solution = planner
-        .solve(start, shape, goal, stop)
-        .map_err(|e| match e {
-            // The query itself is unusable: bad input, as in `arc bench prm`.
-            PlanError::TablesMismatch { .. }
-            | PlanError::StartInvalid(_)
-            | PlanError::GoalInvalid(_) => CliError::input(e.to_string()),
-            _ => CliError::failed(format!(
-                "no plan: {e} (after {:.1} ms of planning; setup {:.1} ms)",
-                began.elapsed().as_secs_f64() * 1e3,
-                setup_s * 1e3
-            )),
-        })?;
+    let solution = planner.solve(&query, stop).map_err(|e| match e {
+        // The query itself is unusable: bad input, as in `arc bench prm`.
+        PlanError::TablesMismatch { .. }
+        | PlanError::StartInvalid(_)
+        | PlanError::GoalInvalid(_) => CliError::input(e.to_string()),
+        _ => CliError::failed(format!(
+            "no plan: {e} (after {:.1} ms of planning; setup {:.1} ms)",
+            began.elapsed().as_secs_f64() * 1e3,
+            setup_s * 1e3
+        )),
+    })?;
     let (solution, refinement) = if a.no_smooth {
         (solution, None)
     } else {
@@ -305,7 +302,7 @@ pub fn run(a: PlanArgs) -> CliResult {
             grid,
             &plan,
             &format!("ARCplanner on {}", a.map.name()),
-            Some(goal),
+            Some(query.goal),
         )
         .save(pic)
         .map_err(|e| CliError::input(e.to_string()))?;

@@ -206,6 +206,17 @@ fn finite3(a: [f64; 3]) -> bool {
     a.iter().all(|v| v.is_finite())
 }
 
+/// Why a collision context cannot be made.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ContextError {
+    /// The chain's parameters are out of range.
+    #[error("chain: {0}")]
+    Chain(aerial_chain_core::ParamError),
+    /// The clearance is negative or not a number.
+    #[error("clearance {0} must be a finite number >= 0")]
+    Clearance(f64),
+}
+
 impl CollisionContext {
     /// A context for chain `params` (validated here) on `field`, growing every radius by
     /// `clearance` (m, finite and `>= 0`).
@@ -213,12 +224,10 @@ impl CollisionContext {
         field: Arc<DistanceField>,
         params: ChainParams,
         clearance: f64,
-    ) -> Result<Self, String> {
-        let params = params.validate().map_err(|e| format!("chain: {e}"))?;
+    ) -> Result<Self, ContextError> {
+        let params = params.validate().map_err(ContextError::Chain)?;
         if !(clearance.is_finite() && clearance >= 0.0) {
-            return Err(format!(
-                "clearance {clearance} must be a finite number >= 0"
-            ));
+            return Err(ContextError::Clearance(clearance));
         }
         let min_step = field.grid().resolution() / 64.0;
         Ok(Self {

@@ -25,6 +25,8 @@ pub enum Source {
     /// Part of the way to a shape the search chose, where refinement found that
     /// enough ([`super::refine`]).
     Shrunk,
+    /// A configuration of the full-state PRM's roadmap ([`crate::baseline`]).
+    Sampled,
 }
 
 /// A shape with its origin.

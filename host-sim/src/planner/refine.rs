@@ -28,7 +28,7 @@ use aerial_chain_core::cost::transition_cost;
 use aerial_chain_core::Shape;
 
 use super::candidates::Source;
-use super::{Checker, Planner, Solution, Step};
+use super::{ArcPlanner, Checker, Solution, Stats, Step};
 
 /// Collision checks refinement may spend on one plan. At a few microseconds each
 /// this bounds the pass to tens of milliseconds; what is left unrefined when it
@@ -95,26 +95,26 @@ fn differs(a: &Shape, b: &Shape) -> bool {
     a.max_angle_diff(b) > SAME_SHAPE
 }
 
-impl Planner {
+impl ArcPlanner {
     /// Refines a solved query's plan (see the module docs). The result starts and
     /// ends where the solution does and passes the same checks. Past `deadline` (the
     /// query's time limit) refinement stops and keeps what it has; only then can two
     /// runs differ.
-    pub fn refine(&self, solution: &Solution, deadline: Option<Instant>) -> (Solution, Refinement) {
+    pub fn refine(
+        &self,
+        solution: &Solution<Stats>,
+        deadline: Option<Instant>,
+    ) -> (Solution<Stats>, Refinement) {
         let began = Instant::now();
         let mut pass = Pass {
-            checker: Checker {
-                ctx: self.ctx.clone(),
-                time: std::time::Duration::ZERO,
-                deadline,
-            },
+            checker: Checker::new(self.ctx.clone(), deadline),
             poses: &solution.steps,
             checks: 0,
         };
         let steps = pass.run();
         let steps = pass.shrink_changes(steps);
         let mut stats = solution.stats.clone();
-        super::count_sources(&steps, &mut stats);
+        super::construction::count_sources(&steps, &mut stats);
         let report = Refinement {
             before: Quality::of(&solution.steps),
             after: Quality::of(&steps),

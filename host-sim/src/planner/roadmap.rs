@@ -8,9 +8,6 @@
 //! and searches again (lazy PRM). Checked edges stay checked, so later queries on
 //! the same roadmap get cheaper (multi-query).
 
-use std::cell::Cell;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 use std::time::Instant;
 
 use kiddo::ImmutableKdTree;
@@ -18,25 +15,11 @@ use kiddo::SquaredEuclidean;
 use rand::Rng;
 use rand_pcg::Pcg64;
 
+use super::graph::{Edge, EdgeState, LazyGraph};
 use crate::collision::CollisionContext;
 
 /// Vertex index in the roadmap; queries add the start and goal after the sampled ones.
-pub type VertexId = usize;
-
-/// Lazy state of one edge.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum EdgeState {
-    Unchecked,
-    Free,
-    Blocked,
-}
-
-#[derive(Clone, Debug)]
-struct Edge {
-    to: VertexId,
-    length: f64,
-    state: Cell<EdgeState>,
-}
+pub use super::graph::VertexId;
 
 /// The head roadmap `G_T`.
 #[derive(Debug)]
@@ -48,7 +31,9 @@ pub struct Roadmap {
     clearance_weight: f64,
     /// Clearance at which the weight factor vanishes (m).
     clearance_ref: f64,
-    edges: Vec<Vec<Edge>>,
+    /// Edges weigh their length, grown near obstacles; the head's check is the same
+    /// both ways, so the graph is symmetric.
+    graph: LazyGraph,
     tree: ImmutableKdTree<f64, 3>,
     r_t: f64,
     sampled: usize,
@@ -135,11 +120,7 @@ impl Roadmap {
             .map(|(i, mut near)| {
                 near.sort_unstable();
                 near.dedup();
-                let edge = |j: usize| Edge {
-                    to: j,
-                    length: dist(points[i], points[j]),
-                    state: Cell::new(EdgeState::Unchecked),
-                };
+                let edge = |j: usize| Edge::new(j, dist(points[i], points[j]), EdgeState::Unknown);
                 near.into_iter().map(edge).collect()
             })
             .collect();
@@ -150,7 +131,7 @@ impl Roadmap {
             clearance,
             clearance_weight,
             clearance_ref,
-            edges,
+            graph: LazyGraph::new(edges, true),
             tree,
             r_t,
             sampled,
@@ -164,10 +145,10 @@ impl Roadmap {
     fn weigh_edges(&mut self, from: VertexId) {
         let (w, r) = (self.clearance_weight, self.clearance_ref.max(1e-9));
         for v in from..self.points.len() {
-            for e in self.edges[v].iter_mut() {
-                let c = self.clearance[v].min(self.clearance[e.to]);
-                e.length =
-                    dist(self.points[v], self.points[e.to]) * (1.0 + w * (1.0 - c / r).max(0.0));
+            let (points, clearance) = (&self.points, &self.clearance);
+            for e in self.graph.edges_mut(v) {
+                let c = clearance[v].min(clearance[e.to]);
+                e.cost = dist(points[v], points[e.to]) * (1.0 + w * (1.0 - c / r).max(0.0));
             }
         }
     }
@@ -184,10 +165,8 @@ impl Roadmap {
 
     /// Number of (undirected) candidate edges between sampled vertices.
     pub fn edge_count(&self) -> usize {
-        self.edges
-            .iter()
-            .take(self.sampled)
-            .map(Vec::len)
+        (0..self.sampled)
+            .map(|v| self.graph.edges(v).len())
             .sum::<usize>()
             / 2
     }
@@ -202,13 +181,13 @@ impl Roadmap {
     pub fn add_query_vertex(&mut self, p: [f64; 3]) -> VertexId {
         let id = self.push_vertex(p, f64::INFINITY);
         for (j, length) in self.sampled_within_r_t(p) {
-            self.link(id, j, length, EdgeState::Unchecked);
+            self.link(id, j, length, EdgeState::Unknown);
         }
         // Query vertices see each other too (a start next to the goal).
         for q in self.sampled..id {
             let length = dist(self.points[q], p);
             if length <= self.r_t {
-                self.link(id, q, length, EdgeState::Unchecked);
+                self.link(id, q, length, EdgeState::Unknown);
             }
         }
         id
@@ -219,7 +198,7 @@ impl Roadmap {
         let id = self.points.len();
         self.points.push(p);
         self.clearance.push(c);
-        self.edges.push(Vec::new());
+        self.graph.push_vertex(Vec::new());
         id
     }
 
@@ -237,11 +216,7 @@ impl Roadmap {
     /// Joins `a` and `b` both ways by an edge of `length` in `state`.
     fn link(&mut self, a: VertexId, b: VertexId, length: f64, state: EdgeState) {
         for (x, y) in [(a, b), (b, a)] {
-            self.edges[x].push(Edge {
-                to: y,
-                length,
-                state: Cell::new(state),
-            });
+            self.graph.push_edge(x, y, length, state);
         }
     }
 
@@ -267,7 +242,7 @@ impl Roadmap {
             for (j, d) in self.sampled_within_r_t(p) {
                 let cj = c.min(self.clearance[j]);
                 let length = d * (1.0 + w * (1.0 - cj / r).max(0.0));
-                self.link(id, j, length, EdgeState::Unchecked);
+                self.link(id, j, length, EdgeState::Unknown);
             }
             ids.push(id);
         }
@@ -276,17 +251,7 @@ impl Roadmap {
             let (a, b) = (wnd[0], wnd[1]);
             let length = dist(self.points[a], self.points[b]);
             for (x, y) in [(a, b), (b, a)] {
-                match self.edges[x].iter_mut().find(|e| e.to == y) {
-                    Some(e) => {
-                        e.length = length;
-                        e.state.set(EdgeState::Free);
-                    }
-                    None => self.edges[x].push(Edge {
-                        to: y,
-                        length,
-                        state: Cell::new(EdgeState::Free),
-                    }),
-                }
+                self.graph.set_edge(x, y, length, EdgeState::Valid);
             }
         }
         ids
@@ -302,70 +267,22 @@ impl Roadmap {
     pub fn clear_query(&mut self) {
         self.points.truncate(self.sampled);
         self.clearance.truncate(self.sampled);
-        self.edges.truncate(self.sampled);
-        let n = self.sampled;
-        for e in self.edges.iter_mut() {
-            e.retain(|x| x.to < n);
-        }
-    }
-
-    fn edge(&self, a: VertexId, b: VertexId) -> Option<&Edge> {
-        self.edges[a].iter().find(|e| e.to == b)
-    }
-
-    fn set_state(&self, a: VertexId, b: VertexId, s: EdgeState) {
-        for (x, y) in [(a, b), (b, a)] {
-            if let Some(e) = self.edge(x, y) {
-                e.state.set(s);
-            }
-        }
+        self.graph.truncate(self.sampled, true);
     }
 
     /// The cost to reach the nearest of `goals` from every vertex over the edges not
-    /// known to be blocked (reverse Dijkstra; the graph is symmetric); infinite where
-    /// no goal can be reached. Blocking or banning edges only raises true costs, so
-    /// this stays a consistent A* heuristic for the rest of the query.
+    /// known to be blocked ([`LazyGraph::cost_to_go`]; the graph is symmetric).
     pub fn cost_to_go(&self, goals: &[VertexId]) -> Vec<f64> {
-        let mut cost = vec![f64::INFINITY; self.points.len()];
-        let mut open = BinaryHeap::new();
-        for &q in goals {
-            cost[q] = 0.0;
-            open.push(Open {
-                f: 0.0,
-                g: 0.0,
-                v: q,
-                via: usize::MAX,
-            });
-        }
-        while let Some(Open { g, v, .. }) = open.pop() {
-            if g > cost[v] {
-                continue;
-            }
-            for e in &self.edges[v] {
-                let ng = g + e.length;
-                if e.state.get() != EdgeState::Blocked && ng < cost[e.to] {
-                    cost[e.to] = ng;
-                    open.push(Open {
-                        f: ng,
-                        g: ng,
-                        v: e.to,
-                        via: v,
-                    });
-                }
-            }
-        }
-        cost
+        self.graph.cost_to_go(goals)
     }
 
     /// The shortest head path from `from` to any vertex of `goals`, every edge on it
     /// checked for the head's sphere. `banned` edges are skipped; `h` is the
     /// heuristic, from [`Self::cost_to_go`] for these goals.
     ///
-    /// Lazy Weighted A* (Cohen, Phillips, Likhachev 2014): a vertex enters the open
-    /// list with the edge that reached it unchecked; the edge is checked only when
-    /// that entry is popped. So one search returns a checked path, and only edges
-    /// leading to expanded vertices are ever checked. With the exact cost-to-go as
-    /// the heuristic, a search expands little more than the path it returns.
+    /// Lazy Weighted A* ([`LazyGraph::lazy_astar`]): only edges leading to expanded
+    /// vertices are ever checked. With the exact cost-to-go as the heuristic, a search
+    /// expands little more than the path it returns.
     pub fn route(
         &self,
         ctx: &CollisionContext,
@@ -374,113 +291,19 @@ impl Roadmap {
         h: &[f64],
         banned: &dyn Fn(VertexId, VertexId) -> bool,
     ) -> Result<Vec<VertexId>, RouteError> {
-        if self.edges[from].is_empty() {
+        if self.graph.edges(from).is_empty() {
             return Err(RouteError::StartIsolated);
         }
-        let n = self.points.len();
-        let mut closed = vec![false; n];
-        let mut parent = vec![usize::MAX; n];
-        // Best cost at which a vertex is queued through an edge known to be free:
-        // a costlier entry can never be needed (an unchecked edge may still fail, so
-        // entries through those are always queued).
-        let mut best_free = vec![f64::INFINITY; n];
-        let mut is_goal = vec![false; n];
+        let mut is_goal = vec![false; self.points.len()];
         for &q in goals {
             is_goal[q] = true;
         }
-        let mut open = BinaryHeap::new();
-        open.push(Open {
-            f: h[from],
-            g: 0.0,
-            v: from,
-            via: usize::MAX,
-        });
-        while let Some(Open { g, v, via, .. }) = open.pop() {
-            if closed[v] {
-                continue;
-            }
-            if via != usize::MAX && !self.edge_free(ctx, via, v) {
-                continue;
-            }
-            closed[v] = true;
-            parent[v] = via;
-            if is_goal[v] {
-                let mut path = vec![v];
-                while parent[path[path.len() - 1]] != usize::MAX {
-                    path.push(parent[path[path.len() - 1]]);
-                }
-                path.reverse();
-                return Ok(path);
-            }
-            for e in &self.edges[v] {
-                let state = e.state.get();
-                if closed[e.to] || state == EdgeState::Blocked || !h[e.to].is_finite() {
-                    continue;
-                }
-                let ng = g + e.length;
-                if ng >= best_free[e.to] || banned(v, e.to) {
-                    continue;
-                }
-                if state == EdgeState::Free {
-                    best_free[e.to] = ng;
-                }
-                open.push(Open {
-                    f: ng + h[e.to],
-                    g: ng,
-                    v: e.to,
-                    via: v,
-                });
-            }
-        }
-        Err(RouteError::Unreachable)
-    }
-
-    /// Checks (once) whether the head's sphere can fly the edge `a b`.
-    fn edge_free(&self, ctx: &CollisionContext, a: VertexId, b: VertexId) -> bool {
-        let e = self.edge(a, b).expect("search follows edges");
-        match e.state.get() {
-            EdgeState::Free => true,
-            EdgeState::Blocked => false,
-            EdgeState::Unchecked => {
-                let free = ctx.is_head_segment_free(self.points[a], self.points[b]);
-                self.set_state(
-                    a,
-                    b,
-                    if free {
-                        EdgeState::Free
-                    } else {
-                        EdgeState::Blocked
-                    },
-                );
-                free
-            }
-        }
-    }
-}
-
-/// Open-list entry: vertex `v` reached from `via` at cost `g`; lowest `f` first,
-/// ties broken by vertex id for determinism.
-#[derive(PartialEq)]
-struct Open {
-    f: f64,
-    g: f64,
-    v: VertexId,
-    via: VertexId,
-}
-
-impl Eq for Open {}
-
-impl Ord for Open {
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.f.total_cmp(&self.f)
-            .then_with(|| o.v.cmp(&self.v))
-            .then_with(|| o.via.cmp(&self.via))
-    }
-}
-
-impl PartialOrd for Open {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
+        let points = &self.points;
+        self.graph
+            .lazy_astar(from, &is_goal, h, banned, |a, b| {
+                ctx.is_head_segment_free(points[a], points[b])
+            })
+            .ok_or(RouteError::Unreachable)
     }
 }
 
@@ -506,7 +329,7 @@ mod tests {
 
     fn cost(map: &Roadmap, path: &[VertexId]) -> f64 {
         path.windows(2)
-            .map(|w| map.edge(w[0], w[1]).expect("path follows edges").length)
+            .map(|w| map.graph.edge(w[0], w[1]).expect("path follows edges").cost)
             .sum()
     }
 

@@ -19,12 +19,12 @@
 //!    change is checked when the search pops the shape it leads to, so no edge is
 //!    checked twice and no search is repeated.
 
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use aerial_chain_core::cost::transition_cost;
 
 use super::candidates::{Candidate, Source};
+use super::graph::{path_to, Open};
 use super::Checker;
 
 /// Lazy answers to "is shape `v` valid at `xi_i`" and "is it admissible along the
@@ -186,12 +186,13 @@ fn cheapest(graph: &mut Graph<'_>, oracle: &mut Oracle<'_>) -> Option<Vec<usize>
     let mut parent = vec![usize::MAX; n];
     let mut done = vec![false; n];
     let mut open = BinaryHeap::new();
-    open.push(Entry {
-        d: 0.0,
+    open.push(Open::<f32> {
+        f: 0.0,
+        g: 0.0,
         v: 0,
         via: usize::MAX,
     });
-    while let Some(Entry { d, v, via }) = open.pop() {
+    while let Some(Open { g: d, v, via, .. }) = open.pop() {
         if done[v] {
             continue;
         }
@@ -205,17 +206,13 @@ fn cheapest(graph: &mut Graph<'_>, oracle: &mut Oracle<'_>) -> Option<Vec<usize>
         done[v] = true;
         parent[v] = via;
         if v != 0 && oracle.admissible(v, nodes) {
-            let mut path = vec![v];
-            while parent[path[path.len() - 1]] != usize::MAX {
-                path.push(parent[path[path.len() - 1]]);
-            }
-            path.reverse();
-            return Some(path);
+            return Some(path_to(&parent, v));
         }
         for &(u, c) in graph.neighbours(v) {
             if !done[u] && oracle.valid(u, nodes) {
-                open.push(Entry {
-                    d: d + c,
+                open.push(Open {
+                    f: d + c,
+                    g: d + c,
                     v: u,
                     via: v,
                 });
@@ -223,28 +220,4 @@ fn cheapest(graph: &mut Graph<'_>, oracle: &mut Oracle<'_>) -> Option<Vec<usize>
         }
     }
     None
-}
-
-/// Open-list entry: shape `v` reached from `via` at cost `d`.
-#[derive(PartialEq)]
-struct Entry {
-    d: f32,
-    v: usize,
-    via: usize,
-}
-
-impl Eq for Entry {}
-
-impl Ord for Entry {
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.d.total_cmp(&self.d)
-            .then_with(|| o.v.cmp(&self.v))
-            .then_with(|| o.via.cmp(&self.via))
-    }
-}
-
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
 }

@@ -1,0 +1,405 @@
+//! The ARCplanner (paper Sec. 3): a head roadmap, then per head edge the cheapest
+//! shape that gets the whole chain along it.
+//!
+//! [`ArcPlanner`] holds the map context, the chain's shape tables, the settings and
+//! the head roadmap `G_T` ([`super::roadmap`]), built by [`Planner::setup`] and shared
+//! by the queries until [`Planner::clear`]. A query ([`Planner::solve`]) runs the
+//! online construction ([`super::construction`]) over the roadmap; where it fails, the
+//! lattice's head route ([`super::lattice`]) joins the roadmap, then the roadmap grows.
+
+use std::time::Instant;
+
+use aerial_chain_core::Shape;
+use rand::SeedableRng;
+use rand_pcg::Pcg64;
+use serde_json::Value;
+
+use super::construction::Construction;
+use super::error::point;
+use super::motion::source_label;
+use super::roadmap::Roadmap;
+use super::{
+    expired, lattice, PlanError, Planner, Query, Settings, Solution, SolutionStats, Step,
+    Termination,
+};
+use crate::collision::CollisionContext;
+use crate::plan::{Plan, Timing};
+use crate::tables::ShapeTables;
+
+/// Counters and timings of one query.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Roadmap build time (s).
+    pub roadmap_s: f64,
+    /// Query time (s).
+    pub planning_s: f64,
+    /// Of the query time, spent in collision checks (s).
+    pub collision_s: f64,
+    /// Head edges flown.
+    pub edges: usize,
+    /// Shape-change waypoints.
+    pub shape_changes: usize,
+    /// Yaw rotations of the current shape used.
+    pub rotations: usize,
+    /// Library shapes used.
+    pub lsc_uses: usize,
+    /// Random shapes used.
+    pub srs_uses: usize,
+    /// Follow-the-leader shapes used (one per short step).
+    pub follow_uses: usize,
+    /// Shape changes that refinement made smaller ([`super::refine`]).
+    pub shrunk: usize,
+    /// SRSConnect calls.
+    pub srs_connects: usize,
+    /// Head edges dropped and routes asked again (in the final roadmap).
+    pub replans: usize,
+    /// Times the roadmap was doubled during the query.
+    pub roadmap_growths: usize,
+    /// Smallest clearance margin (m) in force on any edge of the plan: every body kept
+    /// at least this far from the map (the preferred clearance unless the planner gave
+    /// way in a narrow passage).
+    pub min_margin: f64,
+    /// Head position at the start of the first edge flown at [`Self::min_margin`],
+    /// when that is below the preferred clearance.
+    pub min_margin_at: Option<[f64; 3]>,
+    /// Head route search ([`lattice`]): lattice points expanded (0: not used).
+    pub lattice_expanded: usize,
+    /// Head route search time (s), part of the query time.
+    pub lattice_s: f64,
+    /// Points of the head route added to the roadmap (start and goal included).
+    pub route_points: usize,
+    /// Full-chain collision checks (configurations, translations, shape changes).
+    pub collision_checks: u64,
+    /// Roadmap vertices and candidate edges.
+    pub roadmap_vertices: usize,
+    /// Candidate edges of the roadmap.
+    pub roadmap_edges: usize,
+}
+
+/// The planner: a map context, a chain's shape tables, settings, and the roadmap.
+pub struct ArcPlanner {
+    /// The map and chain at the preferred clearance.
+    pub(super) ctx: CollisionContext,
+    /// The same map and chain at the smallest clearance (`Settings::clearance_min`).
+    pub(super) ctx_min: CollisionContext,
+    lattice: lattice::HeadLattice,
+    /// The chain's shape library, random shapes and their adjacency.
+    pub(super) tables: ShapeTables,
+    /// Per SRS shape: the yaw from the head to the centroid of its units.
+    pub(super) trail_yaw: Vec<f32>,
+    pub(super) settings: Settings,
+    roadmap: Option<Roadmap>,
+    roadmap_s: f64,
+}
+
+impl ArcPlanner {
+    /// A planner for the chain of `ctx`; `tables` must be for the same chain.
+    pub fn new(
+        ctx: CollisionContext,
+        tables: ShapeTables,
+        settings: Settings,
+    ) -> Result<Self, PlanError> {
+        if tables.params != *ctx.params() {
+            return Err(PlanError::TablesMismatch {
+                tables: tables.params.units,
+                chain: ctx.params().units,
+            });
+        }
+        let trail_yaw = tables
+            .srs
+            .iter()
+            .map(|s| trail_yaw(&tables.params, s))
+            .collect();
+        let c_min = settings.clearance_min.clamp(0.0, ctx.clearance_margin());
+        let mut ctx_min = CollisionContext::new(ctx.field_arc().clone(), *ctx.params(), c_min)
+            .map_err(|e| PlanError::StartInvalid(format!("clearance_min: {e}")))?;
+        ctx_min.set_min_step(ctx.min_step());
+        let lattice = lattice::HeadLattice::new(&ctx, c_min, settings.clearance_weight);
+        Ok(Self {
+            ctx,
+            ctx_min,
+            lattice,
+            tables,
+            trail_yaw,
+            settings,
+            roadmap: None,
+            roadmap_s: 0.0,
+        })
+    }
+
+    /// Builds the head roadmap (once; later calls do nothing), cut short at
+    /// `deadline` (the roadmap is then smaller).
+    fn setup_until(&mut self, deadline: Option<Instant>) {
+        if self.roadmap.is_none() {
+            let t = Instant::now();
+            self.build_roadmap(self.settings.vertices, deadline);
+            self.roadmap_s = t.elapsed().as_secs_f64();
+        }
+    }
+
+    /// (Re)builds the roadmap with `vertices` vertices, or fewer if `deadline` passes.
+    /// The sampler restarts from the seed, so a larger roadmap holds every vertex of a
+    /// smaller one. The radius shrinks as `(M_VT / vertices)^(1/3)`, so the number of
+    /// neighbours stays the same.
+    fn build_roadmap(&mut self, vertices: usize, deadline: Option<Instant>) {
+        let mut rng = Pcg64::seed_from_u64(self.settings.seed);
+        let weight = (
+            self.settings.clearance_weight,
+            self.ctx.params().reach() as f64 / 2.0,
+        );
+        let r_t =
+            self.settings.r_t * (self.settings.vertices as f64 / vertices.max(1) as f64).cbrt();
+        let near = (r_t, self.settings.max_neighbours);
+        self.roadmap = Some(Roadmap::build(
+            &self.ctx, vertices, near, weight, &mut rng, deadline,
+        ));
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// The lattice's head route (`Ok(None)`: the lattice cannot say within `budget`);
+    /// [`PlanError::Separated`] when it proves that none exists. Adds its time to `s`.
+    fn head_route(
+        &self,
+        start: [f64; 3],
+        goal: [f64; 3],
+        budget: usize,
+        deadline: Option<Instant>,
+        s: &mut f64,
+    ) -> Result<Option<lattice::HeadRoute>, PlanError> {
+        let t = Instant::now();
+        let outcome = self
+            .lattice
+            .route_within(&self.ctx_min, start, goal, budget, deadline);
+        *s += t.elapsed().as_secs_f64();
+        match outcome {
+            lattice::LatticeOutcome::Found(r) if r.points.len() >= 2 => Ok(Some(r)),
+            lattice::LatticeOutcome::Separated { side, visited } => Err(PlanError::Separated {
+                radius: self.lattice.radius_min(),
+                side,
+                visited,
+                spacing: self.lattice.spacing(),
+            }),
+            _ => Ok(None),
+        }
+    }
+
+    /// Full-chain checks made so far by both contexts.
+    fn check_count(&self) -> u64 {
+        [self.ctx.stats(), self.ctx_min.stats()]
+            .iter()
+            .map(|c| c.configs + c.translations + c.shape_changes)
+            .sum()
+    }
+
+    /// The head route search.
+    pub fn lattice(&self) -> &lattice::HeadLattice {
+        &self.lattice
+    }
+
+    /// Refuses a query whose start configuration is not valid or whose goal cannot
+    /// hold the head (at the smallest clearance).
+    fn check_query(&self, query: &Query) -> Result<(), PlanError> {
+        self.ctx_min
+            .check_config(query.start, &query.start_shape)
+            .map_err(|c| PlanError::StartInvalid(c.to_string()))?;
+        let goal = query.goal;
+        if !self.ctx_min.is_head_free(goal) {
+            let why = if self.ctx.field().grid().in_bounds(goal) {
+                format!(
+                    "the head's sphere (radius + clearance) collides at {}",
+                    point(&goal)
+                )
+            } else {
+                format!("{} is outside the map's bounds", point(&goal))
+            };
+            return Err(PlanError::GoalInvalid(why));
+        }
+        Ok(())
+    }
+
+    /// Plans `query` ([`Planner::solve`]): the online construction over the head
+    /// roadmap, with the lattice's head route and roadmap growth where it fails.
+    fn solve_query(
+        &mut self,
+        query: &Query,
+        stop: Termination,
+    ) -> Result<Solution<Stats>, PlanError> {
+        let (start, goal) = (query.start, query.goal);
+        // The time limit covers the roadmap too (when it is built here) and growth.
+        let began = Instant::now();
+        let deadline = stop.deadline(began);
+        self.setup_until(deadline);
+        let query_began = Instant::now();
+        let checks_before = self.check_count();
+        self.check_query(query)?;
+        // The head route over the lattice ([`lattice`]), searched when the uniform
+        // roadmap fails (where it works, it is cheaper in rooms and mazes): the route
+        // joins the roadmap, and a proof that none exists ends the query.
+        let mut route = None;
+        let (mut lattice_expanded, mut lattice_s) = (0, 0.0);
+        let mut lattice_done = !self.settings.head_lattice;
+        // Like OMPL's PRM, grow the roadmap while the query fails and time remains.
+        let mut growths = 0;
+        let (steps, mut stats, size) = loop {
+            if expired(deadline) {
+                return Err(PlanError::TimeLimit { replans: 0 });
+            }
+            let mut roadmap = self.roadmap.take().expect("setup built the roadmap");
+            let inner = route
+                .as_ref()
+                .map(|r: &lattice::HeadRoute| &r.points[1..r.points.len() - 1]);
+            let result = Construction::new(self, &mut roadmap, query, inner, stop, began).run();
+            roadmap.clear_query();
+            let size = (roadmap.vertex_count(), roadmap.edge_count());
+            self.roadmap = Some(roadmap);
+            match result {
+                Ok((steps, stats)) => break (steps, stats, size),
+                Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
+                    if !lattice_done && !expired(deadline) =>
+                {
+                    // The roadmap alone failed: now the full lattice search.
+                    lattice_done = true;
+                    let budget = self.lattice.budget;
+                    if let Some(r) =
+                        self.head_route(start, goal, budget, deadline, &mut lattice_s)?
+                    {
+                        lattice_expanded = r.expanded;
+                        route = Some(r);
+                    }
+                }
+                Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
+                    if growths < self.settings.max_growth && !expired(deadline) =>
+                {
+                    growths += 1;
+                    self.build_roadmap(self.settings.vertices << growths, deadline);
+                }
+                // A roadmap cut short by the deadline fails for want of time.
+                Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
+                    if expired(deadline) =>
+                {
+                    return Err(PlanError::TimeLimit { replans: 0 })
+                }
+                Err(PlanError::NoShape {
+                    from, to, replans, ..
+                }) => {
+                    return Err(PlanError::NoShape {
+                        from,
+                        to,
+                        replans,
+                        narrowest: route.map(|r| (r.narrowest, r.narrowest_margin)),
+                    })
+                }
+                Err(e) => return Err(e),
+            }
+        };
+        stats.roadmap_growths = growths;
+        stats.collision_checks = self.check_count() - checks_before;
+        stats.lattice_expanded = lattice_expanded;
+        stats.lattice_s = lattice_s;
+        stats.route_points = route.as_ref().map_or(0, |r| r.points.len());
+        stats.roadmap_s = self.roadmap_s;
+        stats.planning_s = query_began.elapsed().as_secs_f64();
+        (stats.roadmap_vertices, stats.roadmap_edges) = size;
+        Ok(Solution { steps, stats })
+    }
+}
+
+/// Yaw of the direction from the head to the centroid of the units of `shape`.
+fn trail_yaw(params: &aerial_chain_core::ChainParams, shape: &Shape) -> f32 {
+    let p = aerial_chain_core::kinematics::offsets(params, shape);
+    let c = p
+        .iter()
+        .take(shape.units())
+        .fold(nalgebra::Vector3::zeros(), |a, q| a + q);
+    c.y.atan2(c.x)
+}
+
+impl Planner for ArcPlanner {
+    type Stats = Stats;
+    type Error = PlanError;
+
+    fn context(&self) -> &CollisionContext {
+        &self.ctx
+    }
+
+    /// Builds the head roadmap (once; later calls do nothing until [`Self::clear`]).
+    /// The head roadmap serves any query, so the query is not read.
+    fn setup(&mut self, _query: &Query, stop: Termination) {
+        self.setup_until(stop.deadline(Instant::now()));
+    }
+
+    /// Plans from the query's start to within its goal tolerance of its goal; sets up
+    /// first if needed, under the same time limit.
+    fn solve(&mut self, query: &Query, stop: Termination) -> Result<Solution<Stats>, PlanError> {
+        self.solve_query(query, stop)
+    }
+
+    fn clear(&mut self) {
+        self.roadmap = None;
+    }
+
+    fn roadmap_stats(&self) -> Stats {
+        let (roadmap_vertices, roadmap_edges) = self
+            .roadmap
+            .as_ref()
+            .map_or((0, 0), |r| (r.vertex_count(), r.edge_count()));
+        Stats {
+            roadmap_s: self.roadmap_s,
+            roadmap_vertices,
+            roadmap_edges,
+            ..Default::default()
+        }
+    }
+}
+
+impl SolutionStats for Stats {
+    fn counts(&self) -> Vec<(&'static str, u64)> {
+        vec![
+            ("edges", self.edges as u64),
+            ("shape_changes", self.shape_changes as u64),
+            ("rotations", self.rotations as u64),
+            ("lsc_uses", self.lsc_uses as u64),
+            ("srs_uses", self.srs_uses as u64),
+            ("follow_uses", self.follow_uses as u64),
+            ("shrunk", self.shrunk as u64),
+            ("srs_connects", self.srs_connects as u64),
+            ("replans", self.replans as u64),
+            ("roadmap_growths", self.roadmap_growths as u64),
+            ("collision_checks", self.collision_checks),
+            ("roadmap_vertices", self.roadmap_vertices as u64),
+            ("roadmap_edges", self.roadmap_edges as u64),
+            ("lattice_expanded", self.lattice_expanded as u64),
+            ("route_points", self.route_points as u64),
+        ]
+    }
+
+    fn timing(&self) -> Timing {
+        Timing {
+            roadmap_s: self.roadmap_s,
+            planning_s: self.planning_s,
+            collision_s: self.collision_s,
+            rest: "shape_search_s",
+        }
+    }
+
+    /// Where each waypoint's shape came from, and the smallest clearance margin in
+    /// force and where (docs/model.md "Files").
+    fn annotate(&self, steps: &[Step], plan: &mut Plan) {
+        let labels: Vec<Value> = steps
+            .iter()
+            .map(|s| Value::String(source_label(&s.source, s.shape_change)))
+            .collect();
+        plan.stats
+            .insert("waypoint_sources".into(), Value::Array(labels));
+        plan.stats
+            .insert("min_margin".into(), serde_json::json!(self.min_margin));
+        if let Some(at) = self.min_margin_at {
+            plan.stats
+                .insert("min_margin_at".into(), serde_json::json!(at));
+        }
+    }
+}

@@ -1,0 +1,61 @@
+//! Full-chain collision checks as the ARC planner's searches make them: timed, and
+//! failing at once past the query's deadline.
+
+use std::time::{Duration, Instant};
+
+use aerial_chain_core::Shape;
+
+use super::expired;
+use crate::collision::CollisionContext;
+
+/// Collision checks with time and count bookkeeping.
+pub struct Checker {
+    /// The context checks are made in (the clearance in force).
+    pub(super) ctx: CollisionContext,
+    /// Time spent in checks.
+    pub(super) time: Duration,
+    /// Past it every check fails at once, so that whatever search is under way ends
+    /// and the query reports the time limit.
+    pub(super) deadline: Option<Instant>,
+}
+
+impl Checker {
+    /// A checker in `ctx` that fails every check past `deadline`.
+    pub fn new(ctx: CollisionContext, deadline: Option<Instant>) -> Self {
+        Self {
+            ctx,
+            time: Duration::ZERO,
+            deadline,
+        }
+    }
+
+    fn timed(&mut self, f: impl FnOnce(&CollisionContext) -> bool) -> bool {
+        if expired(self.deadline) {
+            return false;
+        }
+        let t = Instant::now();
+        let r = f(&self.ctx);
+        self.time += t.elapsed();
+        r
+    }
+
+    /// The shape is collision-free with the head at `xi` (shape known valid).
+    pub fn placement(&mut self, xi: [f64; 3], s: &Shape) -> bool {
+        self.timed(|c| c.check_placement(xi, s).is_ok())
+    }
+
+    /// The configuration is valid (joint limits, self-collision, map).
+    pub fn config(&mut self, xi: [f64; 3], s: &Shape) -> bool {
+        self.timed(|c| c.check_config(xi, s).is_ok())
+    }
+
+    /// The chain in shape `s` can translate from `a` to `b`.
+    pub fn translation(&mut self, a: [f64; 3], b: [f64; 3], s: &Shape) -> bool {
+        self.timed(|c| c.check_translation(a, b, s).is_ok())
+    }
+
+    /// The chain can change shape from `s` to `t` with the head at `xi`.
+    pub fn shape_change(&mut self, xi: [f64; 3], s: &Shape, t: &Shape) -> bool {
+        self.timed(|c| c.check_shape_change(xi, s, t).is_ok())
+    }
+}

@@ -1,0 +1,95 @@
+//! Why the ARC planner gives no plan, or cannot be asked.
+
+use super::Failure;
+
+/// A point for messages: `(x, y, z)` to the millimetre.
+pub(super) fn point(p: &[f64; 3]) -> String {
+    format!("({:.3}, {:.3}, {:.3})", p[0], p[1], p[2])
+}
+
+/// Why a query has no solution, or cannot be asked.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    /// The tables are for another chain than the map context.
+    #[error("the shape tables are for N = {tables} units, the chain has N = {chain}")]
+    TablesMismatch {
+        /// Units in the tables.
+        tables: u8,
+        /// Units of the chain.
+        chain: u8,
+    },
+    /// The start configuration is not valid.
+    #[error("start is invalid: {0}")]
+    StartInvalid(String),
+    /// The goal cannot hold the head.
+    #[error("goal is invalid: {0}")]
+    GoalInvalid(String),
+    /// The head cannot reach the goal in the roadmap at all.
+    #[error("goal is not reachable by the head (no roadmap path from the start to within {tol} m of the goal)")]
+    Unreachable {
+        /// Goal tolerance (m).
+        tol: f64,
+    },
+    /// The head could be routed, but the chain found no shape for some edge.
+    #[error(
+        "no shape fits head edge {} -> {} after {replans} replans{}",
+        point(from),
+        point(to),
+        narrow_note(.narrowest)
+    )]
+    NoShape {
+        /// The last edge tried.
+        from: [f64; 3],
+        /// Its end.
+        to: [f64; 3],
+        /// Replans made.
+        replans: usize,
+        /// The head route's narrowest point and the head's margin there (m), when the
+        /// lattice found a route.
+        narrowest: Option<([f64; 3], f64)>,
+    },
+    /// The head's sphere cannot get from the start to the goal at all: the lattice
+    /// search flooded one side's free region without meeting the other.
+    #[error("start and goal are in separate free regions for the head's sphere (radius {radius:.3} m, the smallest clearance included): the {side}'s region ({visited} lattice points at {spacing:.3} m) does not reach the other")]
+    Separated {
+        /// Sphere radius tested (m).
+        radius: f64,
+        /// Which side's region was flooded ("start" or "goal").
+        side: &'static str,
+        /// Lattice points in it.
+        visited: usize,
+        /// Lattice spacing (m).
+        spacing: f64,
+    },
+    /// The termination condition stopped the query.
+    #[error("time limit reached after {replans} replans")]
+    TimeLimit {
+        /// Replans made.
+        replans: usize,
+    },
+}
+
+/// The tail of [`PlanError::NoShape`]'s message: where the head route is narrowest.
+fn narrow_note(n: &Option<([f64; 3], f64)>) -> String {
+    match n {
+        Some((p, m)) => format!(
+            "; the head route is narrowest at ({:.3}, {:.3}, {:.3}), where the head keeps {:.3} m from the map",
+            p[0], p[1], p[2], m
+        ),
+        None => String::new(),
+    }
+}
+
+impl Failure for PlanError {
+    fn outcome(&self) -> &'static str {
+        match self {
+            PlanError::TimeLimit { .. } => "time_limit",
+            PlanError::NoShape { .. } => "no_shape",
+            PlanError::Unreachable { .. } => "unreachable",
+            PlanError::Separated { .. } => "separated",
+            PlanError::StartInvalid(_) => "start_invalid",
+            PlanError::GoalInvalid(_) => "goal_invalid",
+            PlanError::TablesMismatch { .. } => "error",
+        }
+    }
+}

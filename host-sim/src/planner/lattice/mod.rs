@@ -1,0 +1,306 @@
+//! Head routes complete at the map's resolution: a search over the half-cell lattice.
+//!
+//! The head roadmap samples the map's box uniformly, and a narrow opening is a tiny
+//! target for uniform samples (a 0.1 m x 0.1 m x 0.2 m tube for the head's centre in a
+//! 0.5 m window). This module searches a LATTICE instead: the points `lo + k h` of the
+//! map's box with `h = r_v / 2`, so it holds every voxel centre (odd `k`), every face,
+//! edge and corner centre (even `k`): a gap an even number of voxels wide is centred on
+//! a voxel face, and a gap an odd number wide on a voxel centre, so both are on it.
+//!
+//! A lattice point is FREE for a sphere of radius `R` (the unit radius plus the
+//! clearance in force, see below) when it is inside the map's box and the sphere
+//! touches no obstacle voxel cube, by the exact sphere-against-cube test of
+//! docs/model.md: the distance field's proven lower bound decides where it exceeds
+//! `R`, and only where it does not are the obstacle cubes near the point measured one
+//! by one ([`exact_clearance`]). Points are 26-connected.
+//!
+//! A query is an A* from the lattice points next to the start to those next to the
+//! goal. Each step costs its length times `1 + w max(0, 1 - (c - r_u) / c_ref)`, `c`
+//! the clearance of the point it enters, plus a surcharge where `c` is below the
+//! PREFERRED radius (unit radius plus `--clearance`): routes keep to the middle of
+//! openings and rooms, and go below the preferred clearance only where no other way
+//! exists. Beside the A*, a breadth-first flood from the goal runs one expansion per
+//! A* expansion: whichever of the two runs out first proves that start and goal lie in
+//! separate free regions of the lattice, so a sealed-off goal pocket is refused after
+//! flooding the pocket, not the map. All state lives in hash maps keyed by lattice
+//! point, so the work and memory follow the free space the query explores, never the
+//! map's box.
+//!
+//! The lattice path is then pulled taut ([`HeadLattice::simplify`]): a run of lattice
+//! points is replaced by one segment only when the head's sphere can fly it (by the
+//! planner's conservative check at the smallest clearance) and the segment keeps as
+//! much clearance as the points it replaces (up to a cap): in open space the route
+//! becomes a few long segments, in a narrow passage it keeps the centred points.
+//!
+//! The route is a GUIDE for the chain, not a proof of anything: every edge the chain
+//! flies is still checked by the planner's conservative checks. What the lattice
+//! proves is the negative: when the search and the flood find no connection, no
+//! lattice route exists for the head's sphere at that radius.
+
+mod clearance;
+mod flood;
+mod nodes;
+mod pull;
+mod search;
+#[cfg(test)]
+mod tests;
+
+pub use clearance::exact_clearance;
+pub use nodes::KeyHasher;
+
+use crate::collision::{CollisionContext, FK_TOLERANCE};
+use nodes::{KeyMap, Nodes};
+use search::{Limit, Search};
+
+/// Bits per axis in a packed lattice key.
+const AXIS_BITS: u32 = 21;
+const AXIS_MASK: u64 = (1 << AXIS_BITS) - 1;
+
+/// Surcharge (per metre) for stepping where the clearance is below the preferred one.
+const NARROW_SURCHARGE: f64 = 4.0;
+/// Clearance above the preferred radius at which the step penalty vanishes (m).
+const CLEARANCE_REF: f64 = 0.5;
+/// Inflation of the A* heuristic (weighted A*): routes within this factor of the
+/// cheapest, found with far fewer expansions.
+const HEURISTIC_WEIGHT: f64 = 2.5;
+/// Longest step (lattice spacings) in open space.
+const MAX_JUMP: f64 = 16.0;
+/// A string-pulled segment keeps the clearance of the points it replaces up to this
+/// much above the preferred radius (m).
+const KEEP_CAP: f64 = 0.3;
+
+/// How the lattice search ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LatticeOutcome {
+    /// A route from the start to the goal.
+    Found(HeadRoute),
+    /// Start and goal are in separate free regions of the lattice: no route exists for
+    /// the head's sphere at the smallest clearance.
+    Separated {
+        /// Which side's region was flooded completely ("start" or "goal").
+        side: &'static str,
+        /// Lattice points visited.
+        visited: usize,
+    },
+    /// No free lattice point next to the start (or the goal): the lattice cannot say.
+    NoAnchor {
+        /// "start" or "goal".
+        side: &'static str,
+    },
+    /// The search visited its budget of lattice points without an answer.
+    Budget,
+}
+
+/// A head route: a polyline from the start to the goal.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeadRoute {
+    /// The polyline, the start first and the goal last.
+    pub points: Vec<[f64; 3]>,
+    /// The route's narrowest lattice point.
+    pub narrowest: [f64; 3],
+    /// The head's margin there: distance to the nearest obstacle cube minus `r_u` (m;
+    /// a proven lower bound).
+    pub narrowest_margin: f64,
+    /// Lattice points the A* expanded.
+    pub expanded: usize,
+}
+
+/// The half-cell lattice of a map, for one chain and two clearances.
+#[derive(Clone, Debug)]
+pub struct HeadLattice {
+    lo: [f64; 3],
+    hi: [f64; 3],
+    h: f64,
+    /// Largest lattice index per axis (`2 dims`).
+    n: [i64; 3],
+    /// Unit radius `r_u` (m).
+    unit_r: f64,
+    /// Sphere radius that must be free: `r_u` + smallest clearance + FK tolerance.
+    r_min: f64,
+    /// Preferred radius: `r_u` + preferred clearance + FK tolerance.
+    r_pref: f64,
+    /// Clearance weight `w` of the step cost.
+    weight: f64,
+    /// Most lattice points a query may visit.
+    pub budget: usize,
+    /// Expansions of the last strided search.
+    searched: std::cell::Cell<Option<usize>>,
+}
+
+impl HeadLattice {
+    /// The lattice of `ctx`'s map for the head's sphere: it must be free at clearance
+    /// `clearance_min`, and prefers `ctx`'s clearance.
+    pub fn new(ctx: &CollisionContext, clearance_min: f64, weight: f64) -> Self {
+        let g = ctx.field().grid();
+        let (lo, hi) = g.bounds();
+        let h = g.resolution() / 2.0;
+        let dims = g.dims();
+        let unit_r = ctx.params().unit_radius as f64;
+        let pref = ctx.clearance_margin();
+        Self {
+            lo,
+            hi,
+            h,
+            n: dims.map(|d| 2 * d as i64),
+            unit_r,
+            r_min: unit_r + clearance_min.min(pref) + FK_TOLERANCE,
+            r_pref: unit_r + pref + FK_TOLERANCE,
+            weight,
+            budget: 60_000_000,
+            searched: std::cell::Cell::new(None),
+        }
+    }
+
+    /// Radius (m) of the sphere that must be free at lattice points: `r_u` plus the
+    /// smallest clearance (plus the FK tolerance).
+    pub fn radius_min(&self) -> f64 {
+        self.r_min
+    }
+
+    /// Lattice spacing `h` (m).
+    pub fn spacing(&self) -> f64 {
+        self.h
+    }
+
+    pub(super) fn pack(&self, i: [i64; 3]) -> Option<u64> {
+        if (0..3).all(|a| i[a] >= 0 && i[a] <= self.n[a])
+            && self.n.iter().all(|&n| n < (1 << AXIS_BITS))
+        {
+            Some(i[0] as u64 | (i[1] as u64) << AXIS_BITS | (i[2] as u64) << (2 * AXIS_BITS))
+        } else {
+            None
+        }
+    }
+
+    pub(super) fn unpack(k: u64) -> [i64; 3] {
+        [
+            (k & AXIS_MASK) as i64,
+            ((k >> AXIS_BITS) & AXIS_MASK) as i64,
+            ((k >> (2 * AXIS_BITS)) & AXIS_MASK) as i64,
+        ]
+    }
+
+    /// Position of lattice point `k`.
+    pub(super) fn point(&self, k: u64) -> [f64; 3] {
+        let i = Self::unpack(k);
+        [0, 1, 2].map(|a| self.lo[a] + i[a] as f64 * self.h)
+    }
+
+    /// Step cost factor for entering a point of clearance `c`.
+    pub(super) fn factor(&self, c: f64) -> f64 {
+        let mut f = 1.0 + self.weight * (1.0 - (c - self.unit_r) / CLEARANCE_REF).max(0.0);
+        if c <= self.r_pref {
+            // Below the preferred clearance: the more so the narrower, so routes
+            // through tight openings keep to their middle.
+            let span = (self.r_pref - self.r_min).max(1e-6);
+            f += NARROW_SURCHARGE * (0.5 + (self.r_pref - c) / span);
+        }
+        f
+    }
+
+    /// Searches a lattice route from `start` to `goal` and pulls it taut with
+    /// `ctx_min`'s conservative head-segment check (`ctx_min`: the smallest clearance).
+    ///
+    /// First over the voxel centres (an eighth of the points), which finds a route in
+    /// all but the tightest passages; then, when that fails, over the whole half-cell
+    /// lattice, with the floods that prove a failure.
+    pub fn route(
+        &self,
+        ctx_min: &CollisionContext,
+        start: [f64; 3],
+        goal: [f64; 3],
+    ) -> LatticeOutcome {
+        self.route_within(ctx_min, start, goal, self.budget, None)
+    }
+
+    /// [`Self::route`], giving up ([`LatticeOutcome::Budget`]) once `budget` lattice
+    /// points have been touched or `deadline` has passed (the query's time limit).
+    pub fn route_within(
+        &self,
+        ctx_min: &CollisionContext,
+        start: [f64; 3],
+        goal: [f64; 3],
+        budget: usize,
+        deadline: Option<std::time::Instant>,
+    ) -> LatticeOutcome {
+        let limit = Limit { budget, deadline };
+        let field = ctx_min.field();
+        let mut nodes = Nodes {
+            lat: self,
+            field,
+            map: KeyMap::default(),
+        };
+        let mut expanded = 0;
+        match self.search(&mut nodes, start, goal, 2, &limit) {
+            Search::Found(keys, n) => {
+                return self.finish(ctx_min, &mut nodes, start, goal, keys, n)
+            }
+            Search::Budget => return LatticeOutcome::Budget,
+            _ => {}
+        }
+        if let Some(n) = self.searched.take() {
+            expanded = n;
+        }
+        // The clearances stay valid; the search state does not.
+        for n in nodes.map.values_mut() {
+            (n.g, n.parent, n.closed, n.flooded) = (f64::INFINITY, u64::MAX, false, false);
+        }
+        match self.search(&mut nodes, start, goal, 1, &limit) {
+            Search::Found(keys, n) => {
+                self.finish(ctx_min, &mut nodes, start, goal, keys, n + expanded)
+            }
+            Search::Separated { side, visited } => LatticeOutcome::Separated { side, visited },
+            Search::NoAnchor(side) => LatticeOutcome::NoAnchor { side },
+            Search::Exhausted | Search::Budget => LatticeOutcome::Budget,
+        }
+    }
+
+    /// The route from the lattice path `keys` (start anchor first).
+    fn finish(
+        &self,
+        ctx_min: &CollisionContext,
+        nodes: &mut Nodes,
+        start: [f64; 3],
+        goal: [f64; 3],
+        keys: Vec<u64>,
+        expanded: usize,
+    ) -> LatticeOutcome {
+        let mut pts = Vec::with_capacity(keys.len() + 2);
+        let mut clear = Vec::with_capacity(keys.len() + 2);
+        pts.push(start);
+        clear.push(nodes.clear(keys[0]).unwrap_or(0.0));
+        for &k in &keys {
+            pts.push(self.point(k));
+            clear.push(nodes.clear(k).unwrap_or(0.0));
+        }
+        pts.push(goal);
+        clear.push(nodes.clear(*keys.last().expect("non-empty")).unwrap_or(0.0));
+        self.centre(nodes, &mut pts, &mut clear);
+        let (mut narrowest, mut nc) = (pts[1], f64::INFINITY);
+        for j in 1..pts.len() - 1 {
+            if clear[j] < nc {
+                (narrowest, nc) = (pts[j], clear[j]);
+            }
+        }
+        let points = self.simplify(ctx_min, &pts, &clear);
+        LatticeOutcome::Found(HeadRoute {
+            points,
+            narrowest,
+            narrowest_margin: nc - self.unit_r,
+            expanded,
+        })
+    }
+}
+
+pub(super) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(super) fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// Euclidean distance (m).
+pub(super) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
