@@ -6,10 +6,8 @@
 //! The contract everything here follows is `docs/model.md`.
 
 pub mod baseline;
-pub mod bench;
-pub mod cli;
 pub mod collision;
-pub mod fsutil;
+mod fsutil;
 pub mod map;
 pub mod picture;
 pub mod plan;

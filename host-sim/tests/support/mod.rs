@@ -8,7 +8,7 @@
 
 use std::io::Read;
 use std::os::unix::process::{CommandExt, ExitStatusExt};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -71,7 +71,12 @@ pub fn run(args: &[&str], dir: &Path) -> Outcome {
 }
 
 /// Waits for `child` under the hang guard and collects its output.
-pub fn wait(mut child: Child, args: &[&str]) -> Outcome {
+pub fn wait(child: Child, args: &[&str]) -> Outcome {
+    wait_at_most(child, args, GUARD_SECONDS)
+}
+
+/// Waits for `child` at most `seconds` and collects its output.
+fn wait_at_most(mut child: Child, args: &[&str], seconds: u64) -> Outcome {
     // Drain the pipes on threads, so a chatty child cannot block on a full pipe.
     let drain = |r: Option<Box<dyn Read + Send>>| {
         std::thread::spawn(move || {
@@ -99,10 +104,10 @@ pub fn wait(mut child: Child, args: &[&str]) -> Outcome {
         if let Some(s) = child.try_wait().expect("wait for arc") {
             break s;
         }
-        if began.elapsed() > Duration::from_secs(GUARD_SECONDS) {
+        if began.elapsed() > Duration::from_secs(seconds) {
             let _ = child.kill();
             let _ = child.wait();
-            panic!("arc {args:?} hung (over {GUARD_SECONDS} s)");
+            panic!("arc {args:?} hung (over {seconds} s)");
         }
         std::thread::sleep(Duration::from_millis(10));
     };
@@ -134,4 +139,110 @@ pub fn hover_plan(unknown_is_occupied: bool) -> String {
  "waypoints": [{{"zeta": {zeta:?}}}, {{"zeta": {zeta:?}}}],
  "stats": {{}}}}"#
     )
+}
+
+/// Wall time an end-to-end run (a plan on a large scenario, a whole flight) may take
+/// before it counts as hung; a guard, not a timing.
+pub const E2E_GUARD_SECONDS: u64 = 900;
+
+/// How a run of `arc` that should have succeeded failed: its exit code and what it
+/// printed.
+#[derive(Debug)]
+pub struct Failure {
+    /// The exit code (`None`: ended by a signal).
+    pub code: Option<i32>,
+    /// Standard error, then standard output.
+    pub message: String,
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "exit {:?}: {}", self.code, self.message)
+    }
+}
+
+/// Runs the real `arc` binary with `args` (paths absolute) and tells whether it
+/// exited 0; a crash fails the test.
+pub fn arc_ok(args: &[&str]) -> Result<(), Failure> {
+    let child = arc(args, &std::env::temp_dir())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn arc");
+    let o = wait_at_most(child, args, E2E_GUARD_SECONDS);
+    assert!(!o.crashed(), "arc {args:?} crashed: {o:?}");
+    if o.code == Some(0) {
+        Ok(())
+    } else {
+        Err(Failure {
+            code: o.code,
+            message: format!("{}{}", o.stderr, o.stdout),
+        })
+    }
+}
+
+/// A path as the `&str` a command line takes.
+pub fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+/// Plans `scenario` for `units` with `arc plan`'s defaults into `dir`, checks the plan
+/// with the exact verifier (never the planner's own checks) and that its head ends
+/// within 0.3 m of the goal; returns the plan and the scenario.
+pub fn plan_verified(
+    scenario: &str,
+    units: u8,
+    dir: &Path,
+) -> (
+    aerial_chain::plan::Plan,
+    aerial_chain::problem::scenarios::Scenario,
+) {
+    let out = dir.join(format!("{scenario}-{units}.json"));
+    let n = units.to_string();
+    arc_ok(&[
+        "plan",
+        "--scenario",
+        scenario,
+        "--units",
+        &n,
+        "--out",
+        s(&out),
+    ])
+    .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
+    let plan = aerial_chain::plan::Plan::read(&out).expect("plan file reads back");
+    let sc = aerial_chain::problem::scenarios::build(scenario).expect("scenario");
+    let report = aerial_chain::collision::verify_plan(&sc.grid, &plan);
+    assert!(report.ok, "{scenario} N={units}: {:?}", report.violation);
+    let last = plan.waypoints[plan.waypoints.len() - 1].xi();
+    let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
+    assert!(
+        d <= 0.3 + 1e-9,
+        "{scenario} N={units}: ends {d} m from the goal"
+    );
+    (plan, sc)
+}
+
+/// A map of two sealed rooms: free inside, walls around and between.
+pub fn sealed_rooms(dir: &Path) -> PathBuf {
+    let mut g = aerial_chain::map::grid::Grid::new(
+        0.1,
+        [0, 0, 0],
+        [80, 40, 30],
+        aerial_chain::map::grid::Cell::Free,
+        true,
+    )
+    .unwrap();
+    let wall = |g: &mut aerial_chain::map::grid::Grid, lo: [f64; 3], hi: [f64; 3]| {
+        g.fill_box(lo, hi, aerial_chain::map::grid::Cell::Occupied)
+    };
+    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 4.0, 0.2]);
+    wall(&mut g, [0.0, 0.0, 2.8], [8.0, 4.0, 3.0]);
+    wall(&mut g, [0.0, 0.0, 0.0], [0.2, 4.0, 3.0]);
+    wall(&mut g, [7.8, 0.0, 0.0], [8.0, 4.0, 3.0]);
+    wall(&mut g, [0.0, 0.0, 0.0], [8.0, 0.2, 3.0]);
+    wall(&mut g, [0.0, 3.8, 0.0], [8.0, 4.0, 3.0]);
+    wall(&mut g, [3.9, 0.0, 0.0], [4.1, 4.0, 3.0]);
+    let path = dir.join("sealed.bt");
+    g.to_octree().unwrap().write_bt(&path).unwrap();
+    path
 }

@@ -1,5 +1,5 @@
 //! `arc bench robust`: the ARCplanner with `arc plan`'s defaults on random instances of
-//! the hard-case family ([`crate::problem::passages`]), N = 4..8.
+//! the hard-case family ([`aerial_chain::problem::passages`]), N = 4..8.
 //!
 //! Each instance is drawn from a seeded generator; it is kept only when its witness
 //! (follow-the-leader along the hand-made centre line, checked by the exact verifier,
@@ -10,7 +10,7 @@
 use rand::{Rng, SeedableRng};
 
 use super::{plot, run_all, ArcMode, Envs, Method, RunResult, RunSpec, Spread};
-use crate::problem::passages::{witness, PassageSpec};
+use aerial_chain::problem::passages::{witness, PassageSpec};
 
 /// Options of the study.
 #[derive(Clone, Debug)]
@@ -180,12 +180,12 @@ pub fn figure(results: &[RunResult]) -> String {
     let curves = vec![
         plot::Curve {
             label: "planning (query)".into(),
-            colour: crate::picture::palette::SRS,
+            colour: aerial_chain::picture::palette::SRS,
             points: sorted(&|r| r.planning_s),
         },
         plot::Curve {
             label: "roadmap".into(),
-            colour: crate::picture::palette::PATH,
+            colour: aerial_chain::picture::palette::PATH,
             points: sorted(&|r| r.roadmap_s),
         },
     ];

@@ -4,11 +4,18 @@
 
 use std::path::PathBuf;
 
-use aerial_chain::bench::{self, ArcMode, Method, RunSpec};
+use crate::study::{self as bench, ArcMode, Method, RunSpec};
+use crate::CliError;
 use aerial_chain::collision::verify_plan;
 use aerial_chain::plan::Plan;
 use aerial_chain::problem::scenarios;
-use arc_tests::arc;
+
+/// Runs the command line in-process with `args` (the program name is added).
+fn arc(args: &[&str]) -> Result<(), CliError> {
+    let mut v = vec!["arc"];
+    v.extend_from_slice(args);
+    crate::run(v)
+}
 
 /// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {

@@ -3,14 +3,14 @@
 //!
 //! A run ([`RunSpec`]) is one planner on one query: the ARCplanner in one of its modes
 //! ([`Method::Arc`]) or the full-state PRM baseline ([`Method::FullPrm`],
-//! [`crate::baseline`]), on a built-in scenario, for one chain size, budget and seed.
+//! [`aerial_chain::baseline`]), on a built-in scenario, for one chain size, budget and seed.
 //! Every run builds its own collision context (its own counters), its own shape tables
 //! (SRS seeded with the run's seed) and its own roadmap (seeded with the run's seed),
 //! so a run's outcome depends on its spec alone: [`run_all`] may spread runs over any
 //! number of threads and returns the same results in the same order, timings aside
 //! (and unless a run is cut by its time limit, which depends on the machine's speed).
 //! Successful plans are checked with the exact verifier
-//! ([`crate::collision::verify_plan`]).
+//! ([`aerial_chain::collision::verify_plan`]).
 //!
 //! Times are wall-clock per run. With several runs in parallel on a loaded machine they
 //! include some contention; both planners of a study run in the same batch, so their
@@ -32,14 +32,14 @@ use aerial_chain_core::lsc::{library, LscKind};
 use aerial_chain_core::ChainParams;
 use rayon::prelude::*;
 
-use crate::baseline::{FullStatePrm, PrmError, PrmSettings};
-use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
-use crate::map::distance::DistanceField;
-use crate::planner::{
+use aerial_chain::baseline::{FullStatePrm, PrmError, PrmSettings};
+use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
+use aerial_chain::map::distance::DistanceField;
+use aerial_chain::planner::{
     motion, ArcPlanner, Failure, Mode, Planner, Settings, Solution, SolutionStats, Termination,
 };
-use crate::problem::scenarios::{self, Scenario};
-use crate::tables::{ShapeTables, TableSettings};
+use aerial_chain::problem::scenarios::{self, Scenario};
+use aerial_chain::tables::{ShapeTables, TableSettings};
 
 /// Which planner a run uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -106,7 +106,7 @@ impl Method {
 }
 
 /// Start and goal of a query (at the default goal tolerance).
-pub use crate::planner::Query;
+pub use aerial_chain::planner::Query;
 
 /// One benchmark run.
 #[derive(Clone, Debug, PartialEq)]
@@ -208,6 +208,7 @@ impl RunResult {
 
     /// Everything but the timings: equal for equal specs on any thread count (unless
     /// the time limit cut a run).
+    #[cfg(test)]
     pub fn fingerprint(&self) -> String {
         format!(
             "{:?}|{}|{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}|{}|{:?}|{:?}",
@@ -297,7 +298,7 @@ pub fn build_scenario(name: &str) -> Result<Scenario, String> {
     sc.grid.fill_box(
         [4.0 + e, 3.0 - h + e, 1.5 - h + e],
         [4.2 - e, 3.0 + h - e, 1.5 + h - e],
-        crate::map::grid::Cell::Free,
+        aerial_chain::map::grid::Cell::Free,
     );
     sc.name = name.to_string();
     sc.description = format!(
@@ -1042,3 +1043,6 @@ mod tests {
         assert_eq!(r.outcome, "error");
     }
 }
+
+#[cfg(test)]
+mod quick_tests;

@@ -7,7 +7,9 @@ use std::path::Path;
 use aerial_chain::collision::verify_plan;
 use aerial_chain::plan::Plan;
 use aerial_chain::problem::scenarios;
-use arc_tests::{arc, plan_verified, s, sealed_rooms};
+mod support;
+
+use support::{arc_ok, plan_verified, s, sealed_rooms};
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().expect("temporary directory")
@@ -18,7 +20,7 @@ fn tmp() -> tempfile::TempDir {
 fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
     let (plan, sc) = plan_verified(scenario, units, dir);
     let out = dir.join(format!("{scenario}-{units}.json"));
-    arc(&["verify", "--scenario", scenario, "--plan", s(&out)])
+    arc_ok(&["verify", "--scenario", scenario, "--plan", s(&out)])
         .unwrap_or_else(|e| panic!("{scenario} N={units}: arc verify: {e}"));
     let report = verify_plan(&sc.grid, &plan);
     assert!(report.min_clearance > 0.0);
@@ -81,7 +83,7 @@ fn same_seed_same_plan_byte_for_byte() {
     let dir = tmp();
     let run = |name: &str, seed: &str| -> String {
         let out = dir.path().join(name);
-        arc(&[
+        arc_ok(&[
             "plan",
             "--scenario",
             "window",
@@ -112,7 +114,7 @@ fn unreachable_goal_exits_1_with_the_reason() {
     let dir = tmp();
     let map = sealed_rooms(dir.path());
     let out = dir.path().join("p.json");
-    let e = arc(&[
+    let e = arc_ok(&[
         "plan",
         "--map",
         s(&map),
@@ -132,7 +134,7 @@ fn unreachable_goal_exits_1_with_the_reason() {
         s(&out),
     ])
     .unwrap_err();
-    assert_eq!(e.code, 1, "{e}");
+    assert_eq!(e.code, Some(1), "{e}");
     assert!(
         e.message.contains("not reachable") || e.message.contains("separate free regions"),
         "{e}"
@@ -148,7 +150,7 @@ fn start_in_collision_names_the_body() {
     let dir = tmp();
     let out = dir.path().join("p.json");
     // Window scenario: the dividing wall stands at x = 4.0..4.2; unit 3 lands in it.
-    let e = arc(&[
+    let e = arc_ok(&[
         "plan",
         "--scenario",
         "window",
@@ -163,7 +165,7 @@ fn start_in_collision_names_the_body() {
     ])
     .unwrap_err();
     // A start in collision is bad input (2), in `arc plan` as in `arc bench prm`.
-    assert_eq!(e.code, 2, "{e}");
+    assert_eq!(e.code, Some(2), "{e}");
     assert!(
         e.message.contains("start is invalid") && e.message.contains("unit"),
         "{e}"
@@ -244,8 +246,8 @@ fn malformed_input_exits_2() {
         vec!["frobnicate"],
     ];
     for c in cases {
-        let e = arc(&c).expect_err(&format!("{c:?} must fail"));
-        assert_eq!(e.code, 2, "{c:?}: {e}");
+        let e = arc_ok(&c).expect_err(&format!("{c:?} must fail"));
+        assert_eq!(e.code, Some(2), "{c:?}: {e}");
         assert!(!e.message.is_empty(), "{c:?}: an error names the problem");
     }
 }
@@ -261,8 +263,8 @@ fn a_tampered_plan_fails_verification() {
     bad.waypoints[k].zeta[1] = 1.0;
     let path = dir.path().join("bad.json");
     bad.write(&path).unwrap();
-    let e = arc(&["verify", "--scenario", "window", "--plan", s(&path)]).unwrap_err();
-    assert_eq!(e.code, 1, "{e}");
+    let e = arc_ok(&["verify", "--scenario", "window", "--plan", s(&path)]).unwrap_err();
+    assert_eq!(e.code, Some(1), "{e}");
     assert!(e.message.contains("INVALID"), "{e}");
 }
 
@@ -270,7 +272,7 @@ fn a_tampered_plan_fails_verification() {
 fn plans_from_a_table_file_match_generated_tables() {
     let dir = tmp();
     let table = dir.path().join("t5.arct");
-    arc(&[
+    arc_ok(&[
         "tables",
         "build",
         "--units",
@@ -283,10 +285,10 @@ fn plans_from_a_table_file_match_generated_tables() {
         s(&table),
     ])
     .unwrap();
-    arc(&["tables", "inspect", s(&table)]).unwrap();
+    arc_ok(&["tables", "inspect", s(&table)]).unwrap();
     let (a, b) = (dir.path().join("a.json"), dir.path().join("b.json"));
-    arc(&["plan", "--scenario", "maze", "--units", "5", "--out", s(&a)]).unwrap();
-    arc(&[
+    arc_ok(&["plan", "--scenario", "maze", "--units", "5", "--out", s(&a)]).unwrap();
+    arc_ok(&[
         "plan",
         "--scenario",
         "maze",
@@ -304,7 +306,7 @@ fn plans_from_a_table_file_match_generated_tables() {
         "the file holds the very shapes the generator makes"
     );
     // A table for another chain is refused.
-    let e = arc(&[
+    let e = arc_ok(&[
         "plan",
         "--scenario",
         "maze",
@@ -316,7 +318,7 @@ fn plans_from_a_table_file_match_generated_tables() {
         s(&a),
     ])
     .unwrap_err();
-    assert_eq!(e.code, 2);
+    assert_eq!(e.code, Some(2));
     assert!(e.message.contains("another chain"), "{e}");
 }
 
@@ -348,7 +350,7 @@ fn long_chains_snake_through_the_window() {
             if !smooth {
                 args.push("--no-smooth");
             }
-            arc(&args).unwrap_or_else(|e| panic!("window N={units}: no plan: {e}"));
+            arc_ok(&args).unwrap_or_else(|e| panic!("window N={units}: no plan: {e}"));
             let plan = Plan::read(&out).expect("plan file reads back");
             let report = verify_plan(&sc.grid, &plan);
             assert!(report.ok, "window N={units}: {:?}", report.violation);
@@ -372,7 +374,7 @@ fn long_chains_snake_through_the_window() {
 fn follow_step_zero_is_the_papers_planner() {
     let dir = tmp();
     let out = dir.path().join("window-5-paper.json");
-    arc(&[
+    arc_ok(&[
         "plan",
         "--scenario",
         "window",
@@ -407,7 +409,7 @@ fn refined_plans_verify_and_ask_less_of_the_chain() {
             let mut args = vec!["plan", "--scenario", scenario, "--units", units];
             args.extend_from_slice(extra);
             args.extend_from_slice(&["--out", s(&out)]);
-            arc(&args).unwrap_or_else(|e| panic!("{scenario}: {e}"));
+            arc_ok(&args).unwrap_or_else(|e| panic!("{scenario}: {e}"));
             let plan = Plan::read(&out).expect("plan file reads back");
             let report = verify_plan(&sc.grid, &plan);
             assert!(report.ok, "{scenario} {name}: {:?}", report.violation);

@@ -9,12 +9,12 @@ use aerial_chain_core::{ChainParams, Shape};
 use clap::Args;
 
 use super::{checks, CliError};
-use crate::map::distance::DistanceField;
-use crate::map::grid::Grid;
-use crate::map::octomap::OcTree;
-use crate::plan::MapSource;
-use crate::planner::Query;
-use crate::problem::scenarios::{self, Scenario};
+use aerial_chain::map::distance::DistanceField;
+use aerial_chain::map::grid::Grid;
+use aerial_chain::map::octomap::OcTree;
+use aerial_chain::plan::MapSource;
+use aerial_chain::planner::Query;
+use aerial_chain::problem::scenarios::{self, Scenario};
 
 /// Chain geometry options shared by every command that makes a chain.
 #[derive(Args, Debug, Clone)]
@@ -120,7 +120,7 @@ pub struct MapArgs {
 /// Why a plan cannot be trusted under the user's assumptions: it was made with
 /// unknown space free, and the user did not say `--unknown-free`. The checker's
 /// assumptions come from the person running it, never from the file under test.
-pub fn looser_assumption(plan: &crate::plan::Plan, map: &MapArgs) -> Option<String> {
+pub fn looser_assumption(plan: &aerial_chain::plan::Plan, map: &MapArgs) -> Option<String> {
     (!plan.map.unknown_is_occupied && !map.unknown_free).then(|| {
         "the plan was made with unknown space free (map.unknown_is_occupied: false), \
          but it is checked with unknown space occupied; give --unknown-free to check it \

@@ -8,10 +8,10 @@ use clap::{Args, Subcommand};
 use super::checks;
 use super::common::{ChainArgs, MapArgs, QueryArgs, Report};
 use super::{CliError, CliResult};
-use crate::baseline::{FullStatePrm, PrmError, PrmSettings};
-use crate::bench::{self, paper, robust, scale};
-use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
-use crate::planner::{motion, Planner, Termination};
+use crate::study::{self, paper, robust, scale};
+use aerial_chain::baseline::{FullStatePrm, PrmError, PrmSettings};
+use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
+use aerial_chain::planner::{motion, Planner, Termination};
 
 /// `arc bench ...`
 #[derive(Subcommand, Debug)]
@@ -240,7 +240,7 @@ fn meta(a: &StudyArgs, runs: usize) -> String {
 }
 
 fn write(dir: &std::path::Path, name: &str, text: &[u8]) -> Result<PathBuf, CliError> {
-    bench::write_out(dir, name, text).map_err(CliError::input)
+    study::write_out(dir, name, text).map_err(CliError::input)
 }
 
 fn run_paper(a: PaperArgs) -> CliResult {
@@ -291,11 +291,11 @@ fn run_paper(a: PaperArgs) -> CliResult {
         )));
     }
     let specs = paper::specs(&o);
-    let envs = bench::Envs::for_specs(&specs).map_err(CliError::input)?;
+    let envs = study::Envs::for_specs(&specs).map_err(CliError::input)?;
     let t = Instant::now();
-    let results = bench::run_all(&envs, &specs, a.study.threads, "arc bench paper", true)
+    let results = study::run_all(&envs, &specs, a.study.threads, "arc bench paper", true)
         .map_err(CliError::input)?;
-    let sums = bench::summarize(&results);
+    let sums = study::summarize(&results);
     let md = paper::markdown(
         &sums,
         &o,
@@ -307,11 +307,11 @@ fn run_paper(a: PaperArgs) -> CliResult {
     );
     let dir = &a.study.out_dir;
     let files = [
-        write(dir, "paper_runs.csv", bench::runs_csv(&results).as_bytes())?,
+        write(dir, "paper_runs.csv", study::runs_csv(&results).as_bytes())?,
         write(
             dir,
             "paper_summary.csv",
-            bench::summary_csv(&sums).as_bytes(),
+            study::summary_csv(&sums).as_bytes(),
         )?,
         write(dir, "paper.md", md.as_bytes())?,
     ];
@@ -362,11 +362,11 @@ fn run_scale(a: ScaleArgs) -> CliResult {
         }
     }
     let (specs, starts) = scale::specs(&o).map_err(CliError::input)?;
-    let envs = bench::Envs::for_specs(&specs).map_err(CliError::input)?;
+    let envs = study::Envs::for_specs(&specs).map_err(CliError::input)?;
     let t = Instant::now();
-    let results = bench::run_all(&envs, &specs, a.study.threads, "arc bench scale", true)
+    let results = study::run_all(&envs, &specs, a.study.threads, "arc bench scale", true)
         .map_err(CliError::input)?;
-    let sums = bench::summarize(&results);
+    let sums = study::summarize(&results);
     let md = scale::markdown(
         &sums,
         &o,
@@ -378,14 +378,15 @@ fn run_scale(a: ScaleArgs) -> CliResult {
         ),
     );
     let svg = scale::figure(&sums, o.corridor_units);
-    let png = crate::picture::rasterise(&svg).map_err(|e| CliError::failed(e.to_string()))?;
+    let png =
+        aerial_chain::picture::rasterise(&svg).map_err(|e| CliError::failed(e.to_string()))?;
     let dir = &a.study.out_dir;
     let files = [
-        write(dir, "scale_runs.csv", bench::runs_csv(&results).as_bytes())?,
+        write(dir, "scale_runs.csv", study::runs_csv(&results).as_bytes())?,
         write(
             dir,
             "scale_summary.csv",
-            bench::summary_csv(&sums).as_bytes(),
+            study::summary_csv(&sums).as_bytes(),
         )?,
         write(dir, "scale.md", md.as_bytes())?,
         write(dir, "scale.svg", svg.as_bytes())?,
@@ -461,7 +462,7 @@ fn run_robust(a: RobustArgs) -> CliResult {
     let svg = robust::figure(&results);
     let dir = &a.out_dir;
     let files = [
-        write(dir, "robust_runs.csv", bench::runs_csv(&results).as_bytes())?,
+        write(dir, "robust_runs.csv", study::runs_csv(&results).as_bytes())?,
         write(dir, "robust.md", md.as_bytes())?,
         write(dir, "robust.svg", svg.as_bytes())?,
     ];

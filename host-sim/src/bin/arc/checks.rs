@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use super::CliError;
-pub use crate::picture::PictureFormat;
+pub use aerial_chain::picture::PictureFormat;
 
 /// Longest `--time-limit` (s): about 11.6 days. Beyond it a limit means nothing, and
 /// far beyond it `Duration` cannot hold it.
@@ -136,7 +136,7 @@ mod tests {
         );
         for t in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e20] {
             let e = time_limit(Some(t)).unwrap_err();
-            assert_eq!(e.code, super::super::exit::BAD_INPUT);
+            assert_eq!(e.code, crate::exit::BAD_INPUT);
             assert!(e.message.starts_with("--time-limit "), "{}", e.message);
             assert!(e.message.contains("1e6"), "{}", e.message);
         }

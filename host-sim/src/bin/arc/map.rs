@@ -7,10 +7,10 @@ use std::time::Instant;
 use clap::{Args, Subcommand};
 
 use super::{CliError, CliResult};
-use crate::map::grid::Grid;
-use crate::map::octomap::OcTree;
-use crate::map::picture::{map_figure, MapPictureOptions};
-use crate::problem::scenarios::{self, Scenario};
+use aerial_chain::map::grid::Grid;
+use aerial_chain::map::octomap::OcTree;
+use aerial_chain::map::picture::{map_figure, MapPictureOptions};
+use aerial_chain::problem::scenarios::{self, Scenario};
 
 /// `arc map ...`
 #[derive(Subcommand, Debug)]
@@ -252,7 +252,7 @@ fn picture(a: PictureArgs) -> CliResult {
 
 #[cfg(test)]
 mod tests {
-    use super::super::run as arc;
+    use crate::run as arc;
 
     #[test]
     fn export_info_picture_round_trip() {
@@ -283,8 +283,8 @@ mod tests {
         ])
         .unwrap();
         let (from_ot, from_bt) = (
-            crate::map::octomap::OcTree::read_bt(&ot).unwrap(),
-            crate::map::octomap::OcTree::read_bt(&bt).unwrap(),
+            aerial_chain::map::octomap::OcTree::read_bt(&ot).unwrap(),
+            aerial_chain::map::octomap::OcTree::read_bt(&bt).unwrap(),
         );
         assert!(std::fs::read(&ot)
             .unwrap()

@@ -9,11 +9,14 @@ use std::process::ExitCode;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod bench;
-pub mod checks;
-pub mod common;
+mod checks;
+mod common;
+#[path = "../../fsutil.rs"]
+mod fsutil;
 mod map;
 mod plan;
 mod sim;
+mod study;
 mod tables;
 mod verify;
 
@@ -185,7 +188,7 @@ fn quiet_on_closed_pipe() {
 }
 
 /// Entry point of the `arc` binary.
-pub fn main() -> ExitCode {
+fn main() -> ExitCode {
     quiet_on_closed_pipe();
     match run(std::env::args_os()) {
         Ok(()) => ExitCode::SUCCESS,

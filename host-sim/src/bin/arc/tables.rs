@@ -12,8 +12,8 @@ use clap::{Args, Subcommand};
 use super::checks;
 use super::common::ChainArgs;
 use super::{CliError, CliResult};
-use crate::picture::{palette, Figure, Panel};
-use crate::tables::{ShapeTables, TableSettings};
+use aerial_chain::picture::{palette, Figure, Panel};
+use aerial_chain::tables::{ShapeTables, TableSettings};
 
 /// `arc tables ...`
 #[derive(Subcommand, Debug)]

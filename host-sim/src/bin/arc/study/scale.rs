@@ -13,7 +13,7 @@
 
 use std::fmt::Write as _;
 
-use crate::picture::{palette, Colour};
+use aerial_chain::picture::{palette, Colour};
 use aerial_chain_core::lsc::library;
 
 use super::plot::{self, Chart, Curve};

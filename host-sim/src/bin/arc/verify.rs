@@ -7,8 +7,8 @@ use clap::Args;
 use super::checks;
 use super::common::{looser_assumption, parse_point, MapArgs};
 use super::{CliError, CliResult};
-use crate::collision::verify_plan;
-use crate::plan::Plan;
+use aerial_chain::collision::verify_plan;
+use aerial_chain::plan::Plan;
 
 /// `arc verify`
 #[derive(Args, Debug)]
@@ -56,8 +56,8 @@ pub fn run(a: VerifyArgs) -> CliResult {
         crate::fsutil::input_name(&a.plan),
         plan.waypoints.len(),
         report.edges.len(),
-        report.edges.iter().filter(|e| **e == crate::collision::EdgeKind::Translation).count(),
-        report.edges.iter().filter(|e| **e == crate::collision::EdgeKind::ShapeChange).count(),
+        report.edges.iter().filter(|e| **e == aerial_chain::collision::EdgeKind::Translation).count(),
+        report.edges.iter().filter(|e| **e == aerial_chain::collision::EdgeKind::ShapeChange).count(),
         report.samples,
         if loaded.grid.unknown_is_occupied() { "occupied" } else { "free" }
     );

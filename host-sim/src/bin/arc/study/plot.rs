@@ -1,7 +1,7 @@
 //! Charts of the benchmark studies (time and success against a size), drawn with
-//! the project's [`crate::picture`] figures so they look like the other pictures.
+//! the project's [`aerial_chain::picture`] figures so they look like the other pictures.
 
-use crate::picture::{stroke, Axis, Colour, Figure, Panel};
+use aerial_chain::picture::{stroke, Axis, Colour, Figure, Panel};
 
 use super::Summary;
 
@@ -39,7 +39,7 @@ fn x_range(chart: &Chart) -> (f64, f64) {
         .curves
         .iter()
         .flat_map(|c| c.points.iter().map(|p| p.0));
-    match crate::picture::axis::finite_range(xs) {
+    match aerial_chain::picture::axis::finite_range(xs) {
         Some((lo, hi)) if hi > lo => {
             let pad = 0.04 * (hi - lo);
             (lo - pad, hi + pad)
@@ -128,7 +128,7 @@ pub fn success_pct(sums: &[&Summary], x: impl Fn(&Summary) -> f64) -> Vec<(f64, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::picture::palette;
+    use aerial_chain::picture::palette;
 
     #[test]
     fn draws_an_svg_even_with_gaps() {

@@ -11,11 +11,13 @@ use serde::Serialize;
 use super::checks;
 use super::common::{looser_assumption, MapArgs, Report};
 use super::{CliError, CliResult};
-use crate::plan::Plan;
-use crate::sim::clearance::{footprint, MapClearance};
-use crate::sim::flight::{simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig};
-use crate::sim::plot::flight_svg;
-use crate::sim::V3;
+use aerial_chain::plan::Plan;
+use aerial_chain::sim::clearance::{footprint, MapClearance};
+use aerial_chain::sim::flight::{
+    simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig,
+};
+use aerial_chain::sim::plot::flight_svg;
+use aerial_chain::sim::V3;
 
 /// `arc sim`
 #[derive(Args, Debug)]
@@ -249,7 +251,7 @@ pub fn run(a: SimArgs) -> CliResult {
         let obs = footprint(&loaded.grid, lo - band, hi + band);
         let title = format!("arc sim: {plan_name} on {}", a.map.name());
         let svg = flight_svg(&flight, &obs, &title);
-        crate::picture::save_svg(&svg, path).map_err(|e| CliError::input(e.to_string()))?;
+        aerial_chain::picture::save_svg(&svg, path).map_err(|e| CliError::input(e.to_string()))?;
         say(format_args!("  wrote {}", path.display()));
     }
     if let Some(why) = looser {

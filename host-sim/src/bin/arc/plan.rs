@@ -10,12 +10,12 @@ use clap::Args;
 use super::checks;
 use super::common::{ChainArgs, MapArgs, QueryArgs, Report};
 use super::{CliError, CliResult};
-use crate::collision::{CollisionContext, DEFAULT_CLEARANCE};
-use crate::planner::refine::{Quality, Refinement};
-use crate::planner::{
+use aerial_chain::collision::{CollisionContext, DEFAULT_CLEARANCE};
+use aerial_chain::planner::refine::{Quality, Refinement};
+use aerial_chain::planner::{
     motion, ArcPlanner, Mode, PlanError, Planner, Preference, Settings, Termination,
 };
-use crate::tables::{ShapeTables, TableSettings};
+use aerial_chain::tables::{ShapeTables, TableSettings};
 
 /// `arc plan`
 #[derive(Args, Debug)]
@@ -298,7 +298,7 @@ pub fn run(a: PlanArgs) -> CliResult {
     }
     if let Some(pic) = &a.picture {
         let grid = planner.context().field().grid();
-        crate::plan_picture::draw(
+        aerial_chain::plan_picture::draw(
             grid,
             &plan,
             &format!("ARCplanner on {}", a.map.name()),

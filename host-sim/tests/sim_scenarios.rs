@@ -12,7 +12,9 @@
 //! - the flown chain keeps a positive exact clearance and reaches the plan's goal.
 
 use aerial_chain::collision::DEFAULT_CLEARANCE;
-use arc_tests::{arc, s};
+mod support;
+
+use support::{arc_ok, s};
 
 fn plan_and_fly(scenario: &str, units: u8) {
     plan_and_fly_with(scenario, units, &[]);
@@ -35,8 +37,8 @@ fn plan_and_fly_with(scenario: &str, units: u8, flags: &[&str]) {
         s(&plan),
     ];
     args.extend_from_slice(flags);
-    arc(&args).unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
-    arc(&[
+    arc_ok(&args).unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
+    arc_ok(&[
         "sim",
         "--scenario",
         scenario,
@@ -122,9 +124,9 @@ fn bad_plans_are_input_errors() {
     let dir = tempfile::tempdir().expect("temporary directory");
     let bad = dir.path().join("bad.json");
     std::fs::write(&bad, "{\"format\": \"nope\"}").unwrap();
-    let e = arc(&["sim", "--scenario", "window", "--plan", s(&bad)]).unwrap_err();
-    assert_eq!(e.code, 2, "{}", e.message);
-    let e = arc(&[
+    let e = arc_ok(&["sim", "--scenario", "window", "--plan", s(&bad)]).unwrap_err();
+    assert_eq!(e.code, Some(2), "{}", e.message);
+    let e = arc_ok(&[
         "sim",
         "--scenario",
         "window",
@@ -132,9 +134,9 @@ fn bad_plans_are_input_errors() {
         s(&dir.path().join("missing.json")),
     ])
     .unwrap_err();
-    assert_eq!(e.code, 2);
-    let e = arc(&["sim", "--scenario", "nowhere", "--plan", s(&bad)]).unwrap_err();
-    assert_eq!(e.code, 2);
+    assert_eq!(e.code, Some(2));
+    let e = arc_ok(&["sim", "--scenario", "nowhere", "--plan", s(&bad)]).unwrap_err();
+    assert_eq!(e.code, Some(2));
 }
 
 #[test]
@@ -158,7 +160,7 @@ fn a_plan_into_a_wall_fails_with_exit_1() {
     };
     let path = dir.path().join("wall.json");
     plan.write(&path).unwrap();
-    let e = arc(&["sim", "--scenario", "window", "--plan", s(&path)]).unwrap_err();
-    assert_eq!(e.code, 1, "{}", e.message);
+    let e = arc_ok(&["sim", "--scenario", "window", "--plan", s(&path)]).unwrap_err();
+    assert_eq!(e.code, Some(1), "{}", e.message);
     assert!(e.message.contains("touched"), "{}", e.message);
 }

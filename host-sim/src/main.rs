@@ -1,4 +1,0 @@
-//! The `arc` command line. All logic lives in [`aerial_chain::cli`].
-fn main() -> std::process::ExitCode {
-    aerial_chain::cli::main()
-}
