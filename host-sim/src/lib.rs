@@ -15,5 +15,6 @@ pub mod picture;
 pub mod plan;
 pub mod plan_picture;
 pub mod planner;
+pub mod shape_index;
 pub mod sim;
 pub mod tables;
