@@ -164,9 +164,10 @@ impl ShapeIndex {
     /// exceeds `limit`.
     fn box_within(&self, node: &Node, q: &[f32], limit: f32) -> bool {
         let mut sum = 0.0;
-        for c in 0..self.dim {
-            let g = arc_gap(q[c], node.lo[c], node.hi[c]);
-            sum += self.weight[c] * g * g;
+        let boxes = node.lo.iter().zip(&node.hi).zip(&self.weight);
+        for (&qc, ((&lo, &hi), &w)) in q.iter().zip(boxes) {
+            let g = arc_gap(qc, lo, hi);
+            sum += w * g * g;
             if sum > limit {
                 return false;
             }
