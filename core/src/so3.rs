@@ -264,7 +264,7 @@ pub(crate) fn rotation_axis(e: &Mat3) -> Vec3 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use proptest::prelude::*;
 
@@ -343,13 +343,19 @@ mod tests {
         assert_eq!(exp_so3(&Vec3::new(inf, 0.0, 0.0)), Mat3::identity());
     }
 
-    #[test]
-    fn nearly_orthonormal_input_is_projected_close_to_the_rotation() {
-        // 1 % scale and shear errors: the projection is close to the true rotation.
+    /// A rotation and the same with 1 % scale and shear errors (the controller's tests
+    /// feed it too).
+    pub(crate) fn noisy_rotation() -> (Mat3, Mat3) {
         let r = from_euler_zyx(0.4, -0.3, 1.1);
-        let noisy = r + Mat3::new(
+        let noise = Mat3::new(
             0.01, -0.005, 0.008, 0.004, -0.01, 0.002, -0.006, 0.003, 0.009,
         );
+        (r, r + noise)
+    }
+
+    #[test]
+    fn nearly_orthonormal_input_is_projected_close_to_the_rotation() {
+        let (r, noisy) = noisy_rotation();
         let p = orthonormalize(&noisy);
         assert!(is_rotation(&p, 1e-5));
         assert!(rotation_angle(&(p.transpose() * r)) < 0.02);
