@@ -1,7 +1,10 @@
 //! Forward kinematics of the chain (paper Eq. 2, docs/model.md):
 //! `p_{i+1} = p_i - l * [cos(psi_i) cos(theta_i), sin(psi_i) cos(theta_i), -sin(theta_i)]`.
+//!
+//! The recurrence is written once, generic over the scalar ([`KinematicsScalar`]): the
+//! units run it in `f32`, the host's exact checks and simulation in `f64`.
 
-use nalgebra::Vector3;
+use nalgebra::{ComplexField, RealField, Vector3};
 
 use crate::params::{ChainParams, MAX_LINKS, MAX_UNITS};
 use crate::shape::{Config, Shape};
@@ -9,12 +12,38 @@ use crate::shape::{Config, Shape};
 /// Unit centres of a chain, head first; only the first N entries are meaningful.
 pub type Points = [Vector3<f32>; MAX_UNITS];
 
+/// A scalar the forward kinematics runs in, with the sine and cosine it uses.
+pub trait KinematicsScalar: RealField + Copy {
+    /// `(sin x, cos x)`.
+    fn sincos(self) -> (Self, Self);
+}
+
+impl KinematicsScalar for f32 {
+    /// libm's `sincosf`, so that every unit and the host compute the same bits.
+    fn sincos(self) -> (f32, f32) {
+        libm::sincosf(self)
+    }
+}
+
+impl KinematicsScalar for f64 {
+    /// nalgebra's `sin_cos`: on the host (with `std`) exactly `(x.sin(), x.cos())`.
+    fn sincos(self) -> (f64, f64) {
+        ComplexField::sin_cos(self)
+    }
+}
+
+/// Generic form of [`link_direction`]:
+/// `d = [cos yaw cos pitch, sin yaw cos pitch, -sin pitch]`.
+pub fn link_direction_of<T: KinematicsScalar>(pitch: T, yaw: T) -> Vector3<T> {
+    let (st, ct) = pitch.sincos();
+    let (sp, cp) = yaw.sincos();
+    Vector3::new(cp * ct, sp * ct, -st)
+}
+
 /// Unit vector along link `k` from its front unit towards its back unit is the
 /// NEGATIVE of this direction: `d = [cos psi cos theta, sin psi cos theta, -sin theta]`.
 pub fn link_direction(pitch: f32, yaw: f32) -> Vector3<f32> {
-    let (st, ct) = libm::sincosf(pitch);
-    let (sp, cp) = libm::sincosf(yaw);
-    Vector3::new(cp * ct, sp * ct, -st)
+    link_direction_of(pitch, yaw)
 }
 
 /// Every link's direction (see [`link_direction`]); only the first N-1 are meaningful.
@@ -26,9 +55,55 @@ pub fn directions(shape: &Shape) -> [Vector3<f32>; MAX_LINKS] {
     d
 }
 
+/// The chain recurrence `out[0] = head`, `out[k + 1] = out[k] - link_length * dirs[k]`,
+/// for as many links as `dirs` yields and `out` holds. Returns the number of unit
+/// centres written.
+pub fn chain_from_directions<T: KinematicsScalar>(
+    link_length: T,
+    head: Vector3<T>,
+    dirs: impl IntoIterator<Item = Vector3<T>>,
+    out: &mut [Vector3<T>],
+) -> usize {
+    let Some(first) = out.first_mut() else {
+        return 0;
+    };
+    *first = head;
+    let mut written = 1;
+    for d in dirs {
+        if written == out.len() {
+            break;
+        }
+        out[written] = out[written - 1] - d * link_length;
+        written += 1;
+    }
+    written
+}
+
+/// Unit centres from the head position and the shape angles `eta` (`2N - 1` numbers,
+/// docs/model.md's order: head yaw, then each link's pitch and yaw; the head yaw is not
+/// read), head first, written into `out`. Returns the number of unit centres written:
+/// `N`, or fewer when `out` is shorter.
+pub fn positions_into<T: KinematicsScalar>(
+    link_length: T,
+    head: Vector3<T>,
+    eta: &[T],
+    out: &mut [Vector3<T>],
+) -> usize {
+    let links = eta.len().saturating_sub(1) / 2;
+    let dirs = (0..links).map(|k| link_direction_of(eta[1 + 2 * k], eta[2 + 2 * k]));
+    chain_from_directions(link_length, head, dirs, out)
+}
+
 /// Unit centres relative to the head (`offsets[0]` is zero).
 pub fn offsets(params: &ChainParams, shape: &Shape) -> Points {
-    offsets_from(params, &directions(shape), shape.links())
+    let mut p = [Vector3::zeros(); MAX_UNITS];
+    positions_into(
+        params.link_length,
+        Vector3::zeros(),
+        shape.as_slice(),
+        &mut p,
+    );
+    p
 }
 
 /// Unit centres relative to the head from the first `links` link directions.
@@ -38,9 +113,12 @@ pub fn offsets_from(
     links: usize,
 ) -> Points {
     let mut p = [Vector3::zeros(); MAX_UNITS];
-    for k in 0..links {
-        p[k + 1] = p[k] - params.link_length * dirs[k];
-    }
+    chain_from_directions(
+        params.link_length,
+        Vector3::zeros(),
+        dirs.iter().take(links).copied(),
+        &mut p,
+    );
     p
 }
 

@@ -14,6 +14,7 @@
 //! - [`lsc`]: the library of shape configurations (LI, SE, SM, SV, CA, PN);
 //! - [`srs`]: the set of random shapes and its roadmap `G_SRS`;
 //! - [`table`]: the postcard shape-table format shared by host and units;
+//! - [`so3`]: rotations, the exponential map, attitude errors, desired attitudes;
 //! - [`control`]: the geometric SO(3) attitude controller.
 //!
 //! Everything is plain data and pure functions in `f32`: no I/O, no clocks, no
@@ -30,6 +31,7 @@ pub mod kinematics;
 pub mod lsc;
 pub mod params;
 pub mod shape;
+pub mod so3;
 pub mod srs;
 pub mod table;
 pub mod validity;

@@ -25,6 +25,10 @@ use crate::validity::{bend, check_transition};
 /// Neighbour list of one roadmap vertex (indices into the shape list).
 pub type Neighbours<const DEG: usize> = heapless::Vec<u16, DEG>;
 
+/// Roadmap candidates of one vertex: `(C_T^2, index)`, nearest first (see
+/// [`nearest_later`]).
+pub type Candidates<const DEG: usize> = heapless::Vec<(f32, u16), DEG>;
+
 /// Settings of the offline SRS build.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SrsSettings {
@@ -177,9 +181,9 @@ pub fn nearest_later<const DEG: usize>(
     i: usize,
     r_s: f32,
     later: impl Iterator<Item = usize>,
-) -> heapless::Vec<(f32, u16), DEG> {
+) -> Candidates<DEG> {
     let r2 = r_s * r_s;
-    let mut near: heapless::Vec<(f32, u16), DEG> = heapless::Vec::new();
+    let mut near: Candidates<DEG> = heapless::Vec::new();
     for j in later {
         // Only a shape nearer than the farthest kept one can enter: stop summing
         // its cost as soon as it cannot (the same costs, far fewer terms).

@@ -14,5 +14,6 @@ pub mod plan;
 pub mod plan_picture;
 pub mod planner;
 pub mod problem;
+mod shape_index;
 pub mod sim;
 pub mod tables;

@@ -7,11 +7,15 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use aerial_chain_core::lsc::LIMIT_MARGIN;
 use aerial_chain_core::lsc::{library, LscEntry, LscKind};
-use aerial_chain_core::srs::{nearest_later, Neighbours, Sampler, SrsError, SrsSettings};
+use aerial_chain_core::srs::{
+    nearest_later, Candidates, Neighbours, Sampler, SrsError, SrsSettings,
+};
 use aerial_chain_core::table::{encode_into, TableError, TableView};
 use aerial_chain_core::validity::{check_transition, Violation};
 use aerial_chain_core::{ChainParams, Shape};
 use rayon::prelude::*;
+
+use crate::shape_index::ShapeIndex;
 
 /// Roadmap degree the host builds `G_SRS` with.
 pub const DEGREE: usize = 12;
@@ -76,12 +80,48 @@ pub enum TablesError {
     },
 }
 
+/// How [`roadmap`] finds each shape's roadmap candidates. Both give the core's
+/// candidates bit for bit; they differ only in speed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CandidateSearch {
+    /// Shapes sorted by head yaw; each shape's later shapes within the head-yaw window
+    /// `C_T^2 >= N dpsi1_r^2` allows are all measured.
+    YawWindow,
+    /// A k-d tree over all angles ([`ShapeIndex`]): boxes that cannot hold a nearer
+    /// shape than those found so far are skipped.
+    KdTree,
+}
+
 /// `G_SRS` as the core's `build_roadmap` makes it, bit for bit, without comparing
-/// every pair: `C_T^2 >= N dpsi1_r^2`, so only shapes whose head yaw lies within
-/// `r_s / sqrt(N)` of a shape's can be its neighbours. Shapes are sorted by head yaw,
-/// each one's candidates are found in its window (in parallel: they are independent),
-/// then joined in order as the core's `connect` does.
-fn indexed_roadmap(params: &ChainParams, shapes: &[Shape], r_s: f32) -> Vec<Neighbours<DEGREE>> {
+/// every pair: each shape's candidates are found with `search` (in parallel: they are
+/// independent), then joined in order as the core's `connect` does.
+pub fn roadmap(
+    params: &ChainParams,
+    shapes: &[Shape],
+    r_s: f32,
+    search: CandidateSearch,
+) -> Vec<Neighbours<DEGREE>> {
+    let near = match search {
+        CandidateSearch::YawWindow => yaw_window_candidates(params, shapes, r_s),
+        CandidateSearch::KdTree => {
+            let index = ShapeIndex::new(shapes);
+            (0..shapes.len())
+                .into_par_iter()
+                .map(|i| index.nearest_later::<DEGREE>(shapes, i, r_s))
+                .collect()
+        }
+    };
+    join_candidates(params, shapes, &near)
+}
+
+/// The core's candidates of every shape, from a head-yaw window:
+/// `C_T^2 >= N dpsi1_r^2`, so only shapes whose head yaw lies within `r_s / sqrt(N)` of
+/// a shape's can be its neighbours.
+fn yaw_window_candidates(
+    params: &ChainParams,
+    shapes: &[Shape],
+    r_s: f32,
+) -> Vec<Candidates<DEGREE>> {
     let n = params.units as f32;
     // A little wider than the bound, for rounding in the core's angle differences.
     let w = (r_s * r_s / n).sqrt() * (1.0 + 1e-4) + 1e-5;
@@ -106,7 +146,7 @@ fn indexed_roadmap(params: &ChainParams, shapes: &[Shape], r_s: f32) -> Vec<Neig
         }
         v
     };
-    let near: Vec<_> = (0..shapes.len())
+    (0..shapes.len())
         .into_par_iter()
         .map(|i| {
             let mut later: Vec<usize> = Vec::new();
@@ -119,27 +159,44 @@ fn indexed_roadmap(params: &ChainParams, shapes: &[Shape], r_s: f32) -> Vec<Neig
             later.dedup();
             nearest_later::<DEGREE>(shapes, i, r_s, later.into_iter())
         })
-        .collect();
-    // The transition checks dominate and do not depend on the order: run them in
-    // parallel, then join in order exactly as the core's `connect` does.
-    let valid: Vec<Vec<bool>> = near
-        .par_iter()
-        .enumerate()
-        .map(|(i, near)| {
-            near.iter()
-                .map(|&(_, j)| {
-                    check_transition(params, &shapes[i], &shapes[j as usize], LIMIT_MARGIN).is_ok()
-                })
-                .collect()
-        })
-        .collect();
+        .collect()
+}
+
+/// Joins every shape to its candidates `near`, as the core's `connect` does.
+fn join_candidates(
+    params: &ChainParams,
+    shapes: &[Shape],
+    near: &[Candidates<DEGREE>],
+) -> Vec<Neighbours<DEGREE>> {
+    // The transition checks dominate. A pair is joined only while neither list is
+    // full, and a full list stays full: so block by block, check in parallel only the
+    // pairs whose lists both have room before the block, then join the block in order
+    // exactly as the core's `connect` does (a pair left unchecked is one it skips).
+    const BLOCK: usize = 2048;
     let mut adj = vec![Neighbours::<DEGREE>::new(); shapes.len()];
-    for (i, (near, valid)) in near.iter().zip(&valid).enumerate() {
-        for (&(_, j), &ok) in near.iter().zip(valid) {
-            let j = j as usize;
-            if ok && !adj[i].is_full() && !adj[j].is_full() {
-                let _ = adj[i].push(j as u16);
-                let _ = adj[j].push(i as u16);
+    for start in (0..shapes.len()).step_by(BLOCK) {
+        let end = (start + BLOCK).min(shapes.len());
+        let valid: Vec<Vec<Option<bool>>> = (start..end)
+            .into_par_iter()
+            .map(|i| {
+                near[i]
+                    .iter()
+                    .map(|&(_, j)| {
+                        let j = j as usize;
+                        (!adj[i].is_full() && !adj[j].is_full()).then(|| {
+                            check_transition(params, &shapes[i], &shapes[j], LIMIT_MARGIN).is_ok()
+                        })
+                    })
+                    .collect()
+            })
+            .collect();
+        for (i, valid) in (start..end).zip(valid) {
+            for (&(_, j), ok) in near[i].iter().zip(valid) {
+                let j = j as usize;
+                if !adj[i].is_full() && !adj[j].is_full() && ok == Some(true) {
+                    let _ = adj[i].push(j as u16);
+                    let _ = adj[j].push(i as u16);
+                }
             }
         }
     }
@@ -165,7 +222,12 @@ impl ShapeTables {
             srs.push(sampler.next_shape().map_err(TablesError::Srs)?);
             progress.store(i + 1, Ordering::Relaxed);
         }
-        let adj = indexed_roadmap(&params, &srs, settings.r_s.unwrap_or(defaults.r_s));
+        let adj = roadmap(
+            &params,
+            &srs,
+            settings.r_s.unwrap_or(defaults.r_s),
+            CandidateSearch::KdTree,
+        );
         Ok(Self {
             params,
             lsc: lib.entries.to_vec(),
@@ -268,18 +330,25 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_indexed_roadmap_is_the_cores_bit_for_bit() {
+    fn both_searches_give_the_cores_roadmap_bit_for_bit() {
         // Small N (narrow yaw windows, with wrap-around) and a larger one (windows
         // covering the circle), default and wide radii.
-        for (units, count, r_s) in [(3u8, 900, None), (3, 400, Some(1.2)), (6, 300, None)] {
+        for (units, count, r_s) in [
+            (3u8, 900, None),
+            (3, 400, Some(1.2)),
+            (6, 300, None),
+            (10, 150, None),
+        ] {
             let p = ChainParams::new(units);
             let mut sampler = Sampler::new(p, 7, 100_000);
             let shapes: Vec<Shape> = (0..count).map(|_| sampler.next_shape().unwrap()).collect();
             let r_s = r_s.unwrap_or(SrsSettings::new(units, count, 7).r_s);
             let mut core = vec![Neighbours::<DEGREE>::new(); count];
             aerial_chain_core::srs::build_roadmap(&p, &shapes, r_s, &mut core);
-            let host = indexed_roadmap(&p, &shapes, r_s);
-            assert_eq!(host, core, "N = {units}");
+            for search in [CandidateSearch::YawWindow, CandidateSearch::KdTree] {
+                let host = roadmap(&p, &shapes, r_s, search);
+                assert_eq!(host, core, "N = {units}, {search:?}");
+            }
             assert!(core.iter().map(|a| a.len()).sum::<usize>() > count);
         }
     }

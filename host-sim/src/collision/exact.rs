@@ -2,6 +2,7 @@
 //! verification. Independent of the distance field: the obstacle voxels near a body are
 //! enumerated from the [`Grid`] and measured one by one.
 
+use aerial_chain_core::kinematics::positions_into;
 use aerial_chain_core::validity::{check_shape, Body, Violation};
 use aerial_chain_core::{ChainParams, Shape};
 
@@ -174,19 +175,9 @@ pub fn nearest_obstacle(grid: &Grid, a: [f64; 3], b: [f64; 3], reach: f64) -> Op
 /// Unit centres of a chain in `f64` (paper Eq. 2), from a head position and the shape
 /// angles `eta` (`2N - 1` numbers; only the link pitches and yaws matter).
 pub fn positions_f64(link_length: f64, head: [f64; 3], eta: &[f64]) -> Vec<[f64; 3]> {
-    let links = eta.len().saturating_sub(1) / 2;
-    let mut p = Vec::with_capacity(links + 1);
-    p.push(head);
-    for k in 0..links {
-        let (th, ps) = (eta[1 + 2 * k], eta[2 + 2 * k]);
-        let q = p[k];
-        p.push([
-            q[0] - link_length * ps.cos() * th.cos(),
-            q[1] - link_length * ps.sin() * th.cos(),
-            q[2] + link_length * th.sin(),
-        ]);
-    }
-    p
+    let mut p = vec![nalgebra::Vector3::zeros(); eta.len().saturating_sub(1) / 2 + 1];
+    positions_into(link_length, head.into(), eta, &mut p);
+    p.into_iter().map(Into::into).collect()
 }
 
 /// Why a configuration is invalid by the exact test.

@@ -27,6 +27,7 @@
 //! nalgebra types the rest of the simulation uses.
 
 use aerial_chain_core::control::{step_attitude, AttitudeState, Mat3, Vec3};
+use aerial_chain_core::kinematics::{link_direction_of, positions_into};
 use nalgebra::{Matrix3, Vector3};
 use rapier3d::glamx::Vec3 as GVec3;
 use rapier3d::prelude::{MultibodyJointHandle, PhysicsWorld, RigidBodyHandle};
@@ -135,23 +136,14 @@ pub struct ChainDynamics {
 
 /// Unit centres of a configuration (`f64` forward kinematics, docs/model.md Eq. 2).
 pub fn unit_positions(l: f64, head: V3, eta: &[f64]) -> Vec<V3> {
-    let links = eta.len().saturating_sub(1) / 2;
-    let mut p = Vec::with_capacity(links + 1);
-    p.push(head);
-    for k in 0..links {
-        let q = p[k] - l * link_direction(eta[1 + 2 * k], eta[2 + 2 * k]);
-        p.push(q);
-    }
+    let mut p = vec![V3::zeros(); eta.len().saturating_sub(1) / 2 + 1];
+    positions_into(l, head, eta, &mut p);
     p
 }
 
 /// docs/model.md's link direction `[cos psi cos theta, sin psi cos theta, -sin theta]`.
 pub fn link_direction(pitch: f64, yaw: f64) -> V3 {
-    V3::new(
-        yaw.cos() * pitch.cos(),
-        yaw.sin() * pitch.cos(),
-        -pitch.sin(),
-    )
+    link_direction_of(pitch, yaw)
 }
 
 /// `Rz(yaw) Ry(pitch)`: a link's attitude with body x along its direction.
