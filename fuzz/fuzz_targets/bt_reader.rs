@@ -2,7 +2,7 @@
 //! survive a write/read round trip unchanged.
 #![no_main]
 
-use aerial_chain::map::octomap::OcTree;
+use aerial_chain::map::OcTree;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

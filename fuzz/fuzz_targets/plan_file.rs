@@ -7,7 +7,7 @@
 use std::sync::OnceLock;
 
 use aerial_chain::collision::verify_plan;
-use aerial_chain::map::grid::{Cell, Grid};
+use aerial_chain::map::{Cell, Grid};
 use aerial_chain::plan::Plan;
 use libfuzzer_sys::fuzz_target;
 

@@ -6,9 +6,9 @@ use std::hint::black_box;
 use std::sync::Arc;
 
 use aerial_chain::collision::CollisionContext;
-use aerial_chain::map::distance::DistanceField;
-use aerial_chain::map::grid::{Cell, Grid};
-use aerial_chain::map::octomap::OcTree;
+use aerial_chain::map::DistanceField;
+use aerial_chain::map::OcTree;
+use aerial_chain::map::{Cell, Grid};
 use aerial_chain_core::{ChainParams, Shape};
 use criterion::{criterion_group, criterion_main, Criterion};
 

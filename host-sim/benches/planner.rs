@@ -11,7 +11,7 @@ use std::time::Duration;
 
 use aerial_chain::baseline::{FullStatePrm, PrmSettings};
 use aerial_chain::collision::{CollisionContext, DEFAULT_CLEARANCE};
-use aerial_chain::map::distance::DistanceField;
+use aerial_chain::map::DistanceField;
 use aerial_chain::planner::{ArcPlanner, Planner, Query, Settings, Termination};
 use aerial_chain::problem::scenarios::{self, Scenario};
 use aerial_chain::tables::{ShapeTables, TableSettings};

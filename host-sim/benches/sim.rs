@@ -11,12 +11,12 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use aerial_chain::sim::dynamics::{ChainDynamics, Formulation, UnitCommand};
-use aerial_chain::sim::mpc::{HeadMpc, MpcConfig, MpcRef};
 use aerial_chain::sim::{
     simulate, ChainController, ChainModel, ControllerConfig, Reference, ReferenceLimits, SimConfig,
     V3,
 };
+use aerial_chain::sim::{ChainDynamics, Formulation, UnitCommand};
+use aerial_chain::sim::{HeadMpc, MpcConfig, MpcRef};
 use aerial_chain_core::ChainParams;
 use criterion::{criterion_group, criterion_main, Criterion};
 

@@ -199,7 +199,48 @@ pub enum PlanError {
         /// The file.
         path: String,
         /// The field and value at fault.
-        what: String,
+        what: FormatError,
+    },
+}
+
+/// A rule of the plan format (docs/model.md, "Plans") that a plan breaks; each names
+/// the field and the value at fault.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum FormatError {
+    /// Another format or version.
+    #[error("format = {0:?}, expected {FORMAT:?}")]
+    Format(String),
+    /// A unit count outside 2..=16.
+    #[error("chain.units = {0} is outside 2..=16")]
+    Units(u32),
+    /// Chain parameters that are no valid chain.
+    #[error("chain: {0}")]
+    Chain(aerial_chain_core::ParamError),
+    /// A map resolution that is not a positive number.
+    #[error("map.resolution = {0} must be a positive number")]
+    Resolution(f64),
+    /// A plan without waypoints.
+    #[error("waypoints is empty")]
+    NoWaypoints,
+    /// A waypoint of the wrong length for the chain.
+    #[error("waypoints[{index}].zeta has {got} numbers, expected {expected} for N = {units}")]
+    ZetaLength {
+        /// The waypoint.
+        index: usize,
+        /// Numbers it has.
+        got: usize,
+        /// Numbers a configuration of this chain has (`2N + 2`).
+        expected: usize,
+        /// The chain's units.
+        units: usize,
+    },
+    /// A waypoint number that is not finite.
+    #[error("waypoints[{index}].zeta[{at}] is not a finite number")]
+    NotFinite {
+        /// The waypoint.
+        index: usize,
+        /// The position of the number in `zeta`.
+        at: usize,
     },
 }
 
@@ -217,9 +258,9 @@ impl ChainSection {
     }
 
     /// The core parameters, validated.
-    pub fn to_params(&self) -> Result<ChainParams, String> {
+    pub fn to_params(&self) -> Result<ChainParams, FormatError> {
         if !(2..=16).contains(&self.units) {
-            return Err(format!("chain.units = {} is outside 2..=16", self.units));
+            return Err(FormatError::Units(self.units));
         }
         ChainParams {
             units: self.units as u8,
@@ -230,7 +271,7 @@ impl ChainSection {
             beta_max: self.beta_max as f32,
         }
         .validate()
-        .map_err(|e| format!("chain: {e}"))
+        .map_err(FormatError::Chain)
     }
 }
 
@@ -312,31 +353,29 @@ impl Plan {
     }
 
     /// Checks the format rules that do not need a map.
-    pub fn check(&self) -> Result<ChainParams, String> {
+    pub fn check(&self) -> Result<ChainParams, FormatError> {
         if self.format != FORMAT {
-            return Err(format!("format = {:?}, expected {FORMAT:?}", self.format));
+            return Err(FormatError::Format(self.format.clone()));
         }
         let params = self.chain.to_params()?;
         if !(self.map.resolution.is_finite() && self.map.resolution > 0.0) {
-            return Err(format!(
-                "map.resolution = {} must be a positive number",
-                self.map.resolution
-            ));
+            return Err(FormatError::Resolution(self.map.resolution));
         }
         if self.waypoints.is_empty() {
-            return Err("waypoints is empty".into());
+            return Err(FormatError::NoWaypoints);
         }
         let dim = 2 * params.n() + 2;
         for (i, w) in self.waypoints.iter().enumerate() {
             if w.zeta.len() != dim {
-                return Err(format!(
-                    "waypoints[{i}].zeta has {} numbers, expected {dim} for N = {}",
-                    w.zeta.len(),
-                    params.n()
-                ));
+                return Err(FormatError::ZetaLength {
+                    index: i,
+                    got: w.zeta.len(),
+                    expected: dim,
+                    units: params.n(),
+                });
             }
             if let Some(j) = w.zeta.iter().position(|v| !v.is_finite()) {
-                return Err(format!("waypoints[{i}].zeta[{j}] is not a finite number"));
+                return Err(FormatError::NotFinite { index: i, at: j });
             }
         }
         Ok(params)
@@ -463,12 +502,17 @@ mod tests {
         assert!(plan
             .check()
             .unwrap_err()
+            .to_string()
             .contains("waypoints[0].zeta has 7 numbers"));
         let mut plan = sample();
         plan.format = "x".into();
-        assert!(plan.check().unwrap_err().contains("format"));
+        assert!(plan.check().unwrap_err().to_string().contains("format"));
         let mut plan = sample();
         plan.chain.units = 40;
-        assert!(plan.check().unwrap_err().contains("chain.units = 40"));
+        assert!(plan
+            .check()
+            .unwrap_err()
+            .to_string()
+            .contains("chain.units = 40"));
     }
 }

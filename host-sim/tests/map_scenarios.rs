@@ -4,9 +4,9 @@
 use std::sync::Arc;
 
 use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
-use aerial_chain::map::distance::DistanceField;
-use aerial_chain::map::grid::Grid;
-use aerial_chain::map::octomap::OcTree;
+use aerial_chain::map::DistanceField;
+use aerial_chain::map::Grid;
+use aerial_chain::map::OcTree;
 use aerial_chain::problem::scenarios;
 use aerial_chain_core::ChainParams;
 
@@ -62,7 +62,7 @@ fn unknown_space_switch_matters_for_partial_maps() {
         for x in 20..40 {
             for y in 0..20 {
                 for z in 0..20 {
-                    grid.set([x, y, z], aerial_chain::map::grid::Cell::Unknown);
+                    grid.set([x, y, z], aerial_chain::map::Cell::Unknown);
                 }
             }
         }

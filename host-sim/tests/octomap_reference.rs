@@ -18,7 +18,7 @@ use std::process::Command;
 use std::sync::OnceLock;
 use std::time::Instant;
 
-use aerial_chain::map::octomap::OcTree;
+use aerial_chain::map::OcTree;
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/octomap")

@@ -41,11 +41,11 @@
 //! same answer on any machine and any number of threads (only the timings differ),
 //! unless the time limit cuts a run short.
 
-pub mod error;
-pub mod metric;
-pub mod roadmap;
-pub mod search;
-pub mod settings;
+pub(crate) mod error;
+pub(crate) mod metric;
+pub(crate) mod roadmap;
+pub(crate) mod search;
+pub(crate) mod settings;
 #[cfg(test)]
 mod tests;
 

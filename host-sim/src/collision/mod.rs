@@ -34,8 +34,8 @@
 //! also bounds the work per edge. Limits and self-collision along a shape change come
 //! from `aerial_chain_core::validity::check_transition`.
 
-pub mod exact;
-pub mod verify;
+pub(crate) mod exact;
+pub(crate) mod verify;
 
 use std::cell::RefCell;
 use std::fmt;

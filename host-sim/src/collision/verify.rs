@@ -14,11 +14,12 @@
 use std::f64::consts::{PI, TAU};
 
 use aerial_chain_core::validity::Body;
-use aerial_chain_core::ChainParams;
 
 use super::exact::{check_config_exact, ExactViolation};
 use crate::map::grid::Grid;
 use crate::plan::Plan;
+#[cfg(test)]
+use aerial_chain_core::ChainParams;
 
 /// Tolerance for "stays" when classifying an edge (docs/model.md).
 pub const STAY_TOLERANCE: f64 = 1e-9;
@@ -264,7 +265,7 @@ pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> Verif
         Err(e) => {
             rep.violation = Some(PlanViolation {
                 site: first,
-                problem: PlanProblem::Format(e),
+                problem: PlanProblem::Format(e.to_string()),
             });
             return rep;
         }
@@ -402,6 +403,7 @@ pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> Verif
 /// docs/model.md's sampling rule, including both ends. Returns the smallest clearance,
 /// or the first failing sample's fraction and violation (an edge that changes both parts
 /// fails at 0 with [`ExactViolation::BadShape`]).
+#[cfg(test)]
 pub fn check_edge_exact(
     grid: &Grid,
     params: &ChainParams,

@@ -1,5 +1,8 @@
 //! Maps: OctoMap files, occupancy grids and distance fields.
-pub mod distance;
-pub mod grid;
-pub mod octomap;
-pub mod picture;
+pub(crate) mod distance;
+pub(crate) mod grid;
+pub(crate) mod octomap;
+
+pub use distance::DistanceField;
+pub use grid::{Cell, Grid, GridError};
+pub use octomap::{MapFileError, OcTree};

@@ -13,11 +13,13 @@ use std::path::{Path, PathBuf};
 use svg::node::element::Rectangle;
 use svg::Document;
 
-pub mod axis;
-pub mod panel;
-pub mod style;
+pub(crate) mod axis;
+mod map;
+pub(crate) mod panel;
+pub(crate) mod style;
 
-pub use axis::Axis;
+pub use axis::{finite_range, Axis};
+pub use map::{map_figure, MapPictureOptions};
 pub use panel::Panel;
 pub use style::{palette, stroke, Colour};
 

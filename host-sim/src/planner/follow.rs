@@ -24,6 +24,7 @@ const PITCH_MARGIN: f32 = 0.02;
 /// Each unit goes to the point `l` from the unit before whose distance along the
 /// track is nearest to one link more: on a zig-zag track (a serpentine body laid
 /// down earlier) units stay on its corners instead of cutting across them.
+#[cfg(test)]
 pub fn lay_along(params: &ChainParams, track: &[Vector3<f32>]) -> Shape {
     lay(
         params,

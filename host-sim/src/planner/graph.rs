@@ -103,11 +103,6 @@ impl LazyGraph {
         self.edges.len()
     }
 
-    /// Whether the graph has no vertex.
-    pub fn is_empty(&self) -> bool {
-        self.edges.is_empty()
-    }
-
     /// The edges leaving `v`.
     pub fn edges(&self, v: VertexId) -> &[Edge] {
         &self.edges[v]

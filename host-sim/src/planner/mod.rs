@@ -18,20 +18,20 @@
 //!
 //! Both search their roadmaps with the one lazy graph search of [`graph`].
 
-pub mod arc;
-pub mod candidates;
+pub(crate) mod arc;
+pub(crate) mod candidates;
 mod checker;
-pub mod connect;
-pub mod construction;
+pub(crate) mod connect;
+pub(crate) mod construction;
 mod error;
-pub mod follow;
-pub mod graph;
-pub mod lattice;
-pub mod motion;
-pub mod refine;
-pub mod roadmap;
+pub(crate) mod follow;
+pub(crate) mod graph;
+pub(crate) mod lattice;
+pub(crate) mod motion;
+pub(crate) mod refine;
+pub(crate) mod roadmap;
 mod settings;
-pub mod srs_connect;
+pub(crate) mod srs_connect;
 
 use std::time::{Duration, Instant};
 
@@ -41,6 +41,8 @@ pub use arc::{ArcPlanner, Stats};
 pub use candidates::Source;
 pub use checker::Checker;
 pub use error::PlanError;
+pub use motion::{annotate_quality, source_label, to_plan};
+pub use refine::{Quality, Refinement};
 pub use settings::{Mode, Preference, Settings};
 
 use crate::collision::CollisionContext;

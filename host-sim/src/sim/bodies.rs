@@ -42,6 +42,18 @@ pub(super) fn from_glam_rotation(q: &GQuat) -> M3 {
     ])
 }
 
+/// The handles of a chain's bodies in the physics world.
+pub(super) struct ChainBodies {
+    /// Unit bodies (full formulation only; empty in the lumped one).
+    pub units: Vec<RigidBodyHandle>,
+    /// Link bodies, head end first.
+    pub links: Vec<RigidBodyHandle>,
+    /// The spherical joints.
+    pub joints: Vec<MultibodyJointHandle>,
+    /// Each link's centre of mass along its axis from its middle (m; lumped only).
+    pub link_com: Vec<f64>,
+}
+
 /// A dynamic body at `pos` turned by `rot` with mass properties `mprops`.
 pub(super) fn free_body(pos: &V3, rot: GQuat, mprops: MassProperties) -> RigidBody {
     RigidBodyBuilder::dynamic()
@@ -60,14 +72,7 @@ pub(super) fn build_full(
     p: &[V3],
     r_unit: &M3,
     link_rot: &[M3],
-) -> Result<
-    (
-        Vec<RigidBodyHandle>,
-        Vec<RigidBodyHandle>,
-        Vec<MultibodyJointHandle>,
-    ),
-    DynamicsError,
-> {
+) -> Result<ChainBodies, DynamicsError> {
     let n = p.len();
     let l = model.link_length();
     let half = (0.5 * l) as f32;
@@ -129,7 +134,12 @@ pub(super) fn build_full(
             .ok_or(DynamicsError::Joint(2 * k + 1))?;
         joints.push(h);
     }
-    Ok((units, links, joints))
+    Ok(ChainBodies {
+        link_com: vec![0.0; links.len()],
+        units,
+        links,
+        joints,
+    })
 }
 
 /// The lumped formulation's bodies: links carrying the units' masses, joined at the
@@ -139,7 +149,7 @@ pub(super) fn build_lumped(
     model: &ChainModel,
     p: &[V3],
     link_rot: &[M3],
-) -> Result<(Vec<RigidBodyHandle>, Vec<MultibodyJointHandle>, Vec<f64>), DynamicsError> {
+) -> Result<ChainBodies, DynamicsError> {
     let n = p.len();
     let half = (0.5 * model.link_length()) as f32;
     let (mut links, mut joints, mut link_com) =
@@ -171,7 +181,12 @@ pub(super) fn build_lumped(
             .ok_or(DynamicsError::Joint(k))?;
         joints.push(h);
     }
-    Ok((links, joints, link_com))
+    Ok(ChainBodies {
+        units: Vec::new(),
+        links,
+        joints,
+        link_com,
+    })
 }
 
 /// Mass properties of link `k`'s body in the lumped formulation: the tube, the unit at

@@ -32,7 +32,9 @@ use nalgebra::{Matrix3, Vector3};
 use rapier3d::glamx::Vec3 as GVec3;
 use rapier3d::prelude::{MultibodyJointHandle, PhysicsWorld, RigidBodyHandle};
 
-use super::bodies::{build_full, build_lumped, from_glam, from_glam_rotation, to_glam};
+use super::bodies::{
+    build_full, build_lumped, from_glam, from_glam_rotation, to_glam, ChainBodies,
+};
 use super::model::ChainModel;
 
 /// World-frame 3-vector in `f64`.
@@ -203,17 +205,15 @@ impl ChainDynamics {
         let link_rot: Vec<M3> = (0..n - 1)
             .map(|k| link_rotation(eta[1 + 2 * k], eta[2 + 2 * k]))
             .collect();
-        let (mut units, links, joints, mut link_com);
-        units = Vec::new();
-        link_com = vec![0.0; n - 1];
-        match formulation {
-            Formulation::Full => {
-                (units, links, joints) = build_full(&mut world, &model, &p, &r_unit, &link_rot)?;
-            }
-            Formulation::Lumped => {
-                (links, joints, link_com) = build_lumped(&mut world, &model, &p, &link_rot)?;
-            }
-        }
+        let ChainBodies {
+            units,
+            links,
+            joints,
+            link_com,
+        } = match formulation {
+            Formulation::Full => build_full(&mut world, &model, &p, &r_unit, &link_rot)?,
+            Formulation::Lumped => build_lumped(&mut world, &model, &p, &link_rot)?,
+        };
         // rapier gives every multibody angular degree of freedom a default damping of
         // 0.1 N m s/rad: larger than a unit's own inertia can ignore (it would couple
         // a unit's spin to its links through the joint). The joints here are ideal.

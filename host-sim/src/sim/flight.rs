@@ -643,13 +643,13 @@ impl Tally {
             .map(|k| (units[k].p - units[k + 1].p).normalize())
             .collect();
         let mut at_goal = (units[0].p - goal.head).norm() <= goal_tolerance;
-        for k in 0..n - 1 {
+        for (k, dir) in dirs.iter().enumerate() {
             let lr = &r.links[k];
-            let e = angle_between(&dirs[k], &super::dynamics::link_direction(lr.pitch, lr.yaw));
+            let e = angle_between(dir, &super::dynamics::link_direction(lr.pitch, lr.yaw));
             self.link_sq += e * e;
             self.link_count += 1;
             self.link_max = self.link_max.max(e);
-            at_goal &= angle_between(&dirs[k], &goal.link_dirs[k]) <= angle_tolerance;
+            at_goal &= angle_between(dir, &goal.link_dirs[k]) <= angle_tolerance;
         }
         self.observe_limits(&dirs, dt);
         self.observe_self_gap(units);

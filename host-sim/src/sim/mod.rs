@@ -11,14 +11,14 @@
 //! - [`plot`]: SVG plots of a flight.
 
 mod bodies;
-pub mod clearance;
-pub mod controller;
-pub mod dynamics;
-pub mod flight;
-pub mod model;
-pub mod mpc;
-pub mod plot;
-pub mod reference;
+pub(crate) mod clearance;
+pub(crate) mod controller;
+pub(crate) mod dynamics;
+pub(crate) mod flight;
+pub(crate) mod model;
+pub(crate) mod mpc;
+pub(crate) mod plot;
+pub(crate) mod reference;
 
 /// Simulation settings (controller, MPC, limits, model, run) outside their limits.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -41,10 +41,16 @@ pub enum SettingsError {
     },
 }
 
+pub use clearance::{footprint, MapClearance};
 pub use controller::{ChainController, ControllerConfig};
-pub use dynamics::{BodyState, ChainDynamics, V3};
-pub use flight::{simulate, Flight, FlightReport, Gust, Obstacles, SimConfig, SimError};
+pub use dynamics::{BodyState, ChainDynamics, Formulation, UnitCommand, V3};
+pub use flight::{
+    simulate, simulate_with_progress, Flight, FlightReport, Gust, Obstacles, Progress, Sample,
+    SimConfig, SimError,
+};
 pub use model::ChainModel;
+pub use mpc::{HeadMpc, MpcConfig, MpcRef};
+pub use plot::flight_svg;
 pub use reference::{Reference, ReferenceLimits};
 
 #[cfg(test)]

@@ -154,8 +154,6 @@ pub enum MpcError {
 pub struct HeadMpc {
     cfg: MpcConfig,
     solver: DefaultSolver<f64>,
-    /// Per-axis Hessian block (H x H, dense, symmetric), without the factor 2.
-    hess: Vec<f64>,
     /// Position and velocity sensitivities: p_k depends on a_j with `sp[k][j]`.
     sp: Vec<f64>,
     sv: Vec<f64>,
@@ -276,18 +274,12 @@ impl HeadMpc {
         Ok(Self {
             cfg,
             solver,
-            hess,
             sp,
             sv,
             wp,
             wv,
             q,
         })
-    }
-
-    /// The configuration.
-    pub fn config(&self) -> &MpcConfig {
-        &self.cfg
     }
 
     /// Solves for the head at position `p0` and velocity `v0`, tracking `refs` (one
@@ -363,11 +355,6 @@ impl HeadMpc {
             plan,
             iterations: sol.iterations,
         })
-    }
-
-    /// The per-axis Hessian block (for tests and diagnostics), row-major H x H.
-    pub fn hessian(&self) -> &[f64] {
-        &self.hess
     }
 }
 

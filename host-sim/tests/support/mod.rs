@@ -224,16 +224,16 @@ pub fn plan_verified(
 
 /// A map of two sealed rooms: free inside, walls around and between.
 pub fn sealed_rooms(dir: &Path) -> PathBuf {
-    let mut g = aerial_chain::map::grid::Grid::new(
+    let mut g = aerial_chain::map::Grid::new(
         0.1,
         [0, 0, 0],
         [80, 40, 30],
-        aerial_chain::map::grid::Cell::Free,
+        aerial_chain::map::Cell::Free,
         true,
     )
     .unwrap();
-    let wall = |g: &mut aerial_chain::map::grid::Grid, lo: [f64; 3], hi: [f64; 3]| {
-        g.fill_box(lo, hi, aerial_chain::map::grid::Cell::Occupied)
+    let wall = |g: &mut aerial_chain::map::Grid, lo: [f64; 3], hi: [f64; 3]| {
+        g.fill_box(lo, hi, aerial_chain::map::Cell::Occupied)
     };
     wall(&mut g, [0.0, 0.0, 0.0], [8.0, 4.0, 0.2]);
     wall(&mut g, [0.0, 0.0, 2.8], [8.0, 4.0, 3.0]);

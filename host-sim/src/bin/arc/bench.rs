@@ -11,7 +11,7 @@ use super::{CliError, CliResult};
 use crate::study::{self, paper, robust, scale};
 use aerial_chain::baseline::{FullStatePrm, PrmError, PrmSettings};
 use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
-use aerial_chain::planner::{motion, Planner, Termination};
+use aerial_chain::planner::{to_plan, Planner, Termination};
 
 /// `arc bench ...`
 #[derive(Subcommand, Debug)]
@@ -511,7 +511,7 @@ fn run_prm(a: PrmArgs) -> CliResult {
             ))
         }
     })?;
-    let mut plan = motion::to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
+    let mut plan = to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
     plan.map.source = source;
     let report = verify_plan(&grid, &plan);
     plan.write(&a.out)

@@ -9,9 +9,9 @@ use aerial_chain_core::{ChainParams, Shape};
 use clap::Args;
 
 use super::{checks, CliError};
-use aerial_chain::map::distance::DistanceField;
-use aerial_chain::map::grid::Grid;
-use aerial_chain::map::octomap::OcTree;
+use aerial_chain::map::DistanceField;
+use aerial_chain::map::Grid;
+use aerial_chain::map::OcTree;
 use aerial_chain::plan::MapSource;
 use aerial_chain::planner::Query;
 use aerial_chain::problem::scenarios::{self, Scenario};

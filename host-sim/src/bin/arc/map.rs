@@ -7,9 +7,9 @@ use std::time::Instant;
 use clap::{Args, Subcommand};
 
 use super::{CliError, CliResult};
-use aerial_chain::map::grid::Grid;
-use aerial_chain::map::octomap::OcTree;
-use aerial_chain::map::picture::{map_figure, MapPictureOptions};
+use aerial_chain::map::Grid;
+use aerial_chain::map::OcTree;
+use aerial_chain::picture::{map_figure, MapPictureOptions};
 use aerial_chain::problem::scenarios::{self, Scenario};
 
 /// `arc map ...`
@@ -283,8 +283,8 @@ mod tests {
         ])
         .unwrap();
         let (from_ot, from_bt) = (
-            aerial_chain::map::octomap::OcTree::read_bt(&ot).unwrap(),
-            aerial_chain::map::octomap::OcTree::read_bt(&bt).unwrap(),
+            aerial_chain::map::OcTree::read_bt(&ot).unwrap(),
+            aerial_chain::map::OcTree::read_bt(&bt).unwrap(),
         );
         assert!(std::fs::read(&ot)
             .unwrap()

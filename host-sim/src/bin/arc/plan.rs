@@ -11,10 +11,11 @@ use super::checks;
 use super::common::{ChainArgs, MapArgs, QueryArgs, Report};
 use super::{CliError, CliResult};
 use aerial_chain::collision::{CollisionContext, DEFAULT_CLEARANCE};
-use aerial_chain::planner::refine::{Quality, Refinement};
 use aerial_chain::planner::{
-    motion, ArcPlanner, Mode, PlanError, Planner, Preference, Settings, Termination,
+    annotate_quality, to_plan, ArcPlanner, Mode, PlanError, Planner, Preference, Settings,
+    Termination,
 };
+use aerial_chain::planner::{Quality, Refinement};
 use aerial_chain::tables::{ShapeTables, TableSettings};
 
 /// `arc plan`
@@ -249,8 +250,8 @@ pub fn run(a: PlanArgs) -> CliResult {
         (refined, Some(r))
     };
     let quality = Quality::of(&solution.steps);
-    let mut plan = motion::to_plan(&solution, &params, resolution, unknown_occ);
-    motion::annotate_quality(&mut plan, &quality, refinement.as_ref());
+    let mut plan = to_plan(&solution, &params, resolution, unknown_occ);
+    annotate_quality(&mut plan, &quality, refinement.as_ref());
     plan.map.source = source;
     plan.write(&a.out)
         .map_err(|e| CliError::input(e.to_string()))?;

@@ -12,12 +12,10 @@ use super::checks;
 use super::common::{looser_assumption, MapArgs, Report};
 use super::{CliError, CliResult};
 use aerial_chain::plan::Plan;
-use aerial_chain::sim::clearance::{footprint, MapClearance};
-use aerial_chain::sim::flight::{
-    simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig,
-};
-use aerial_chain::sim::plot::flight_svg;
+use aerial_chain::sim::flight_svg;
 use aerial_chain::sim::V3;
+use aerial_chain::sim::{footprint, MapClearance};
+use aerial_chain::sim::{simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig};
 
 /// `arc sim`
 #[derive(Args, Debug)]

@@ -85,8 +85,5 @@ mod voxels;
 #[cfg(test)]
 mod tests;
 
-pub use encode::{OT_FREE_LOG_ODDS, OT_OCCUPIED_LOG_ODDS};
 pub use error::MapFileError;
-pub use header::{MAX_RESOLUTION, MIN_RESOLUTION};
-pub use query::Leaf;
-pub use tree::{OcTree, TREE_DEPTH};
+pub use tree::OcTree;

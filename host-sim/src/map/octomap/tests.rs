@@ -2,6 +2,7 @@
 //! bit and child order, header parsing, round trips, pruning, and every way a file can
 //! be bad. The comparison with the real library is in `host-sim/tests/octomap_reference.rs`.
 
+use super::query::Leaf;
 use super::*;
 
 /// SplitMix64: small deterministic random numbers for tests.

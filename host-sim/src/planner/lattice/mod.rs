@@ -46,7 +46,6 @@ mod search;
 mod tests;
 
 pub use clearance::exact_clearance;
-pub use nodes::KeyHasher;
 
 use crate::collision::{CollisionContext, FK_TOLERANCE};
 use nodes::{KeyMap, Nodes};

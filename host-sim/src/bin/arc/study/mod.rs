@@ -34,9 +34,9 @@ use rayon::prelude::*;
 
 use aerial_chain::baseline::{FullStatePrm, PrmError, PrmSettings};
 use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
-use aerial_chain::map::distance::DistanceField;
+use aerial_chain::map::DistanceField;
 use aerial_chain::planner::{
-    motion, ArcPlanner, Failure, Mode, Planner, Settings, Solution, SolutionStats, Termination,
+    to_plan, ArcPlanner, Failure, Mode, Planner, Settings, Solution, SolutionStats, Termination,
 };
 use aerial_chain::problem::scenarios::{self, Scenario};
 use aerial_chain::tables::{ShapeTables, TableSettings};
@@ -298,7 +298,7 @@ pub fn build_scenario(name: &str) -> Result<Scenario, String> {
     sc.grid.fill_box(
         [4.0 + e, 3.0 - h + e, 1.5 - h + e],
         [4.2 - e, 3.0 + h - e, 1.5 + h - e],
-        aerial_chain::map::grid::Cell::Free,
+        aerial_chain::map::Cell::Free,
     );
     sc.name = name.to_string();
     sc.description = format!(
@@ -464,7 +464,7 @@ fn run_planner<P: Planner>(
             r.collision_s = Some(t.collision_s);
             r.search_s = Some((t.planning_s - t.collision_s).max(0.0));
             let g = &env.scenario.grid;
-            let plan = motion::to_plan(sol, &params, g.resolution(), g.unknown_is_occupied());
+            let plan = to_plan(sol, &params, g.resolution(), g.unknown_is_occupied());
             r.waypoints = Some(plan.waypoints.len());
             r.verified = Some(verify_plan(g, &plan).ok);
         }

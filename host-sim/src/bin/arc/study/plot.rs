@@ -39,7 +39,7 @@ fn x_range(chart: &Chart) -> (f64, f64) {
         .curves
         .iter()
         .flat_map(|c| c.points.iter().map(|p| p.0));
-    match aerial_chain::picture::axis::finite_range(xs) {
+    match aerial_chain::picture::finite_range(xs) {
         Some((lo, hi)) if hi > lo => {
             let pad = 0.04 * (hi - lo);
             (lo - pad, hi + pad)

@@ -5,7 +5,7 @@
 
 use crate::picture::{palette, Figure, Panel};
 
-use super::grid::{Cell, Grid};
+use crate::map::grid::{Cell, Grid};
 use crate::problem::scenarios::Scenario;
 
 /// What to draw.
