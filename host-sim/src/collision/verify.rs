@@ -18,7 +18,6 @@ use aerial_chain_core::validity::Body;
 use super::exact::{check_config_exact, ExactViolation};
 use crate::map::grid::Grid;
 use crate::plan::Plan;
-#[cfg(test)]
 use aerial_chain_core::ChainParams;
 
 /// Tolerance for "stays" when classifying an edge (docs/model.md).
@@ -270,37 +269,59 @@ pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> Verif
             return rep;
         }
     };
+    rep.notes = assumption_notes(grid, plan);
+    let mut v = Verifier {
+        grid,
+        params,
+        horizon: opts.horizon,
+        rep,
+    };
+    v.check(&plan.waypoints[0].zeta, first);
+    for (e, w) in plan.waypoints.windows(2).enumerate() {
+        v.check_edge(e, &w[0].zeta, &w[1].zeta);
+    }
+    let mut rep = v.rep;
+    rep.ok = rep.violation.is_none();
+    rep
+}
+
+/// Notes where the plan's own map assumptions differ from the map it is checked on
+/// (the check uses the caller's map; the notes only say so).
+fn assumption_notes(grid: &Grid, plan: &Plan) -> Vec<String> {
+    let mut notes = Vec::new();
     if (plan.map.resolution - grid.resolution()).abs() > 1e-9 {
-        rep.notes.push(format!(
+        notes.push(format!(
             "the plan was made for resolution {} m, the map has {} m",
             plan.map.resolution,
             grid.resolution()
         ));
     }
     if plan.map.unknown_is_occupied != grid.unknown_is_occupied() {
-        rep.notes.push(format!(
+        let word = |occupied: bool| if occupied { "occupied" } else { "free" };
+        notes.push(format!(
             "the plan assumed unknown space {}, this check treats it as {}",
-            if plan.map.unknown_is_occupied {
-                "occupied"
-            } else {
-                "free"
-            },
-            if grid.unknown_is_occupied() {
-                "occupied"
-            } else {
-                "free"
-            }
+            word(plan.map.unknown_is_occupied),
+            word(grid.unknown_is_occupied())
         ));
     }
-    let check = |rep: &mut VerifyReport, zeta: &[f64], site: Site| {
+    notes
+}
+
+/// The exact check of one plan, sample by sample, filling its report.
+struct Verifier<'a> {
+    grid: &'a Grid,
+    params: ChainParams,
+    horizon: f64,
+    rep: VerifyReport,
+}
+
+impl Verifier<'_> {
+    /// Checks one configuration; records the smallest clearance and the first violation.
+    fn check(&mut self, zeta: &[f64], site: Site) {
+        let rep = &mut self.rep;
         rep.samples += 1;
-        match check_config_exact(
-            grid,
-            &params,
-            [zeta[0], zeta[1], zeta[2]],
-            &zeta[3..],
-            opts.horizon,
-        ) {
+        let head = [zeta[0], zeta[1], zeta[2]];
+        match check_config_exact(self.grid, &self.params, head, &zeta[3..], self.horizon) {
             Ok(c) => {
                 if rep.min_clearance_at.is_none() || c.clearance < rep.min_clearance {
                     rep.min_clearance = c.clearance;
@@ -317,86 +338,62 @@ pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> Verif
                         rep.min_clearance_at = Some((site, body));
                     }
                 }
-                if rep.violation.is_none() {
-                    rep.violation = Some(PlanViolation {
-                        site,
-                        problem: PlanProblem::Invalid(v),
-                    });
-                }
+                self.flag(site, PlanProblem::Invalid(v));
             }
         }
-    };
-    check(&mut rep, &plan.waypoints[0].zeta, first);
-    for (e, w) in plan.waypoints.windows(2).enumerate() {
-        let (a, b) = (&w[0].zeta, &w[1].zeta);
+    }
+
+    /// Records `problem` at `site` unless an earlier violation is already recorded.
+    fn flag(&mut self, site: Site, problem: PlanProblem) {
+        if self.rep.violation.is_none() {
+            self.rep.violation = Some(PlanViolation { site, problem });
+        }
+    }
+
+    /// Checks edge `e` from `a` to `b` by docs/model.md's sampling rule (its start was
+    /// checked as the previous edge's end).
+    fn check_edge(&mut self, e: usize, a: &[f64], b: &[f64]) {
         let kind = classify_edge(a, b);
-        rep.edges.push(kind);
+        self.rep.edges.push(kind);
         let end = Site {
             waypoint: e + 1,
             edge: None,
             sample: 0,
             t: 1.0,
         };
+        let on_edge = |sample: usize, t: f64| Site {
+            waypoint: e,
+            edge: Some(e),
+            sample,
+            t,
+        };
         match kind {
-            EdgeKind::Stay => check(&mut rep, b, end),
+            EdgeKind::Stay => self.check(b, end),
             EdgeKind::Both => {
-                if rep.violation.is_none() {
-                    let site = Site {
-                        waypoint: e,
-                        edge: Some(e),
-                        sample: 0,
-                        t: 0.0,
-                    };
-                    rep.violation = Some(PlanViolation {
-                        site,
-                        problem: PlanProblem::BothChange,
-                    });
-                }
-                check(&mut rep, b, end);
+                self.flag(on_edge(0, 0.0), PlanProblem::BothChange);
+                self.check(b, end);
             }
             EdgeKind::Translation | EdgeKind::ShapeChange => {
-                let n = edge_intervals(kind, params.link_length as f64, a, b, grid.resolution());
+                let l = self.params.link_length as f64;
+                let n = edge_intervals(kind, l, a, b, self.grid.resolution());
                 if n > MAX_INTERVALS {
                     // Only a translation that leaves any real map gets here (a shape
                     // change moves no point more than 15 * l * 4.5 m): check its end,
                     // which is outside the bounds, instead of sampling for ever.
-                    let before = rep.violation.is_none();
-                    check(&mut rep, b, end);
-                    if before && rep.violation.is_none() {
-                        let site = Site {
-                            waypoint: e,
-                            edge: Some(e),
-                            sample: 0,
-                            t: 0.0,
-                        };
-                        let what = format!("the edge needs {n} samples, more than {MAX_INTERVALS}");
-                        rep.violation = Some(PlanViolation {
-                            site,
-                            problem: PlanProblem::Format(what),
-                        });
-                    }
-                    continue;
+                    self.check(b, end);
+                    let what = format!("the edge needs {n} samples, more than {MAX_INTERVALS}");
+                    self.flag(on_edge(0, 0.0), PlanProblem::Format(what));
+                    return;
                 }
                 for j in 1..=n {
                     let t = j as f64 / n as f64;
                     let z = edge_sample(kind, a, b, t);
-                    let site = if j == n {
-                        end
-                    } else {
-                        Site {
-                            waypoint: e,
-                            edge: Some(e),
-                            sample: j,
-                            t,
-                        }
-                    };
-                    check(&mut rep, &z, site);
+                    let site = if j == n { end } else { on_edge(j, t) };
+                    self.check(&z, site);
                 }
             }
         }
     }
-    rep.ok = rep.violation.is_none();
-    rep
 }
 
 /// Exact check of one edge `a -> b` (`zeta`s) on `grid` for chain `params`, by

@@ -155,6 +155,48 @@ pub fn run(a: SimArgs) -> CliResult {
     // plan's: a plan made with looser assumptions fails (docs/model.md).
     let looser = looser_assumption(&plan, &a.map);
     let loaded = a.map.load()?;
+    let cfg = sim_config(&a)?;
+    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
+    let obstacles = MapClearance::new(&loaded.grid, &params);
+    let flight = with_progress(|progress| {
+        simulate_with_progress(&params, &waypoints, &cfg, Some(&obstacles), progress)
+    })
+    .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
+    let r = &flight.report;
+    // With `--out -` the flight is standard output; the report goes to standard error.
+    let report = Report::new(a.out.as_deref().unwrap_or(Path::new("")));
+    let say = |args: std::fmt::Arguments<'_>| report.line(args);
+    say_report(&say, &plan_name, plan.waypoints.len(), r);
+    if let Some(path) = &a.out {
+        write_flight(path, &a, &plan_name, &flight)?;
+        if !crate::fsutil::is_stdio(path) {
+            say(format_args!("  wrote {}", path.display()));
+        }
+    }
+    if let Some(path) = &a.picture {
+        draw_flight(
+            path,
+            &flight,
+            &loaded.grid,
+            &params,
+            &format!("arc sim: {plan_name} on {}", a.map.name()),
+        )?;
+        say(format_args!("  wrote {}", path.display()));
+    }
+    if let Some(why) = looser {
+        return Err(CliError::failed(format!("{plan_name}: {why}")));
+    }
+    if r.success() {
+        return Ok(());
+    }
+    Err(CliError::failed(format!(
+        "{plan_name}: {}",
+        why_failed(r, cfg.settle_time)
+    )))
+}
+
+/// The simulation settings from the command line, checked.
+fn sim_config(a: &SimArgs) -> Result<SimConfig, CliError> {
     let gusts = a
         .gust
         .iter()
@@ -172,21 +214,21 @@ pub fn run(a: SimArgs) -> CliResult {
     cfg.limits.angular_rate = a.angular_rate_deg.to_radians();
     cfg.validate()
         .map_err(|e| CliError::input(format!("simulation settings: {e}")))?;
-    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
-    let obstacles = MapClearance::new(&loaded.grid, &params);
-    let flight = with_progress(|progress| {
-        simulate_with_progress(&params, &waypoints, &cfg, Some(&obstacles), progress)
-    })
-    .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
-    let r = &flight.report;
-    // With `--out -` the flight is standard output; the report goes to standard error.
-    let report = Report::new(a.out.as_deref().unwrap_or(Path::new("")));
-    let say = |args: std::fmt::Arguments<'_>| report.line(args);
+    Ok(cfg)
+}
+
+/// The flight's report, one line per measure.
+fn say_report(
+    say: &dyn Fn(std::fmt::Arguments<'_>),
+    plan_name: &str,
+    waypoints: usize,
+    r: &aerial_chain::sim::FlightReport,
+) {
     say(format_args!(
         "{}: N = {}, {} waypoints, plan {:.2} s, flown {:.2} s at {} Hz ({:.1}x real time, MPC {} solves, {} fallbacks)",
         plan_name,
         r.units,
-        plan.waypoints.len(),
+        waypoints,
         r.planned_duration,
         r.simulated_time,
         r.rate_hz,
@@ -220,45 +262,53 @@ pub fn run(a: SimArgs) -> CliResult {
         "  joint-limit excursions: pitch {:.3} deg, bend {:.3} deg, {:.3} s beyond",
         r.limits.max_pitch_excess_deg, r.limits.max_bend_excess_deg, r.limits.time_beyond
     ));
-    if let Some(path) = &a.out {
-        let file = SimFile {
-            format: "arc-sim/1",
-            plan: plan_name.clone(),
-            map: a.map.name(),
-            report: r,
-            record_every: a.record_every,
-            samples: flight.samples.iter().step_by(a.record_every).collect(),
-        };
-        let text = serde_json::to_string(&file)
-            .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
-        crate::fsutil::write_output(path, text.as_bytes())
-            .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
-        if !crate::fsutil::is_stdio(path) {
-            say(format_args!("  wrote {}", path.display()));
-        }
-    }
-    if let Some(path) = &a.picture {
-        let zs = flight
-            .samples
-            .iter()
-            .flat_map(|s| s.units.iter().map(|u| u.p[2] as f64));
-        let (lo, hi) = zs.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), z| {
-            (l.min(z), h.max(z))
-        });
-        let band = params.unit_radius as f64;
-        let obs = footprint(&loaded.grid, lo - band, hi + band);
-        let title = format!("arc sim: {plan_name} on {}", a.map.name());
-        let svg = flight_svg(&flight, &obs, &title);
-        aerial_chain::picture::save_svg(&svg, path).map_err(|e| CliError::input(e.to_string()))?;
-        say(format_args!("  wrote {}", path.display()));
-    }
-    if let Some(why) = looser {
-        return Err(CliError::failed(format!("{plan_name}: {why}")));
-    }
-    if r.success() {
-        return Ok(());
-    }
-    let why = if r.diverged {
+}
+
+/// Writes the flight (`arc-sim/1` JSON, every `--record-every`-th sample).
+fn write_flight(
+    path: &Path,
+    a: &SimArgs,
+    plan_name: &str,
+    flight: &aerial_chain::sim::Flight,
+) -> Result<(), CliError> {
+    let file = SimFile {
+        format: "arc-sim/1",
+        plan: plan_name.to_string(),
+        map: a.map.name(),
+        report: &flight.report,
+        record_every: a.record_every,
+        samples: flight.samples.iter().step_by(a.record_every).collect(),
+    };
+    let text = serde_json::to_string(&file)
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    crate::fsutil::write_output(path, text.as_bytes())
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))
+}
+
+/// Draws the flight over the map's footprint in the height band the chain flew.
+fn draw_flight(
+    path: &Path,
+    flight: &aerial_chain::sim::Flight,
+    grid: &aerial_chain::map::Grid,
+    params: &aerial_chain_core::ChainParams,
+    title: &str,
+) -> Result<(), CliError> {
+    let zs = flight
+        .samples
+        .iter()
+        .flat_map(|s| s.units.iter().map(|u| u.p[2] as f64));
+    let (lo, hi) = zs.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), z| {
+        (l.min(z), h.max(z))
+    });
+    let band = params.unit_radius as f64;
+    let obs = footprint(grid, lo - band, hi + band);
+    let svg = flight_svg(flight, &obs, title);
+    aerial_chain::picture::save_svg(&svg, path).map_err(|e| CliError::input(e.to_string()))
+}
+
+/// Why a flight that ran is not a success.
+fn why_failed(r: &aerial_chain::sim::FlightReport, settle_time: f64) -> String {
+    if r.diverged {
         "the flight diverged".to_string()
     } else if r.contact {
         format!(
@@ -270,8 +320,7 @@ pub fn run(a: SimArgs) -> CliResult {
     } else {
         format!(
             "the chain did not reach the goal within {:.1} s of the plan's end",
-            cfg.settle_time
+            settle_time
         )
-    };
-    Err(CliError::failed(format!("{plan_name}: {why}")))
+    }
 }

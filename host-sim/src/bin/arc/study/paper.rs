@@ -296,6 +296,15 @@ pub fn markdown(sums: &[Summary], o: &PaperOptions, meta: &str) -> String {
          median [first-third quartile]; shape changes median [min-max]. `verified`: successful \
          plans that pass the exact checker (`arc verify`).\n"
     );
+    ablation_tables(&mut s, sums, o);
+    table3(&mut s, sums, o);
+    speedup_lines(&mut s, sums, o);
+    profile_table(&mut s, sums);
+    s
+}
+
+/// Tables 1 and 2: the ablation (LSC, SRS, both) per chain size, paper beside ours.
+fn ablation_tables(s: &mut String, sums: &[Summary], o: &PaperOptions) {
     for (table, scenario, title) in [
         (
             "table1",
@@ -350,6 +359,10 @@ pub fn markdown(sums: &[Summary], o: &PaperOptions, meta: &str) -> String {
         }
         s.push('\n');
     }
+}
+
+/// Table 3: the full-state PRM against the ARCplanner, paper beside ours.
+fn table3(s: &mut String, sums: &[Summary], o: &PaperOptions) {
     let _ = writeln!(
         s,
         "## Table 3: full-state lazy PRM against the ARCplanner\n\n\
@@ -434,6 +447,10 @@ pub fn markdown(sums: &[Summary], o: &PaperOptions, meta: &str) -> String {
         }
     }
     s.push('\n');
+}
+
+/// One line per scenario and chain size: how much faster the ARCplanner is.
+fn speedup_lines(s: &mut String, sums: &[Summary], o: &PaperOptions) {
     for sp in speedups(sums, o) {
         let head = format!(
             "**{}, N = {}, {}:** the full-state PRM's best success rate is {} (M_F = {}), the ARCplanner's {}.",
@@ -469,6 +486,10 @@ pub fn markdown(sums: &[Summary], o: &PaperOptions, meta: &str) -> String {
         };
         let _ = writeln!(s, "{head}{body}\n");
     }
+}
+
+/// Where the ARCplanner's time goes: collision checks against the rest of the query.
+fn profile_table(s: &mut String, sums: &[Summary]) {
     let _ = writeln!(
         s,
         "## Profile: where the ARCplanner's time goes (successful runs, medians)\n\n\
@@ -512,5 +533,4 @@ pub fn markdown(sums: &[Summary], o: &PaperOptions, meta: &str) -> String {
             }
         );
     }
-    s
 }

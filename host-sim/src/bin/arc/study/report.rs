@@ -1,0 +1,165 @@
+//! Benchmark reports: runs and summaries as CSV, times and counts for markdown tables,
+//! and writing them into the output directory.
+
+use super::*;
+
+pub(super) fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+fn opt<T: ToString>(v: Option<T>) -> String {
+    v.map(|x| x.to_string()).unwrap_or_default()
+}
+
+/// One line per run.
+pub fn runs_csv(results: &[RunResult]) -> String {
+    let mut s = String::from(
+        "study,scenario,units,method,vertices,srs,seed,time_limit_s,start_x,start_y,start_z,success,outcome,\
+         tables_s,roadmap_s,planning_s,roadmap_cpu_s,planning_cpu_s,collision_s,search_s,shape_changes,edges,replans,srs_connects,\
+         iterations,collision_checks,roadmap_vertices,build_capped,waypoints,verified,message\n",
+    );
+    for r in results {
+        let p = &r.spec;
+        let start = p.query.map(|q| q.start);
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            csv_field(&p.study),
+            csv_field(&p.scenario),
+            p.units,
+            p.method.label(),
+            p.vertices,
+            p.srs,
+            p.seed,
+            opt(p.time_limit),
+            opt(start.map(|s| s[0])),
+            opt(start.map(|s| s[1])),
+            opt(start.map(|s| s[2])),
+            r.success,
+            r.outcome,
+            r.tables_s,
+            r.roadmap_s,
+            r.planning_s,
+            opt(r.roadmap_cpu_s.map(|x| format!("{x:.6}"))),
+            opt(r.planning_cpu_s.map(|x| format!("{x:.6}"))),
+            opt(r.collision_s.map(|x| format!("{x:.6}"))),
+            opt(r.search_s.map(|x| format!("{x:.6}"))),
+            opt(r.shape_changes),
+            opt(r.edges),
+            opt(r.replans),
+            opt(r.srs_connects),
+            opt(r.iterations),
+            opt(r.collision_checks),
+            r.roadmap_vertices,
+            r.build_capped,
+            opt(r.waypoints),
+            opt(r.verified),
+            csv_field(&r.message)
+        );
+    }
+    s
+}
+
+fn spread_cols(s: &Spread) -> String {
+    format!(
+        "{:.6},{:.6},{:.6},{:.6},{:.6}",
+        s.median, s.q1, s.q3, s.min, s.max
+    )
+}
+
+/// One line per group.
+pub fn summary_csv(sums: &[Summary]) -> String {
+    let mut s = String::from("study,scenario,units,method,vertices,srs,time_limit_s,runs,successes,success_rate,verified,time_limited");
+    for name in [
+        "roadmap_s",
+        "planning_s",
+        "planning_all_s",
+        "total_all_s",
+        "roadmap_cpu_s",
+        "planning_cpu_s",
+        "total_cpu_all_s",
+        "collision_s",
+        "search_s",
+        "shape_changes",
+    ] {
+        for q in ["median", "q1", "q3", "min", "max"] {
+            let _ = write!(s, ",{name}_{q}");
+        }
+    }
+    s.push('\n');
+    for g in sums {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{},{},{}",
+            csv_field(&g.study),
+            csv_field(&g.scenario),
+            g.units,
+            g.method.label(),
+            g.vertices,
+            g.srs,
+            opt(g.time_limit),
+            g.runs,
+            g.successes,
+            g.success_rate(),
+            g.verified,
+            g.time_limited,
+            spread_cols(&g.roadmap),
+            spread_cols(&g.planning),
+            spread_cols(&g.planning_all),
+            spread_cols(&g.total_all),
+            spread_cols(&g.roadmap_cpu),
+            spread_cols(&g.planning_cpu),
+            spread_cols(&g.total_cpu_all),
+            spread_cols(&g.collision),
+            spread_cols(&g.search),
+            spread_cols(&g.shape_changes)
+        );
+    }
+    s
+}
+
+/// `median [q1-q3]` in milliseconds, or `-` without values.
+pub fn ms(s: &Spread) -> String {
+    if s.n == 0 {
+        "-".into()
+    } else {
+        format!("{} [{}-{}]", fmt_ms(s.median), fmt_ms(s.q1), fmt_ms(s.q3))
+    }
+}
+
+/// A duration in milliseconds with 3 significant digits.
+pub fn fmt_ms(sec: f64) -> String {
+    let m = sec * 1e3;
+    if m >= 100.0 {
+        format!("{m:.0}")
+    } else if m >= 10.0 {
+        format!("{m:.1}")
+    } else {
+        format!("{m:.2}")
+    }
+}
+
+/// `median [min-max]` of a count, or `-`.
+pub fn count(s: &Spread) -> String {
+    if s.n == 0 {
+        "-".into()
+    } else {
+        format!("{} [{}-{}]", s.median, s.min, s.max)
+    }
+}
+
+/// Writes `name` under `dir` atomically (creating `dir`).
+pub fn write_out(
+    dir: &std::path::Path,
+    name: &str,
+    bytes: &[u8],
+) -> Result<std::path::PathBuf, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let p = dir.join(name);
+    crate::fsutil::write_atomic(&p, bytes).map_err(|e| format!("{}: {e}", p.display()))?;
+    Ok(p)
+}
