@@ -87,7 +87,7 @@ pub enum CandidateSearch {
     /// Shapes sorted by head yaw; each shape's later shapes within the head-yaw window
     /// `C_T^2 >= N dpsi1_r^2` allows are all measured.
     YawWindow,
-    /// A k-d tree over all angles ([`ShapeIndex`]): boxes that cannot hold a nearer
+    /// A k-d tree over all angles (`ShapeIndex`): boxes that cannot hold a nearer
     /// shape than those found so far are skipped.
     KdTree,
 }

@@ -15,7 +15,7 @@
 //!
 //! # Edges (docs/model.md "Motion between two configurations")
 //! The roadmap joins every vertex to its `k` nearest neighbours (and the relation is
-//! made symmetric) in the weighted zeta metric of [`metric`] (RMS displacement of the
+//! made symmetric) in the weighted zeta metric of `metric` (RMS displacement of the
 //! units, `C_T` weights, exact k-d tree), `k` by the PRM* rule
 //! `ceil(e (1 + 1/d) ln n)` with `d = 2N + 2` unless set ([`PrmSettings::k`]), as OMPL's
 //! LazyPRMstar. Moving along an edge `a -> b` means the paper's "change shape, then
@@ -33,9 +33,9 @@
 //! path passes, when no path is left (the roadmap is too sparse: failure), or at the
 //! time limit.
 //!
-//! The PRM is a [`Planner`]: [`Planner::setup`] builds the roadmap ([`roadmap`]),
-//! [`Planner::solve`] runs one query ([`search`]) over the lazy graph of
-//! [`crate::planner::graph`].
+//! The PRM is a [`Planner`]: [`Planner::setup`] builds the roadmap (`roadmap`),
+//! [`Planner::solve`] runs one query (`search`) over the lazy graph of
+//! `crate::planner::graph`.
 //!
 //! Deterministic: the same map, chain, settings and seed give the same roadmap and the
 //! same answer on any machine and any number of threads (only the timings differ),

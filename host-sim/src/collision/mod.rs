@@ -5,7 +5,7 @@
 //! - the FAST, CONSERVATIVE one in this module ([`CollisionContext`]), built on the
 //!   distance field's proven lower bounds, for the planner: it may reject a valid
 //!   configuration or edge, never accept an invalid one;
-//! - the EXACT one ([`exact`], [`verify`]), independent of the distance field, for
+//! - the EXACT one (`exact`, `verify`), independent of the distance field, for
 //!   verifying plans: exact point/segment-to-voxel-cube distances and docs/model.md's
 //!   edge sampling rule.
 //!

@@ -49,7 +49,7 @@ pub enum GridError {
     /// The bounds are not finite or are inverted.
     #[error("bounds {0:?} .. {1:?} are not a finite box")]
     Bounds([f64; 3], [f64; 3]),
-    /// The bounding box holds more than [`MAX_CELLS`] voxels at this resolution.
+    /// The bounding box holds more than `MAX_CELLS` voxels at this resolution.
     #[error(
         "the bounding box needs {} x {} x {} voxels, more than {MAX_CELLS}",
         .dims[0], .dims[1], .dims[2]

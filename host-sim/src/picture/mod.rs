@@ -3,9 +3,9 @@
 //! the `svg` crate) or PNG (the same SVG rasterised by `resvg`, text with the
 //! system's fonts).
 //!
-//! - [`style`]: colours, fonts and stroke widths;
-//! - [`axis`]: chart axes (linear or logarithmic) and their ticks;
-//! - [`panel`]: one framed plot area, map (equal scale) or chart (free scales);
+//! - `style`: colours, fonts and stroke widths;
+//! - `axis`: chart axes (linear or logarithmic) and their ticks;
+//! - `panel`: one framed plot area, map (equal scale) or chart (free scales);
 //! - here: the figure (title, panels, legend) and writing it out.
 
 use std::path::{Path, PathBuf};

@@ -47,7 +47,7 @@ pub struct Stats {
     pub srs_uses: usize,
     /// Follow-the-leader shapes used (one per short step).
     pub follow_uses: usize,
-    /// Shape changes that refinement made smaller ([`super::refine`]).
+    /// Shape changes that refinement made smaller (`super::refine`).
     pub shrunk: usize,
     /// SRSConnect calls.
     pub srs_connects: usize,
@@ -62,7 +62,7 @@ pub struct Stats {
     /// Head position at the start of the first edge flown at [`Self::min_margin`],
     /// when that is below the preferred clearance.
     pub min_margin_at: Option<[f64; 3]>,
-    /// Head route search ([`lattice`]): lattice points expanded (0: not used).
+    /// Head route search (`lattice`): lattice points expanded (0: not used).
     pub lattice_expanded: usize,
     /// Head route search time (s), part of the query time.
     pub lattice_s: f64,

@@ -23,7 +23,7 @@ pub enum Source {
     /// The chain laid back along the head's track (follow-the-leader).
     Follow,
     /// Part of the way to a shape the search chose, where refinement found that
-    /// enough ([`super::refine`]).
+    /// enough (`super::refine`).
     Shrunk,
     /// A configuration of the full-state PRM's roadmap ([`crate::baseline`]).
     Sampled,

@@ -10,13 +10,13 @@
 //! every planner through this trait alike.
 //!
 //! Two planners implement it:
-//! - [`ArcPlanner`], the paper's ARCplanner ([`arc`]): a lazy head roadmap
-//!   ([`roadmap`], [`lattice`]) and, per head edge, the cheapest shape that gets the
-//!   chain along it ([`construction`], [`connect`], [`candidates`], [`follow`],
-//!   [`srs_connect`]), then [`refine`];
+//! - [`ArcPlanner`], the paper's ARCplanner (`arc`): a lazy head roadmap
+//!   (`roadmap`, `lattice`) and, per head edge, the cheapest shape that gets the
+//!   chain along it (`construction`, `connect`, `candidates`, `follow`,
+//!   `srs_connect`), then `refine`;
 //! - the full-state PRM baseline, [`crate::baseline::FullStatePrm`].
 //!
-//! Both search their roadmaps with the one lazy graph search of [`graph`].
+//! Both search their roadmaps with the one lazy graph search of `graph`.
 
 pub(crate) mod arc;
 pub(crate) mod candidates;

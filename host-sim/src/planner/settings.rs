@@ -47,16 +47,16 @@ pub struct Settings {
     /// Times a failing query may double the roadmap and try again.
     pub max_growth: usize,
     /// How strongly head paths avoid passing close to obstacles (0: shortest paths,
-    /// as in the paper); see [`super::roadmap::Roadmap::build`].
+    /// as in the paper); see `super::roadmap::Roadmap::build`.
     pub clearance_weight: f64,
-    /// Step (m) of follow-the-leader motion ([`super::follow`]), tried after the library
+    /// Step (m) of follow-the-leader motion (`super::follow`), tried after the library
     /// and before SRSConnect; 0 turns it off (the paper's planner).
     pub follow_step: f64,
     /// Smallest clearance margin (m) the planner may give way to where a passage is
     /// narrower than the context's (preferred) clearance; 0 is docs/model.md's exact
     /// contract. Values above the preferred clearance are taken as it.
     pub clearance_min: f64,
-    /// Search a head route over the half-cell lattice of the map ([`super::lattice`]) and add
+    /// Search a head route over the half-cell lattice of the map (`super::lattice`) and add
     /// it to the roadmap before each query; off: the paper's uniform roadmap only.
     pub head_lattice: bool,
 }

@@ -352,7 +352,7 @@ pub enum SimError {
     /// The control stack cannot be built.
     #[error(transparent)]
     Controller(#[from] super::mpc::MpcError),
-    /// The flight would record more than [`MAX_RECORDED_BYTES`].
+    /// The flight would record more than `MAX_RECORDED_BYTES`.
     #[error("{0}")]
     Budget(String),
     /// The dynamics cannot be built.

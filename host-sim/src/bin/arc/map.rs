@@ -50,7 +50,7 @@ pub struct PictureArgs {
     /// The map (.bt or .ot); or give --scenario.
     #[arg(required_unless_present = "scenario", conflicts_with = "scenario")]
     pub file: Option<PathBuf>,
-    /// A built-in scenario instead of a file (window, maze, silos, corridor[:LENGTH]).
+    /// A built-in scenario instead of a file (window, maze, silos, corridor or corridor:LENGTH).
     #[arg(long)]
     pub scenario: Option<String>,
     /// Output picture: .svg or .png.

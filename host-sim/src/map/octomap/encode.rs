@@ -60,8 +60,8 @@ impl OcTree {
     /// The tree as a full `.ot` file (OctoMap's `AbstractOcTree::write`): per node, in
     /// depth-first order, its log-odds occupancy (`f32`, little-endian) and a byte of
     /// child-exists bits. The tree keeps only max-likelihood states, so a leaf is written
-    /// with OctoMap's default clamping bound for its state ([`OT_OCCUPIED_LOG_ODDS`],
-    /// [`OT_FREE_LOG_ODDS`]) and an inner node with the largest value below it, as
+    /// with OctoMap's default clamping bound for its state (`OT_OCCUPIED_LOG_ODDS`,
+    /// `OT_FREE_LOG_ODDS`) and an inner node with the largest value below it, as
     /// OctoMap's `updateInnerOccupancy` sets it. Reading the file gives this tree back.
     pub fn to_ot_bytes(&self) -> Vec<u8> {
         let header = header_text(Kind::Full, self.stats.nodes, self.resolution);
