@@ -163,6 +163,22 @@ fn cases() -> Vec<Case> {
         },
         Case {
             base: &[
+                "view",
+                "--scenario",
+                "window",
+                "--plan",
+                "hover.json",
+                "--out",
+                "v.html",
+            ],
+            flags: vec![
+                flag("--goal-tol", F64_MAX, "oxxxxx"),
+                flag("--near", F64_MAX, "xxxxxx"),
+                flag("--max-boxes", USIZE_MAX, "xxxxxx"),
+            ],
+        },
+        Case {
+            base: &[
                 "bench",
                 "prm",
                 "--scenario",

@@ -296,6 +296,19 @@ pub fn start_shape(params: &ChainParams, name: &str, yaw: f32) -> Result<Shape, 
         .rotated(aerial_chain_core::angle::diff(e.shape.head_yaw(), yaw)))
 }
 
+/// Reads a plan file (`-`: standard input) and checks it: the plan, its name for
+/// messages, and its chain's parameters.
+pub fn read_plan(
+    path: &std::path::Path,
+) -> Result<(aerial_chain::plan::Plan, String, ChainParams), CliError> {
+    let plan = aerial_chain::plan::Plan::read(path).map_err(|e| CliError::input(e.to_string()))?;
+    let name = crate::fsutil::input_name(path);
+    let params = plan
+        .check()
+        .map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    Ok((plan, name, params))
+}
+
 /// Parses `x,y,z`.
 pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
     let v: Vec<&str> = s.split(',').map(str::trim).collect();

@@ -19,6 +19,7 @@ mod sim;
 mod study;
 mod tables;
 mod verify;
+mod view;
 
 /// The exit-code table of every subcommand, the one place that defines it
 /// (docs/promises.md repeats it for users).
@@ -108,6 +109,15 @@ enum Command {
         after_help = "Example:\n  arc sim --scenario window --plan window.json --picture flight.svg"
     )]
     Sim(sim::SimArgs),
+    /// Write one HTML page with a 3D view of a plan (and a flight) on its map.
+    ///
+    /// The page opens from disk in a browser, offline. Waypoint times are those `arc sim`
+    /// flies with its default limits; a flight keeps its own times. `view.html#t=3.5`
+    /// opens at 3.5 s.
+    #[command(
+        after_help = "Examples:\n  arc view --scenario window --plan window.json --out view.html\n  arc sim --scenario window --plan window.json --out flight.json\n  arc view --scenario window --plan window.json --flight flight.json --out view.html"
+    )]
+    View(view::ViewArgs),
 }
 
 /// The command line, where every option that takes a value takes a negative number
@@ -172,6 +182,7 @@ where
         Command::Map(c) => map::run(c),
         Command::Bench(c) => bench::run(c),
         Command::Sim(a) => sim::run(a),
+        Command::View(a) => view::run(a),
     }
 }
 

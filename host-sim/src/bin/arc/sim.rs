@@ -9,9 +9,8 @@ use clap::Args;
 use serde::Serialize;
 
 use super::checks;
-use super::common::{looser_assumption, MapArgs, Report};
+use super::common::{looser_assumption, read_plan, MapArgs, Report};
 use super::{CliError, CliResult};
-use aerial_chain::plan::Plan;
 use aerial_chain::sim::flight_svg;
 use aerial_chain::sim::V3;
 use aerial_chain::sim::{footprint, MapClearance};
@@ -146,11 +145,7 @@ fn check(a: &SimArgs) -> Result<(), CliError> {
 /// the map or itself.
 pub fn run(a: SimArgs) -> CliResult {
     check(&a)?;
-    let plan = Plan::read(&a.plan).map_err(|e| CliError::input(e.to_string()))?;
-    let plan_name = crate::fsutil::input_name(&a.plan);
-    let params = plan
-        .check()
-        .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
+    let (plan, plan_name, params) = read_plan(&a.plan)?;
     // The flight is judged under the user's assumption about unknown space, never the
     // plan's: a plan made with looser assumptions fails (docs/model.md).
     let looser = looser_assumption(&plan, &a.map);
