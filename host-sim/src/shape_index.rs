@@ -56,8 +56,13 @@ pub struct ShapeIndex {
     weight: Vec<f32>,
     /// Wrapped angles of shape `i` at `coords[i * dim..(i + 1) * dim]`.
     coords: Vec<f32>,
-    /// Shape indices, grouped by leaf.
+    /// Shape indices, grouped by leaf, ascending within a leaf (so a search skips a
+    /// leaf's shapes at or before its own with one binary search).
     order: Vec<usize>,
+    /// The same angles leaf by leaf, coordinate-major: the leaf of `order[start..end]`
+    /// holds coordinate `c` of its shapes at `start * dim + c * (end - start)..`, so
+    /// a leaf is screened one coordinate at a time over contiguous memory.
+    leaf_coords: Vec<f32>,
     nodes: Vec<Node>,
 }
 
@@ -103,6 +108,7 @@ impl ShapeIndex {
             weight,
             coords,
             order: (0..shapes.len()).collect(),
+            leaf_coords: vec![0.0; shapes.len() * dim],
             nodes: Vec::new(),
         };
         if !shapes.is_empty() {
@@ -135,6 +141,7 @@ impl ShapeIndex {
             split: 0.0,
         });
         if end - start <= LEAF {
+            self.lay_out_leaf(start, end);
             return at;
         }
         // Split the coordinate that spreads the most in the metric, at its median.
@@ -159,6 +166,18 @@ impl ShapeIndex {
         at
     }
 
+    /// Sorts the leaf `order[start..end]` by index and copies its angles into
+    /// `leaf_coords`, coordinate-major.
+    fn lay_out_leaf(&mut self, start: usize, end: usize) {
+        self.order[start..end].sort_unstable();
+        let (dim, len) = (self.dim, end - start);
+        for (k, &i) in self.order[start..end].iter().enumerate() {
+            for c in 0..dim {
+                self.leaf_coords[start * dim + c * len + k] = self.coords[i * dim + c];
+            }
+        }
+    }
+
     /// Whether a shape in `node` may lie within `limit` in `C_T^2` of the shape with
     /// angles `q`: the box's lower bound, summed heaviest coordinates first until it
     /// exceeds `limit`.
@@ -175,21 +194,36 @@ impl ShapeIndex {
         true
     }
 
-    /// Whether shape `j` may lie within `limit` in `C_T^2` of the shape with angles
-    /// `q`: its angles' circular distances, weighted, without the core's exact
-    /// wrapping (the core then measures the shapes this lets through).
-    fn point_within(&self, j: usize, q: &[f32], limit: f32) -> bool {
-        let x = &self.coords[j * self.dim..(j + 1) * self.dim];
-        let mut sum = 0.0;
-        for c in 0..self.dim {
-            let d = (q[c] - x[c]).abs();
-            let g = d.min(TAU - d);
-            sum += self.weight[c] * g * g;
-            if sum > limit {
-                return false;
+    /// Offers to `near` the shapes of the leaf `order[start..end]` after the query's
+    /// that may lie within its bound: each shape's weighted circular distances to
+    /// the query, summed over all coordinates at once (a loop the compiler
+    /// vectorises), without the core's exact wrapping (the core then measures the
+    /// shapes this lets through).
+    fn screen_leaf<const DEG: usize>(
+        &self,
+        (start, end): (usize, usize),
+        search: &Search<'_>,
+        near: &mut Candidates<DEG>,
+    ) {
+        let ids = &self.order[start..end];
+        let first = ids.partition_point(|&j| j <= search.i);
+        let len = end - start;
+        let block = &self.leaf_coords[start * self.dim..end * self.dim];
+        let mut sums = [0.0f32; LEAF];
+        let sums = &mut sums[..len - first];
+        for (c, (&w, &q)) in self.weight.iter().zip(search.q).enumerate() {
+            let xs = &block[c * len + first..(c + 1) * len];
+            for (sum, &x) in sums.iter_mut().zip(xs) {
+                let d = (q - x).abs();
+                let g = if d > PI { TAU - d } else { d };
+                *sum += w * g * g;
             }
         }
-        true
+        for (&sum, &j) in sums.iter().zip(&ids[first..]) {
+            if sum <= loosened(search.bound(near)) {
+                search.offer(j, near);
+            }
+        }
     }
 
     /// The roadmap candidates of `shapes[i]` (the shapes this index was built from):
@@ -223,14 +257,7 @@ impl ShapeIndex {
             return;
         }
         match node.kind {
-            NodeKind::Leaf { start, end } => {
-                for &j in &self.order[start..end] {
-                    if j > search.i && self.point_within(j, search.q, loosened(search.bound(near)))
-                    {
-                        search.offer(j, near);
-                    }
-                }
-            }
+            NodeKind::Leaf { start, end } => self.screen_leaf((start, end), search, near),
             NodeKind::Inner { left, right } => {
                 // The child on the query's side of the split first: it likely holds
                 // the nearest shapes, which shrink the bound for the other.
