@@ -3,17 +3,13 @@
 //! `arc verify --plan -` reads it from standard input, so the two pipe together.
 
 use std::io::Write;
-use std::process::{Command, Output, Stdio};
+use std::process::{Output, Stdio};
+mod support;
 
 /// Runs the `arc` binary with `args`, feeding `input` to its standard input.
 fn arc(args: &[&str], input: &[u8]) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_arc"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("arc starts");
+    let mut command = support::arc(args, &std::env::temp_dir());
+    let mut child = support::spawn(command.stdin(Stdio::piped()));
     child
         .stdin
         .take()

@@ -380,6 +380,22 @@ fn scene(origin: [i32; 3], seed: u64) -> Vec<([i32; 3], bool)> {
     v
 }
 
+/// Runs the OctoMap checker's `report` on `files` (a tree, points, maybe a file to
+/// rewrite the tree to); `what` names the tree file in failures.
+fn octomap_report(checker: &Path, files: &[&Path], name: &str, what: &str) -> Report {
+    let out = Command::new(checker)
+        .arg("report")
+        .args(files)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{name}: OctoMap refused {what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    parse_report(&String::from_utf8_lossy(&out.stdout), name)
+}
+
 #[test]
 fn octomap_reads_what_we_write() {
     let checker = checker()
@@ -423,19 +439,7 @@ fn octomap_reads_what_we_write() {
             .map(|p| format!("{} {} {}\n", p[0], p[1], p[2]))
             .collect();
         std::fs::write(&points_file, text).unwrap();
-        let out = Command::new(checker)
-            .arg("report")
-            .arg(&bt)
-            .arg(&points_file)
-            .arg(&rewrite)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{name}: OctoMap refused our file: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let report = parse_report(&String::from_utf8_lossy(&out.stdout), name);
+        let report = octomap_report(checker, &[&bt, &points_file, &rewrite], name, "our file");
         assert_eq!(
             report.queries.len(),
             pts.len(),
@@ -462,18 +466,7 @@ fn octomap_reads_what_we_write() {
         // The same tree as a full .ot file, read by OctoMap's AbstractOcTree::read.
         let ot = dir.path().join(format!("{name}.ot"));
         tree.write_ot(&ot).unwrap();
-        let out = Command::new(checker)
-            .arg("report")
-            .arg(&ot)
-            .arg(&points_file)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{name}: OctoMap refused our .ot file: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let report = parse_report(&String::from_utf8_lossy(&out.stdout), name);
+        let report = octomap_report(checker, &[&ot, &points_file], name, "our .ot file");
         assert_matches(
             tree,
             &report,

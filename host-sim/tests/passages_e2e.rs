@@ -8,7 +8,7 @@ use aerial_chain::problem::passages::{witness, PassageSpec};
 use aerial_chain::problem::scenarios;
 mod support;
 
-use support::{arc_ok, plan_verified, s, sealed_rooms};
+use support::{plan_across_sealed_rooms, plan_verified};
 
 /// Plans `scenario` with default flags, verifies exactly; returns the plan.
 fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
@@ -43,26 +43,7 @@ fn family_names_parse_and_build() {
 #[test]
 fn a_map_cut_in_two_exits_1_with_the_reason_whatever_max_growth_says() {
     let dir = tempfile::tempdir().unwrap();
-    let map = sealed_rooms(dir.path());
-    let out = dir.path().join("p.json");
-    let e = arc_ok(&[
-        "plan",
-        "--map",
-        s(&map),
-        "--units",
-        "4",
-        "--start",
-        "3,2,1.5",
-        "--start-yaw-deg",
-        "0",
-        "--goal",
-        "6,2,1.5",
-        "--max-growth",
-        "8",
-        "--out",
-        s(&out),
-    ])
-    .unwrap_err();
+    let (e, out) = plan_across_sealed_rooms(dir.path(), &["--max-growth", "8"]);
     assert_eq!(e.code, Some(1), "{e}");
     assert!(e.message.contains("separate free regions"), "{e}");
     assert!(!out.exists());

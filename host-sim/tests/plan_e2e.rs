@@ -9,7 +9,9 @@ use aerial_chain::plan::Plan;
 use aerial_chain::problem::scenarios;
 mod support;
 
-use support::{arc_ok, plan_verified, s, sealed_rooms};
+use support::{
+    arc_ok, assert_verified_to_goal, plan_across_sealed_rooms, plan_scenario, plan_verified, s,
+};
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().expect("temporary directory")
@@ -46,36 +48,32 @@ fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
     plan
 }
 
-#[test]
-fn window_plans_verify() {
+/// Plans and verifies `scenario` for N = 4, 5 and 6.
+fn plans_verify_for_4_to_6_units(scenario: &str) {
     let dir = tmp();
     for n in [4, 5, 6] {
-        plan_and_verify("window", n, dir.path());
+        plan_and_verify(scenario, n, dir.path());
     }
+}
+
+#[test]
+fn window_plans_verify() {
+    plans_verify_for_4_to_6_units("window");
 }
 
 #[test]
 fn maze_plans_verify() {
-    let dir = tmp();
-    for n in [4, 5, 6] {
-        plan_and_verify("maze", n, dir.path());
-    }
+    plans_verify_for_4_to_6_units("maze");
 }
 
 #[test]
 fn silos_plans_verify() {
-    let dir = tmp();
-    for n in [4, 5, 6] {
-        plan_and_verify("silos", n, dir.path());
-    }
+    plans_verify_for_4_to_6_units("silos");
 }
 
 #[test]
 fn corridor_plans_verify() {
-    let dir = tmp();
-    for n in [4, 5, 6] {
-        plan_and_verify("corridor", n, dir.path());
-    }
+    plans_verify_for_4_to_6_units("corridor");
 }
 
 #[test]
@@ -83,18 +81,7 @@ fn same_seed_same_plan_byte_for_byte() {
     let dir = tmp();
     let run = |name: &str, seed: &str| -> String {
         let out = dir.path().join(name);
-        arc_ok(&[
-            "plan",
-            "--scenario",
-            "window",
-            "--units",
-            "5",
-            "--seed",
-            seed,
-            "--out",
-            s(&out),
-        ])
-        .expect("plan");
+        plan_scenario("window", 5, &["--seed", seed], &out).expect("plan");
         let mut v: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
         // Wall-clock timings are the one part that differs between runs.
@@ -112,28 +99,8 @@ fn same_seed_same_plan_byte_for_byte() {
 #[test]
 fn unreachable_goal_exits_1_with_the_reason() {
     let dir = tmp();
-    let map = sealed_rooms(dir.path());
-    let out = dir.path().join("p.json");
-    let e = arc_ok(&[
-        "plan",
-        "--map",
-        s(&map),
-        "--units",
-        "4",
-        "--start",
-        "3,2,1.5",
-        "--start-yaw-deg",
-        "0",
-        "--goal",
-        "6,2,1.5",
-        "--vertices",
-        "300",
-        "--max-growth",
-        "1",
-        "--out",
-        s(&out),
-    ])
-    .unwrap_err();
+    let (e, out) =
+        plan_across_sealed_rooms(dir.path(), &["--vertices", "300", "--max-growth", "1"]);
     assert_eq!(e.code, Some(1), "{e}");
     assert!(
         e.message.contains("not reachable") || e.message.contains("separate free regions"),
@@ -150,20 +117,8 @@ fn start_in_collision_names_the_body() {
     let dir = tmp();
     let out = dir.path().join("p.json");
     // Window scenario: the dividing wall stands at x = 4.0..4.2; unit 3 lands in it.
-    let e = arc_ok(&[
-        "plan",
-        "--scenario",
-        "window",
-        "--units",
-        "4",
-        "--start",
-        "5.1,1,1.5",
-        "--start-yaw-deg",
-        "0",
-        "--out",
-        s(&out),
-    ])
-    .unwrap_err();
+    let start = ["--start", "5.1,1,1.5", "--start-yaw-deg", "0"];
+    let e = plan_scenario("window", 4, &start, &out).unwrap_err();
     // A start in collision is bad input (2), in `arc plan` as in `arc bench prm`.
     assert_eq!(e.code, Some(2), "{e}");
     assert!(
@@ -183,37 +138,11 @@ fn malformed_input_exits_2() {
         b"# Octomap OcTree binary file\nid OcTree\nsize 99\nres 0.1\ndata\n\x03",
     )
     .unwrap();
-    let cases: Vec<Vec<&str>> = vec![
+    let mut cases: Vec<Vec<&str>> = vec![
         vec!["plan", "--scenario", "window", "--out"],
         vec!["plan", "--scenario", "window", "--start", "1,2", "--out", o],
         vec!["plan", "--scenario", "window", "--units", "40", "--out", o],
         vec!["plan", "--scenario", "nowhere", "--out", o],
-        vec![
-            "plan",
-            "--map",
-            "/no/such/map.bt",
-            "--units",
-            "4",
-            "--start",
-            "1,1,1",
-            "--goal",
-            "2,2,2",
-            "--out",
-            o,
-        ],
-        vec![
-            "plan",
-            "--map",
-            s(&garbage),
-            "--units",
-            "4",
-            "--start",
-            "1,1,1",
-            "--goal",
-            "2,2,2",
-            "--out",
-            o,
-        ],
         vec![
             "plan",
             "--scenario",
@@ -245,6 +174,11 @@ fn malformed_input_exits_2() {
         vec!["tables", "inspect", s(&garbage)],
         vec!["frobnicate"],
     ];
+    // A map file that is missing, and one that is no octree.
+    for map in ["/no/such/map.bt", s(&garbage)] {
+        let query = ["--units", "4", "--start", "1,1,1", "--goal", "2,2,2"];
+        cases.push([&["plan", "--map", map], &query[..], &["--out", o]].concat());
+    }
     for c in cases {
         let e = arc_ok(&c).expect_err(&format!("{c:?} must fail"));
         assert_eq!(e.code, Some(2), "{c:?}: {e}");
@@ -287,37 +221,15 @@ fn plans_from_a_table_file_match_generated_tables() {
     .unwrap();
     arc_ok(&["tables", "inspect", s(&table)]).unwrap();
     let (a, b) = (dir.path().join("a.json"), dir.path().join("b.json"));
-    arc_ok(&["plan", "--scenario", "maze", "--units", "5", "--out", s(&a)]).unwrap();
-    arc_ok(&[
-        "plan",
-        "--scenario",
-        "maze",
-        "--units",
-        "5",
-        "--tables",
-        s(&table),
-        "--out",
-        s(&b),
-    ])
-    .unwrap();
+    plan_scenario("maze", 5, &[], &a).unwrap();
+    plan_scenario("maze", 5, &["--tables", s(&table)], &b).unwrap();
     let (pa, pb) = (Plan::read(&a).unwrap(), Plan::read(&b).unwrap());
     assert_eq!(
         pa.waypoints, pb.waypoints,
         "the file holds the very shapes the generator makes"
     );
     // A table for another chain is refused.
-    let e = arc_ok(&[
-        "plan",
-        "--scenario",
-        "maze",
-        "--units",
-        "6",
-        "--tables",
-        s(&table),
-        "--out",
-        s(&a),
-    ])
-    .unwrap_err();
+    let e = plan_scenario("maze", 6, &["--tables", s(&table)], &a).unwrap_err();
     assert_eq!(e.code, Some(2));
     assert!(e.message.contains("another chain"), "{e}");
 }
@@ -333,33 +245,14 @@ fn long_chains_snake_through_the_window() {
     for units in [12u8, 16] {
         for smooth in [false, true] {
             let out = dir.path().join(format!("window-{units}-{smooth}.json"));
-            let n = units.to_string();
-            let mut args = vec![
-                "plan",
-                "--scenario",
-                "window",
-                "--units",
-                &n,
-                "--start-shape",
-                "PN",
-                "--start-yaw-deg",
-                "90",
-                "--out",
-                s(&out),
-            ];
+            let mut flags = vec!["--start-shape", "PN", "--start-yaw-deg", "90"];
             if !smooth {
-                args.push("--no-smooth");
+                flags.push("--no-smooth");
             }
-            arc_ok(&args).unwrap_or_else(|e| panic!("window N={units}: no plan: {e}"));
+            plan_scenario("window", units, &flags, &out)
+                .unwrap_or_else(|e| panic!("window N={units}: no plan: {e}"));
             let plan = Plan::read(&out).expect("plan file reads back");
-            let report = verify_plan(&sc.grid, &plan);
-            assert!(report.ok, "window N={units}: {:?}", report.violation);
-            let last = plan.waypoints[plan.waypoints.len() - 1].xi();
-            let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
-            assert!(
-                d <= 0.3 + 1e-9,
-                "window N={units}: ends {d} m from the goal"
-            );
+            assert_verified_to_goal(&sc, &plan, &format!("window N={units}"));
             if !smooth {
                 let follow = plan.stats["follow_uses"].as_u64().expect("follow_uses");
                 assert!(follow > 0, "window N={units}: no follow-the-leader step");
@@ -374,18 +267,8 @@ fn long_chains_snake_through_the_window() {
 fn follow_step_zero_is_the_papers_planner() {
     let dir = tmp();
     let out = dir.path().join("window-5-paper.json");
-    arc_ok(&[
-        "plan",
-        "--scenario",
-        "window",
-        "--units",
-        "5",
-        "--follow-step",
-        "0",
-        "--out",
-        s(&out),
-    ])
-    .expect("window N=5 plans without follow-the-leader");
+    plan_scenario("window", 5, &["--follow-step", "0"], &out)
+        .expect("window N=5 plans without follow-the-leader");
     let plan = Plan::read(&out).expect("plan file reads back");
     let sc = scenarios::build("window").expect("built-in scenario");
     assert!(verify_plan(&sc.grid, &plan).ok);
@@ -402,14 +285,12 @@ fn follow_step_zero_is_the_papers_planner() {
 #[test]
 fn refined_plans_verify_and_ask_less_of_the_chain() {
     let dir = tmp();
-    for (scenario, units) in [("window", "5"), ("maze", "5"), ("corridor", "4")] {
+    for (scenario, units) in [("window", 5), ("maze", 5), ("corridor", 4)] {
         let sc = scenarios::build(scenario).expect("built-in scenario");
         let plan = |name: &str, extra: &[&str]| -> Plan {
             let out = dir.path().join(name);
-            let mut args = vec!["plan", "--scenario", scenario, "--units", units];
-            args.extend_from_slice(extra);
-            args.extend_from_slice(&["--out", s(&out)]);
-            arc_ok(&args).unwrap_or_else(|e| panic!("{scenario}: {e}"));
+            plan_scenario(scenario, units, extra, &out)
+                .unwrap_or_else(|e| panic!("{scenario}: {e}"));
             let plan = Plan::read(&out).expect("plan file reads back");
             let report = verify_plan(&sc.grid, &plan);
             assert!(report.ok, "{scenario} {name}: {:?}", report.violation);

@@ -14,7 +14,7 @@
 use aerial_chain::collision::DEFAULT_CLEARANCE;
 mod support;
 
-use support::{arc_ok, s};
+use support::{arc_ok, plan_scenario, s};
 
 fn plan_and_fly(scenario: &str, units: u8) {
     plan_and_fly_with(scenario, units, &[]);
@@ -26,18 +26,8 @@ fn plan_and_fly_with(scenario: &str, units: u8, flags: &[&str]) {
     let plan = dir.path().join("plan.json");
     let out = dir.path().join("sim.json");
     let pic = dir.path().join("sim.svg");
-    let n = units.to_string();
-    let mut args = vec![
-        "plan",
-        "--scenario",
-        scenario,
-        "--units",
-        &n,
-        "--out",
-        s(&plan),
-    ];
-    args.extend_from_slice(flags);
-    arc_ok(&args).unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
+    plan_scenario(scenario, units, flags, &plan)
+        .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
     arc_ok(&[
         "sim",
         "--scenario",

@@ -60,6 +60,12 @@ pub const FK_TOLERANCE: f64 = 1e-4;
 /// Slack kept by `check_transition` for self-collision along shape changes (m, rad).
 const TRANSITION_MARGIN: f32 = 1e-4;
 
+/// The smallest of `horizons` (infinity when there are none): how far every body is
+/// proven free.
+fn smallest(horizons: &[f64]) -> f64 {
+    horizons.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
 /// Why the conservative checker rejected a configuration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Collision {
@@ -542,11 +548,7 @@ impl CollisionContext {
         let mut horizon = [0.0f64; 2 * MAX_UNITS];
         let mut c = [0.0f64; MAX_UNITS];
         loop {
-            let u = horizon[..nb]
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min)
-                .min(dist);
+            let u = smallest(&horizon[..nb]).min(dist);
             let off = scale(dir, u);
             let frac = if dist > 0.0 { u / dist } else { 0.0 };
             // Units first (the links use their bounds).
@@ -621,11 +623,7 @@ impl CollisionContext {
         let mut horizon = [0.0f64; 2 * MAX_UNITS];
         let mut c = [0.0f64; MAX_UNITS];
         loop {
-            let t = horizon[..nb]
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min)
-                .min(1.0);
+            let t = smallest(&horizon[..nb]).min(1.0);
             let s = if t >= 1.0 {
                 *to
             } else {

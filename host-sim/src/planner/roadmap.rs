@@ -327,6 +327,15 @@ mod tests {
         (ctx, map, sc.start, sc.goal)
     }
 
+    /// Adds `start` and `goal` as query vertices; returns them and the cost-to-go to the
+    /// goal.
+    fn query(map: &mut Roadmap, start: [f64; 3], goal: [f64; 3]) -> (VertexId, VertexId, Vec<f64>) {
+        let s = map.add_query_vertex(start);
+        let g = map.add_query_vertex(goal);
+        let h = map.cost_to_go(&[g]);
+        (s, g, h)
+    }
+
     fn cost(map: &Roadmap, path: &[VertexId]) -> f64 {
         path.windows(2)
             .map(|w| map.graph.edge(w[0], w[1]).expect("path follows edges").cost)
@@ -336,9 +345,7 @@ mod tests {
     #[test]
     fn routes_are_checked_edges_and_no_cheaper_than_the_heuristic() {
         let (ctx, mut map, start, goal) = window_roadmap();
-        let s = map.add_query_vertex(start);
-        let g = map.add_query_vertex(goal);
-        let h = map.cost_to_go(&[g]);
+        let (s, g, h) = query(&mut map, start, goal);
         assert_eq!(h[g], 0.0);
         // The heuristic never overestimates: weights are at least the length.
         for (v, &hv) in h.iter().enumerate() {
@@ -355,9 +362,7 @@ mod tests {
     #[test]
     fn banned_edges_are_avoided_and_the_route_stays_optimal_among_the_rest() {
         let (ctx, mut map, start, goal) = window_roadmap();
-        let s = map.add_query_vertex(start);
-        let g = map.add_query_vertex(goal);
-        let h = map.cost_to_go(&[g]);
+        let (s, g, h) = query(&mut map, start, goal);
         let first = map.route(&ctx, s, &[g], &h, &|_, _| false).expect("route");
         let (a, b) = (first[0], first[1]);
         let banned = move |x: VertexId, y: VertexId| (x, y) == (a, b) || (x, y) == (b, a);

@@ -51,39 +51,26 @@ impl Obstacles for MapClearance<'_> {
                     ),
                 );
             }
-            if let Some(n) = nearest_obstacle(self.grid, arr(p), arr(p), HORIZON + self.unit_radius)
-            {
-                let c = n.distance - self.unit_radius;
-                if c < best.0 {
-                    let v = n.voxel;
-                    best = (
-                        c,
-                        format!(
-                            "unit {} near the voxel at ({:.2}, {:.2}, {:.2})",
-                            i + 1,
-                            v[0],
-                            v[1],
-                            v[2]
-                        ),
-                    );
-                }
-            }
         }
-        for (k, w) in units.windows(2).enumerate() {
-            if let Some(n) = nearest_obstacle(
-                self.grid,
-                arr(&w[0]),
-                arr(&w[1]),
-                HORIZON + self.link_radius,
-            ) {
-                let c = n.distance - self.link_radius;
+        let unit_bodies = units
+            .iter()
+            .enumerate()
+            .map(|(i, p)| ("unit", i, p, p, self.unit_radius));
+        let link_bodies = units
+            .windows(2)
+            .enumerate()
+            .map(|(k, w)| ("link", k, &w[0], &w[1], self.link_radius));
+        for (kind, i, a, b, radius) in unit_bodies.chain(link_bodies) {
+            // The body's core is the segment a-b (a point for a unit).
+            if let Some(n) = nearest_obstacle(self.grid, arr(a), arr(b), HORIZON + radius) {
+                let c = n.distance - radius;
                 if c < best.0 {
                     let v = n.voxel;
                     best = (
                         c,
                         format!(
-                            "link {} near the voxel at ({:.2}, {:.2}, {:.2})",
-                            k + 1,
+                            "{kind} {} near the voxel at ({:.2}, {:.2}, {:.2})",
+                            i + 1,
                             v[0],
                             v[1],
                             v[2]

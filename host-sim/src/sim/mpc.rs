@@ -373,6 +373,12 @@ mod tests {
         ]
     }
 
+    /// The plan from rest at the origin towards a reference held still at `p`.
+    fn solve_from_rest(m: &mut HeadMpc, p: V3) -> MpcSolution {
+        m.solve(V3::zeros(), V3::zeros(), &still(p, 15), V3::zeros())
+            .unwrap()
+    }
+
     #[test]
     fn at_the_reference_it_does_nothing() {
         let mut m = HeadMpc::new(MpcConfig::default()).unwrap();
@@ -385,14 +391,7 @@ mod tests {
     fn pushes_towards_the_reference_within_the_tilt_cone() {
         let cfg = MpcConfig::default();
         let mut m = HeadMpc::new(cfg).unwrap();
-        let s = m
-            .solve(
-                V3::zeros(),
-                V3::zeros(),
-                &still(V3::new(10.0, 0.0, 0.0), 15),
-                V3::zeros(),
-            )
-            .unwrap();
+        let s = solve_from_rest(&mut m, V3::new(10.0, 0.0, 0.0));
         assert!(s.accel.x > 0.5);
         let tan = cfg.tilt_max.tan();
         for a in &s.plan {
@@ -405,14 +404,7 @@ mod tests {
             );
         }
         // Far below: climbs at most a_z_max.
-        let s = m
-            .solve(
-                V3::zeros(),
-                V3::zeros(),
-                &still(V3::new(0.0, 0.0, 50.0), 15),
-                V3::zeros(),
-            )
-            .unwrap();
+        let s = solve_from_rest(&mut m, V3::new(0.0, 0.0, 50.0));
         assert!((s.accel.z - cfg.a_z_max).abs() < 1e-3);
     }
 

@@ -12,6 +12,15 @@ fn zeta(xi: [f64; 3], eta: &[f64]) -> Vec<f64> {
     z
 }
 
+/// The default simulation, `min_time` seconds at least, with one `gust`.
+fn with_gust(gust: Gust, min_time: f64) -> SimConfig {
+    SimConfig {
+        min_time,
+        gusts: vec![gust],
+        ..Default::default()
+    }
+}
+
 fn line(n: usize) -> Vec<f64> {
     vec![0.0; 2 * n - 1]
 }
@@ -114,11 +123,7 @@ fn a_gust_is_rejected() {
         unit: None,
         force: V3::new(2.0, 1.0, -1.0),
     };
-    let cfg = SimConfig {
-        min_time: 8.0,
-        gusts: vec![gust],
-        ..Default::default()
-    };
+    let cfg = with_gust(gust, 8.0);
     let f = simulate(&p, &[zeta([0.0, 0.0, 2.0], &bent(4))], &cfg, None).unwrap();
     let r = &f.report;
     assert!(r.success(), "{r:?}");
@@ -153,11 +158,7 @@ fn a_steady_wind_is_rejected_without_offset() {
         unit: Some(0),
         force: V3::new(1.5, 0.0, 0.0),
     };
-    let cfg = SimConfig {
-        min_time: 10.0,
-        gusts: vec![gust],
-        ..Default::default()
-    };
+    let cfg = with_gust(gust, 10.0);
     let f = simulate(&p, &[zeta([0.0, 0.0, 2.0], &line(3))], &cfg, None).unwrap();
     let last = f.samples.last().unwrap();
     assert!(f.report.success(), "{:?}", f.report);
@@ -281,11 +282,7 @@ fn the_reported_clearance_is_the_every_step_minimum() {
         unit: None,
         force: V3::new(0.0, -0.2, 0.0),
     };
-    let cfg = SimConfig {
-        gusts: vec![gust],
-        min_time: 6.0,
-        ..Default::default()
-    };
+    let cfg = with_gust(gust, 6.0);
     // 2. An ordinary flight along the wall, drifting towards it.
     let along = zeta([3.0, -0.004, 2.0], &line(3));
     let flights = [

@@ -60,14 +60,17 @@ pub fn arc(args: &[&str], dir: &Path) -> Command {
     c
 }
 
-/// Runs `arc args` in `dir` and waits, killing it after [`GUARD_SECONDS`].
-pub fn run(args: &[&str], dir: &Path) -> Outcome {
-    let child = arc(args, dir)
-        .stdout(Stdio::piped())
+/// Starts the command `c` (an [`arc`] command) with its standard output and error piped.
+pub fn spawn(c: &mut Command) -> Child {
+    c.stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .expect("spawn arc");
-    wait(child, args)
+        .expect("spawn arc")
+}
+
+/// Runs `arc args` in `dir` and waits, killing it after [`GUARD_SECONDS`].
+pub fn run(args: &[&str], dir: &Path) -> Outcome {
+    wait(spawn(&mut arc(args, dir)), args)
 }
 
 /// Waits for `child` under the hang guard and collects its output.
@@ -164,12 +167,11 @@ impl std::fmt::Display for Failure {
 /// Runs the real `arc` binary with `args` (paths absolute) and tells whether it
 /// exited 0; a crash fails the test.
 pub fn arc_ok(args: &[&str]) -> Result<(), Failure> {
-    let child = arc(args, &std::env::temp_dir())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn arc");
-    let o = wait_at_most(child, args, E2E_GUARD_SECONDS);
+    let o = wait_at_most(
+        spawn(&mut arc(args, &std::env::temp_dir())),
+        args,
+        E2E_GUARD_SECONDS,
+    );
     assert!(!o.crashed(), "arc {args:?} crashed: {o:?}");
     if o.code == Some(0) {
         Ok(())
@@ -186,9 +188,32 @@ pub fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
 }
 
+/// Runs `arc plan --scenario scenario --units units` with the extra `flags`, writing
+/// the plan to `out`.
+pub fn plan_scenario(scenario: &str, units: u8, flags: &[&str], out: &Path) -> Result<(), Failure> {
+    let n = units.to_string();
+    let mut args = vec!["plan", "--scenario", scenario, "--units", &n];
+    args.extend_from_slice(flags);
+    args.extend_from_slice(&["--out", s(out)]);
+    arc_ok(&args)
+}
+
+/// Checks `plan` for `sc` with the exact verifier (never the planner's own checks) and
+/// that its head ends within 0.3 m of the goal; `label` names the case in failures.
+pub fn assert_verified_to_goal(
+    sc: &aerial_chain::problem::scenarios::Scenario,
+    plan: &aerial_chain::plan::Plan,
+    label: &str,
+) {
+    let report = aerial_chain::collision::verify_plan(&sc.grid, plan);
+    assert!(report.ok, "{label}: {:?}", report.violation);
+    let last = plan.waypoints[plan.waypoints.len() - 1].xi();
+    let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
+    assert!(d <= 0.3 + 1e-9, "{label}: ends {d} m from the goal");
+}
+
 /// Plans `scenario` for `units` with `arc plan`'s defaults into `dir`, checks the plan
-/// with the exact verifier (never the planner's own checks) and that its head ends
-/// within 0.3 m of the goal; returns the plan and the scenario.
+/// with [`assert_verified_to_goal`]; returns the plan and the scenario.
 pub fn plan_verified(
     scenario: &str,
     units: u8,
@@ -198,28 +223,36 @@ pub fn plan_verified(
     aerial_chain::problem::scenarios::Scenario,
 ) {
     let out = dir.join(format!("{scenario}-{units}.json"));
-    let n = units.to_string();
-    arc_ok(&[
-        "plan",
-        "--scenario",
-        scenario,
-        "--units",
-        &n,
-        "--out",
-        s(&out),
-    ])
-    .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
+    plan_scenario(scenario, units, &[], &out)
+        .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
     let plan = aerial_chain::plan::Plan::read(&out).expect("plan file reads back");
     let sc = aerial_chain::problem::scenarios::build(scenario).expect("scenario");
-    let report = aerial_chain::collision::verify_plan(&sc.grid, &plan);
-    assert!(report.ok, "{scenario} N={units}: {:?}", report.violation);
-    let last = plan.waypoints[plan.waypoints.len() - 1].xi();
-    let d = ((0..3).map(|k| (last[k] - sc.goal[k]).powi(2)).sum::<f64>()).sqrt();
-    assert!(
-        d <= 0.3 + 1e-9,
-        "{scenario} N={units}: ends {d} m from the goal"
-    );
+    assert_verified_to_goal(&sc, &plan, &format!("{scenario} N={units}"));
     (plan, sc)
+}
+
+/// Runs `arc plan` from one of the [`sealed_rooms`] into the other, with the extra
+/// `flags`; returns how it failed and the plan file it must not have written.
+pub fn plan_across_sealed_rooms(dir: &Path, flags: &[&str]) -> (Failure, PathBuf) {
+    let map = sealed_rooms(dir);
+    let out = dir.join("p.json");
+    let mut args = vec![
+        "plan",
+        "--map",
+        s(&map),
+        "--units",
+        "4",
+        "--start",
+        "3,2,1.5",
+        "--start-yaw-deg",
+        "0",
+        "--goal",
+        "6,2,1.5",
+    ];
+    args.extend_from_slice(flags);
+    args.extend_from_slice(&["--out", s(&out)]);
+    let failure = arc_ok(&args).expect_err("no plan between sealed rooms");
+    (failure, out)
 }
 
 /// A map of two sealed rooms: free inside, walls around and between.

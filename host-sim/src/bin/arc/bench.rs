@@ -6,11 +6,11 @@ use std::time::{Duration, Instant};
 use clap::{Args, Subcommand};
 
 use super::checks;
-use super::common::{ChainArgs, MapArgs, QueryArgs, Report};
+use super::common::{write_plan, ProblemArgs};
 use super::{CliError, CliResult};
 use crate::study::{self, paper, robust, scale};
 use aerial_chain::baseline::{FullStatePrm, PrmError, PrmSettings};
-use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
+use aerial_chain::collision::{verify_plan, DEFAULT_CLEARANCE};
 use aerial_chain::planner::{to_plan, Planner, Termination};
 
 /// `arc bench ...`
@@ -121,14 +121,7 @@ pub struct RobustArgs {
 #[derive(Args, Debug)]
 pub struct PrmArgs {
     #[command(flatten)]
-    map: MapArgs,
-    #[command(flatten)]
-    chain: ChainArgs,
-    #[command(flatten)]
-    query: QueryArgs,
-    /// Goal tolerance for the head (m).
-    #[arg(long, default_value_t = 0.3)]
-    goal_tol: f64,
+    problem: ProblemArgs,
     /// Vertex budget M_F.
     #[arg(long, default_value_t = 1500)]
     vertices: usize,
@@ -402,7 +395,7 @@ fn run_scale(a: ScaleArgs) -> CliResult {
 /// Checks every option of `arc bench prm` before any work (docs/promises.md).
 fn check_prm(a: &PrmArgs) -> Result<Option<Duration>, CliError> {
     checks::length("--clearance", a.clearance, false)?;
-    checks::length("--goal-tol", a.goal_tol, false)?;
+    checks::length("--goal-tol", a.problem.goal_tol, false)?;
     checks::count(
         "--vertices",
         a.vertices,
@@ -475,15 +468,10 @@ fn run_robust(a: RobustArgs) -> CliResult {
 
 fn run_prm(a: PrmArgs) -> CliResult {
     let time_limit = check_prm(&a)?;
-    let loaded = a.map.load()?;
-    let (params, query) = a
-        .query
-        .resolve(&a.chain, loaded.scenario.as_ref(), a.goal_tol)?;
+    let (loaded, params, query) = a.problem.load()?;
     let grid = loaded.grid.clone();
     let source = loaded.source.clone();
-    let (field, _) = loaded.into_field();
-    let ctx = CollisionContext::new(field, params, a.clearance)
-        .map_err(|e| CliError::input(e.to_string()))?;
+    let ctx = loaded.into_context(params, a.clearance)?;
     let settings = PrmSettings {
         vertices: a.vertices,
         k: a.k,
@@ -514,19 +502,17 @@ fn run_prm(a: PrmArgs) -> CliResult {
     let mut plan = to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
     plan.map.source = source;
     let report = verify_plan(&grid, &plan);
-    plan.write(&a.out)
-        .map_err(|e| CliError::input(e.to_string()))?;
     let s = &sol.stats;
-    let lines = Report::new(&a.out);
-    lines.line(format_args!(
-        "{}: full-state PRM solved {} with N = {}: {} waypoints, {} roadmap edges, {} shape changes",
-        crate::fsutil::output_name(&a.out),
-        a.map.name(),
-        params.units,
-        plan.waypoints.len(),
-        s.path_edges,
-        s.shape_changes
-    ));
+    let lines = write_plan(
+        &plan,
+        &a.out,
+        "full-state PRM solved",
+        &a.problem.map,
+        format_args!(
+            "{} roadmap edges, {} shape changes",
+            s.path_edges, s.shape_changes
+        ),
+    )?;
     lines.line(format_args!(
         "  roadmap {:.1} ms ({} vertices, k = {}, {} edges), planning {:.1} ms ({} lazy searches, {} edges checked, {} blocked; {:.1} ms in checks)",
         s.roadmap_s * 1e3,

@@ -1,6 +1,6 @@
 //! Arguments and loading shared by the commands that work on a map.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use aerial_chain_core::lsc::{library, LscKind};
@@ -9,10 +9,11 @@ use aerial_chain_core::{ChainParams, Shape};
 use clap::Args;
 
 use super::{checks, CliError};
+use aerial_chain::collision::CollisionContext;
 use aerial_chain::map::DistanceField;
 use aerial_chain::map::Grid;
 use aerial_chain::map::OcTree;
-use aerial_chain::plan::MapSource;
+use aerial_chain::plan::{MapSource, Plan};
 use aerial_chain::planner::Query;
 use aerial_chain::problem::scenarios::{self, Scenario};
 
@@ -183,9 +184,15 @@ impl MapArgs {
 }
 
 impl LoadedMap {
-    /// The distance field over the grid (which it keeps), and the scenario.
-    pub fn into_field(self) -> (Arc<DistanceField>, Option<Scenario>) {
-        (Arc::new(DistanceField::new(self.grid)), self.scenario)
+    /// The collision context of the chain `params` with `clearance` on this map; its
+    /// distance field keeps the grid.
+    pub fn into_context(
+        self,
+        params: ChainParams,
+        clearance: f64,
+    ) -> Result<CollisionContext, CliError> {
+        let field = Arc::new(DistanceField::new(self.grid));
+        CollisionContext::new(field, params, clearance).map_err(|e| CliError::input(e.to_string()))
     }
 }
 
@@ -211,6 +218,57 @@ impl Report {
             println!("{args}");
         }
     }
+}
+
+/// A planning problem from the command line: the map, the chain, the query and how
+/// close to the goal the head must end.
+#[derive(Args, Debug, Clone)]
+pub struct ProblemArgs {
+    #[command(flatten)]
+    pub map: MapArgs,
+    #[command(flatten)]
+    pub chain: ChainArgs,
+    #[command(flatten)]
+    pub query: QueryArgs,
+    /// Goal tolerance for the head (m).
+    #[arg(long, default_value_t = 0.3)]
+    pub goal_tol: f64,
+}
+
+impl ProblemArgs {
+    /// Loads the map, then resolves the chain and the query on it
+    /// ([`QueryArgs::resolve`]).
+    pub fn load(&self) -> Result<(LoadedMap, ChainParams, Query), CliError> {
+        let loaded = self.map.load()?;
+        let (params, query) =
+            self.query
+                .resolve(&self.chain, loaded.scenario.as_ref(), self.goal_tol)?;
+        Ok((loaded, params, query))
+    }
+}
+
+/// Writes `plan` to `out` and opens the report that follows it with a line naming the
+/// file, then `solved`, the map, the chain size and the number of waypoints, then
+/// `details`.
+pub fn write_plan(
+    plan: &Plan,
+    out: &Path,
+    solved: &str,
+    map: &MapArgs,
+    details: std::fmt::Arguments<'_>,
+) -> Result<Report, CliError> {
+    plan.write(out)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    // With `--out -` the plan is standard output; the report goes to standard error.
+    let report = Report::new(out);
+    report.line(format_args!(
+        "{}: {solved} {} with N = {}: {} waypoints, {details}",
+        crate::fsutil::output_name(out),
+        map.name(),
+        plan.chain.units,
+        plan.waypoints.len()
+    ));
+    Ok(report)
 }
 
 /// Where a query starts and ends; a scenario supplies what is not given.

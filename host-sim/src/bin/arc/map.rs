@@ -252,29 +252,23 @@ fn picture(a: PictureArgs) -> CliResult {
 
 #[cfg(test)]
 mod tests {
-    use crate::run as arc;
+    use super::CliResult;
+
+    /// Runs `arc map` with `args`.
+    fn map(args: &[&str]) -> CliResult {
+        crate::run(["arc", "map"].iter().chain(args).copied())
+    }
 
     #[test]
     fn export_info_picture_round_trip() {
         let dir = tempfile::tempdir().unwrap();
         let bt = dir.path().join("w.bt");
         let bt_s = bt.to_str().unwrap();
-        arc([
-            "arc",
-            "map",
-            "export",
-            "--scenario",
-            "window",
-            "--out",
-            bt_s,
-        ])
-        .unwrap();
-        arc(["arc", "map", "info", bt_s]).unwrap();
+        map(&["export", "--scenario", "window", "--out", bt_s]).unwrap();
+        map(&["info", bt_s]).unwrap();
         // A full .ot holds the same map.
         let ot = dir.path().join("w.ot");
-        arc([
-            "arc",
-            "map",
+        map(&[
             "export",
             "--scenario",
             "window",
@@ -291,9 +285,7 @@ mod tests {
             .starts_with(b"# Octomap OcTree file\n"));
         assert_eq!(from_ot, from_bt);
         let svg = dir.path().join("w.svg");
-        arc([
-            "arc",
-            "map",
+        map(&[
             "picture",
             bt_s,
             "--out",
@@ -304,9 +296,7 @@ mod tests {
         .unwrap();
         assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
         let svg2 = dir.path().join("c.svg");
-        arc([
-            "arc",
-            "map",
+        map(&[
             "picture",
             "--scenario",
             "corridor:12",
@@ -322,86 +312,54 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("x.bt");
         let out_s = out.to_str().unwrap();
-        let code = |args: &[&str]| arc(args.iter().copied()).unwrap_err().code;
-        assert_eq!(
-            code(&["arc", "map", "export", "--scenario", "nope", "--out", out_s]),
-            2
-        );
-        assert_eq!(
-            code(&[
-                "arc",
-                "map",
-                "export",
-                "--scenario",
-                "corridor:500",
-                "--out",
-                out_s
-            ]),
-            2
-        );
-        assert_eq!(code(&["arc", "map", "info", "/nonexistent/map.bt"]), 2);
+        // A wrong file name: refused, naming the formats, and nothing is written.
         let txt = dir.path().join("x.txt");
-        let e = arc([
-            "arc",
-            "map",
-            "export",
-            "--scenario",
-            "window",
-            "--out",
-            txt.to_str().unwrap(),
-        ])
-        .unwrap_err();
+        let txt_s = txt.to_str().unwrap();
+        let e = map(&["export", "--scenario", "window", "--out", txt_s]).unwrap_err();
         assert_eq!(e.code, 2);
         assert!(e.message.contains(".bt or .ot"), "{}", e.message);
         assert!(!txt.exists(), "nothing written under a wrong name");
+        // A file that is no octomap: the error names it.
         let junk = dir.path().join("junk.bt");
         std::fs::write(&junk, b"not an octomap").unwrap();
-        let e = arc(["arc", "map", "info", junk.to_str().unwrap()]).unwrap_err();
+        let e = map(&["info", junk.to_str().unwrap()]).unwrap_err();
         assert_eq!(e.code, 2);
         assert!(e.message.contains("junk.bt"), "{}", e.message);
         let pic = dir.path().join("p.jpg");
-        assert_eq!(
-            code(&[
-                "arc",
-                "map",
-                "picture",
-                "--scenario",
-                "maze",
-                "--out",
-                pic.to_str().unwrap()
-            ]),
-            2
-        );
-        assert_eq!(code(&["arc", "map", "picture", "--out", "x.svg"]), 2);
         let svg = dir.path().join("p.svg");
-        let svg_s = svg.to_str().unwrap();
-        assert_eq!(
-            code(&[
-                "arc",
-                "map",
+        let cases: [&[&str]; 7] = [
+            &["export", "--scenario", "nope", "--out", out_s],
+            &["export", "--scenario", "corridor:500", "--out", out_s],
+            &["info", "/nonexistent/map.bt"],
+            &[
                 "picture",
                 "--scenario",
                 "maze",
                 "--out",
-                svg_s,
+                pic.to_str().unwrap(),
+            ],
+            &["picture", "--out", "x.svg"],
+            &[
+                "picture",
+                "--scenario",
+                "maze",
+                "--out",
+                svg.to_str().unwrap(),
                 "--band-min",
                 "2",
                 "--band-max",
-                "1"
-            ]),
-            2
-        );
-        assert_eq!(
-            code(&[
-                "arc",
-                "map",
+                "1",
+            ],
+            &[
                 "export",
                 "--scenario",
                 "maze",
                 "--out",
-                "/nonexistent-dir/x.bt"
-            ]),
-            2
-        );
+                "/nonexistent-dir/x.bt",
+            ],
+        ];
+        for args in cases {
+            assert_eq!(map(args).unwrap_err().code, 2, "arc map {args:?}");
+        }
     }
 }

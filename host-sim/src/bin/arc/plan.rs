@@ -8,9 +8,9 @@ use aerial_chain_core::ChainParams;
 use clap::Args;
 
 use super::checks;
-use super::common::{ChainArgs, MapArgs, QueryArgs, Report};
+use super::common::{write_plan, ProblemArgs, Report};
 use super::{CliError, CliResult};
-use aerial_chain::collision::{CollisionContext, DEFAULT_CLEARANCE};
+use aerial_chain::collision::DEFAULT_CLEARANCE;
 use aerial_chain::planner::{
     annotate_quality, to_plan, ArcPlanner, Mode, PlanError, Planner, Preference, Settings,
     Termination,
@@ -22,14 +22,7 @@ use aerial_chain::tables::{ShapeTables, TableSettings};
 #[derive(Args, Debug)]
 pub struct PlanArgs {
     #[command(flatten)]
-    map: MapArgs,
-    #[command(flatten)]
-    chain: ChainArgs,
-    #[command(flatten)]
-    query: QueryArgs,
-    /// Goal tolerance for the head (m).
-    #[arg(long, default_value_t = 0.3)]
-    goal_tol: f64,
+    problem: ProblemArgs,
     /// Shape sources: both (the ARCplanner), lsc or srs (the paper's ablation).
     #[arg(long, value_enum, default_value_t = Mode::Both)]
     mode: Mode,
@@ -144,7 +137,7 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
             &format!("0 (off) or between {MIN_FOLLOW_STEP} and 1 m"),
         ));
     }
-    checks::length("--goal-tol", a.goal_tol, false)?;
+    checks::length("--goal-tol", a.problem.goal_tol, false)?;
     checks::length("--clearance", a.clearance, false)?;
     checks::count(
         "--max-replans",
@@ -199,16 +192,11 @@ pub fn run(a: PlanArgs) -> CliResult {
     // Setup (map, distance field, shape tables) is timed apart: the time limit
     // covers what follows it (docs/promises.md).
     let setup = Instant::now();
-    let loaded = a.map.load()?;
-    let (params, query) = a
-        .query
-        .resolve(&a.chain, loaded.scenario.as_ref(), a.goal_tol)?;
+    let (loaded, params, query) = a.problem.load()?;
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
     let (resolution, unknown_occ) = (loaded.grid.resolution(), loaded.grid.unknown_is_occupied());
     let source = loaded.source.clone();
-    let (field, _) = loaded.into_field();
-    let ctx = CollisionContext::new(field, params, a.clearance)
-        .map_err(|e| CliError::input(e.to_string()))?;
+    let ctx = loaded.into_context(params, a.clearance)?;
     let settings = Settings {
         vertices: a.vertices,
         r_t: a.r_t,
@@ -253,25 +241,23 @@ pub fn run(a: PlanArgs) -> CliResult {
     let mut plan = to_plan(&solution, &params, resolution, unknown_occ);
     annotate_quality(&mut plan, &quality, refinement.as_ref());
     plan.map.source = source;
-    plan.write(&a.out)
-        .map_err(|e| CliError::input(e.to_string()))?;
     let s = &solution.stats;
-    // With `--out -` the plan is standard output; the report goes to standard error.
-    let report = Report::new(&a.out);
-    report.line(format_args!(
-        "{}: solved on {} with N = {}: {} waypoints, {} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations, {} follow), {} replans",
-        crate::fsutil::output_name(&a.out),
-        a.map.name(),
-        params.units,
-        plan.waypoints.len(),
-        s.edges,
-        s.shape_changes,
-        s.lsc_uses,
-        s.srs_uses,
-        s.rotations,
-        s.follow_uses,
-        s.replans
-    ));
+    let report = write_plan(
+        &plan,
+        &a.out,
+        "solved on",
+        &a.problem.map,
+        format_args!(
+            "{} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations, {} follow), {} replans",
+            s.edges,
+            s.shape_changes,
+            s.lsc_uses,
+            s.srs_uses,
+            s.rotations,
+            s.follow_uses,
+            s.replans
+        ),
+    )?;
     report.line(format_args!(
         "  setup {:.1} ms, roadmap {:.1} ms ({} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
         setup_s * 1e3,
@@ -302,7 +288,7 @@ pub fn run(a: PlanArgs) -> CliResult {
         aerial_chain::plan_picture::draw(
             grid,
             &plan,
-            &format!("ARCplanner on {}", a.map.name()),
+            &format!("ARCplanner on {}", a.problem.map.name()),
             Some(query.goal),
         )
         .save(pic)

@@ -3,7 +3,7 @@
 
 use aerial_chain::picture::{stroke, Axis, Colour, Figure, Panel};
 
-use super::Summary;
+use super::{Spread, Summary};
 
 /// One curve: (x, median, q1, q3) points; points without a value are skipped.
 pub struct Curve {
@@ -90,32 +90,28 @@ pub fn svg(charts: &[Chart], rows: usize, cols: usize, size: (u32, u32)) -> Stri
     fig.to_svg()
 }
 
-/// `(x, median, q1, q3)` of the successful runs' query times (ms) of `sums`, by `x`.
-pub fn planning_ms(sums: &[&Summary], x: impl Fn(&Summary) -> f64) -> Vec<(f64, f64, f64, f64)> {
+/// `(x, median, q1, q3)` in ms of the times `spread` picks from each of `sums`, by `x`.
+fn spread_ms(
+    sums: &[&Summary],
+    x: impl Fn(&Summary) -> f64,
+    spread: impl Fn(&Summary) -> &Spread,
+) -> Vec<(f64, f64, f64, f64)> {
     sums.iter()
         .map(|s| {
-            (
-                x(s),
-                s.planning.median * 1e3,
-                s.planning.q1 * 1e3,
-                s.planning.q3 * 1e3,
-            )
+            let t = spread(s);
+            (x(s), t.median * 1e3, t.q1 * 1e3, t.q3 * 1e3)
         })
         .collect()
 }
 
+/// `(x, median, q1, q3)` of the successful runs' query times (ms) of `sums`, by `x`.
+pub fn planning_ms(sums: &[&Summary], x: impl Fn(&Summary) -> f64) -> Vec<(f64, f64, f64, f64)> {
+    spread_ms(sums, x, |s| &s.planning)
+}
+
 /// `(x, median, q1, q3)` of the roadmap build times (ms) of `sums`, by `x`.
 pub fn roadmap_ms(sums: &[&Summary], x: impl Fn(&Summary) -> f64) -> Vec<(f64, f64, f64, f64)> {
-    sums.iter()
-        .map(|s| {
-            (
-                x(s),
-                s.roadmap.median * 1e3,
-                s.roadmap.q1 * 1e3,
-                s.roadmap.q3 * 1e3,
-            )
-        })
-        .collect()
+    spread_ms(sums, x, |s| &s.roadmap)
 }
 
 /// `(x, success %, -, -)` of `sums`, by `x`.

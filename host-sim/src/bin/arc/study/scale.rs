@@ -251,61 +251,59 @@ pub fn figure(sums: &[Summary], corridor_units: u8) -> String {
             (0.1, 1000.0)
         }
     };
-    let time_curves = |v: &[&Summary], x: &dyn Fn(&Summary) -> f64| {
-        vec![
-            Curve {
-                label: "t_P, query (successful runs)".into(),
-                colour: BLUE,
-                points: plot::planning_ms(v, x),
-            },
-            Curve {
-                label: "t_G, head roadmap".into(),
-                colour: ORANGE,
-                points: plot::roadmap_ms(v, x),
-            },
-        ]
-    };
+    let time_chart =
+        |title: String, x_label: &str, v: &[&Summary], x: &dyn Fn(&Summary) -> f64| Chart {
+            title,
+            x_label: x_label.into(),
+            y_label: "ms".into(),
+            log_y: true,
+            y_range: range(times(v)),
+            curves: vec![
+                Curve {
+                    label: "t_P, query (successful runs)".into(),
+                    colour: BLUE,
+                    points: plot::planning_ms(v, x),
+                },
+                Curve {
+                    label: "t_G, head roadmap".into(),
+                    colour: ORANGE,
+                    points: plot::roadmap_ms(v, x),
+                },
+            ],
+        };
+    let success_chart =
+        |title: &str, x_label: &str, v: &[&Summary], x: &dyn Fn(&Summary) -> f64| Chart {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: "success (%)".into(),
+            log_y: false,
+            y_range: (0.0, 105.0),
+            curves: vec![Curve {
+                label: "success".into(),
+                colour: GREEN,
+                points: plot::success_pct(v, x),
+            }],
+        };
     let charts = vec![
-        Chart {
-            title: "window: time against N (median, IQR)".into(),
-            x_label: "units N".into(),
-            y_label: "ms".into(),
-            log_y: true,
-            y_range: range(times(&by_n)),
-            curves: time_curves(&by_n, &n),
-        },
-        Chart {
-            title: format!("corridor:L: time against length (N = {corridor_units})"),
-            x_label: "corridor length L (m)".into(),
-            y_label: "ms".into(),
-            log_y: true,
-            y_range: range(times(&by_l)),
-            curves: time_curves(&by_l, &corridor_length),
-        },
-        Chart {
-            title: "window: success against N".into(),
-            x_label: "units N".into(),
-            y_label: "success (%)".into(),
-            log_y: false,
-            y_range: (0.0, 105.0),
-            curves: vec![Curve {
-                label: "success".into(),
-                colour: GREEN,
-                points: plot::success_pct(&by_n, n),
-            }],
-        },
-        Chart {
-            title: "corridor:L: success against length".into(),
-            x_label: "corridor length L (m)".into(),
-            y_label: "success (%)".into(),
-            log_y: false,
-            y_range: (0.0, 105.0),
-            curves: vec![Curve {
-                label: "success".into(),
-                colour: GREEN,
-                points: plot::success_pct(&by_l, corridor_length),
-            }],
-        },
+        time_chart(
+            "window: time against N (median, IQR)".into(),
+            "units N",
+            &by_n,
+            &n,
+        ),
+        time_chart(
+            format!("corridor:L: time against length (N = {corridor_units})"),
+            "corridor length L (m)",
+            &by_l,
+            &corridor_length,
+        ),
+        success_chart("window: success against N", "units N", &by_n, &n),
+        success_chart(
+            "corridor:L: success against length",
+            "corridor length L (m)",
+            &by_l,
+            &corridor_length,
+        ),
     ];
     plot::svg(&charts, 2, 2, (1200, 800))
 }
