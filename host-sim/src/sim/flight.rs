@@ -539,14 +539,7 @@ fn run_steps(
         let units = dynamics.unit_states();
         let out = controller.step(t, &units, reference);
         let r = reference.sample(t);
-        let (e_head, at_goal) = tally.observe(
-            dt,
-            &units,
-            &r,
-            goal,
-            cfg.goal_tolerance,
-            cfg.angle_tolerance,
-        );
+        let (e_head, at_goal) = tally.observe(&units, &r, goal, cfg);
         if let Some(obs) = obstacles {
             tally
                 .watch
@@ -625,15 +618,12 @@ impl Tally {
 
     /// Tracking errors, limits and self-contact of one step; returns the head's
     /// tracking error and whether the chain is at the goal.
-    #[allow(clippy::too_many_arguments)]
     fn observe(
         &mut self,
-        dt: f64,
         units: &[BodyState],
         r: &RefPoint,
         goal: &Goal,
-        goal_tolerance: f64,
-        angle_tolerance: f64,
+        cfg: &SimConfig,
     ) -> (f64, bool) {
         let n = units.len();
         let e_head = (units[0].p - r.p).norm();
@@ -642,16 +632,16 @@ impl Tally {
         let dirs: Vec<V3> = (0..n - 1)
             .map(|k| (units[k].p - units[k + 1].p).normalize())
             .collect();
-        let mut at_goal = (units[0].p - goal.head).norm() <= goal_tolerance;
+        let mut at_goal = (units[0].p - goal.head).norm() <= cfg.goal_tolerance;
         for (k, dir) in dirs.iter().enumerate() {
             let lr = &r.links[k];
             let e = angle_between(dir, &super::dynamics::link_direction(lr.pitch, lr.yaw));
             self.link_sq += e * e;
             self.link_count += 1;
             self.link_max = self.link_max.max(e);
-            at_goal &= angle_between(dir, &goal.link_dirs[k]) <= angle_tolerance;
+            at_goal &= angle_between(dir, &goal.link_dirs[k]) <= cfg.angle_tolerance;
         }
-        self.observe_limits(&dirs, dt);
+        self.observe_limits(&dirs, 1.0 / cfg.rate);
         self.observe_self_gap(units);
         (e_head, at_goal)
     }

@@ -23,11 +23,10 @@ pub mod robust;
 pub mod scale;
 mod statistics;
 
-pub use report::{count, fmt_ms, ms, runs_csv, summary_csv, write_out};
+pub use report::{fmt_ms, ms, runs_csv, summary_csv, write_out};
 pub use statistics::{summarize, Spread, Summary};
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;

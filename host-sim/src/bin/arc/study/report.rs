@@ -1,7 +1,9 @@
 //! Benchmark reports: runs and summaries as CSV, times and counts for markdown tables,
 //! and writing them into the output directory.
 
-use super::*;
+use std::fmt::Write as _;
+
+use super::{RunResult, Spread, Summary};
 
 pub(super) fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {

@@ -1,7 +1,10 @@
 //! Statistics over benchmark runs: medians and quartiles per study, method, scenario
 //! and chain size.
 
-use super::*;
+use std::collections::BTreeMap;
+
+use super::report::{count, ms};
+use super::{Method, RunResult};
 
 /// Order statistics of a sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
