@@ -29,7 +29,7 @@ use crate::tables::ShapeTables;
 /// Counters and timings of one query.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Stats {
-    /// Roadmap build time (s).
+    /// Setup time (s): the head roadmap and the labelled free regions.
     pub roadmap_s: f64,
     /// Query time (s).
     pub planning_s: f64,
@@ -132,6 +132,9 @@ impl ArcPlanner {
     fn setup_until(&mut self, deadline: Option<Instant>) {
         if self.roadmap.is_none() {
             let t = Instant::now();
+            if self.settings.head_lattice {
+                self.lattice.regions(self.ctx.field());
+            }
             self.build_roadmap(self.settings.vertices, deadline);
             self.roadmap_s = t.elapsed().as_secs_f64();
         }
@@ -177,13 +180,27 @@ impl ArcPlanner {
         *s += t.elapsed().as_secs_f64();
         match outcome {
             lattice::LatticeOutcome::Found(r) if r.points.len() >= 2 => Ok(Some(r)),
-            lattice::LatticeOutcome::Separated { side, visited } => Err(PlanError::Separated {
+            separated @ lattice::LatticeOutcome::Separated { .. } => Err(self.separated(separated)),
+            _ => Ok(None),
+        }
+    }
+
+    /// The planning error for a lattice outcome that proves separation.
+    fn separated(&self, outcome: lattice::LatticeOutcome) -> PlanError {
+        match outcome {
+            lattice::LatticeOutcome::Separated {
+                side,
+                size,
+                unit,
+                spacing,
+            } => PlanError::Separated {
                 radius: self.lattice.radius_min(),
                 side,
-                visited,
-                spacing: self.lattice.spacing(),
-            }),
-            _ => Ok(None),
+                size,
+                unit,
+                spacing,
+            },
+            other => unreachable!("not a separation: {other:?}"),
         }
     }
 
@@ -236,6 +253,12 @@ impl ArcPlanner {
         let query_began = Instant::now();
         let checks_before = self.check_count();
         self.check_query(query)?;
+        if self.settings.head_lattice {
+            // The labelled regions refuse a sealed-off goal at once, whatever the map.
+            if let Some(sep) = self.lattice.separation(self.ctx.field(), start, goal) {
+                return Err(self.separated(sep));
+            }
+        }
         // The head route over the lattice ([`lattice`]), searched when the uniform
         // roadmap fails (where it works, it is cheaper in rooms and mazes): the route
         // joins the roadmap, and a proof that none exists ends the query.

@@ -117,6 +117,31 @@ fn a_wall_without_an_opening_separates_the_regions() {
     }
 }
 
+#[test]
+fn labelled_regions_refuse_a_sealed_wall_and_keep_a_one_voxel_hole() {
+    let res = 0.35;
+    let (a, b) = ([1.5, 1.5, 1.5], [5.5, 5.5, 1.5]);
+    let mut sealed = boxed(res, [20, 20, 10]);
+    wall_with_hole(&mut sealed, 10, 0..0, 0..0);
+    let c = ctx(sealed, 0.0);
+    let lat = HeadLattice::new(&c, 0.0, 2.0);
+    match lat.separation(c.field(), a, b) {
+        Some(LatticeOutcome::Separated {
+            side, size, unit, ..
+        }) => {
+            assert_eq!(unit, "voxels");
+            // The smaller side: 8 x 18 x 8 free voxels behind the wall.
+            assert_eq!((side, size), ("goal", 8 * 18 * 8));
+        }
+        other => panic!("not separated: {other:?}"),
+    }
+    let mut holed = boxed(res, [20, 20, 10]);
+    wall_with_hole(&mut holed, 10, 10..11, 5..6);
+    let c = ctx(holed, 0.0);
+    let lat = HeadLattice::new(&c, 0.0, 2.0);
+    assert_eq!(lat.separation(c.field(), a, b), None);
+}
+
 /// Reference: a breadth-first flood over the whole lattice with the same exact
 /// test, from the start's anchors to the goal's.
 fn flood_connects(
@@ -184,6 +209,10 @@ proptest! {
         };
         let (a, b) = (pick(&mut rng), pick(&mut rng));
         let reference = flood_connects(&lat, &c, a, b);
+        // The labelled regions only ever prove what the flood confirms.
+        if let Some(sep) = lat.separation(c.field(), a, b) {
+            prop_assert_eq!(reference, Some(false), "regions said {:?}", sep);
+        }
         let got = lat.route(&c, a, b);
         match (reference, &got) {
             (None, LatticeOutcome::NoAnchor { .. }) => {}
