@@ -77,7 +77,9 @@ pub fn build(name: &str) -> Result<Scenario, ProblemError> {
         "silos" => Ok(silos()),
         "corridor" => corridor(DEFAULT_CORRIDOR_LENGTH),
         _ => {
-            if let Some(spec) = name.strip_prefix("passage:") {
+            if let Some(large) = super::large::build(name) {
+                large
+            } else if let Some(spec) = name.strip_prefix("passage:") {
                 super::passages::PassageSpec::parse(spec)?.build()
             } else if let Some(len) = name.strip_prefix("corridor:") {
                 let l: f64 = len

@@ -55,9 +55,7 @@ impl HeadLattice {
     /// the exact distance to the obstacle cubes otherwise) when the sphere of radius
     /// `r_min` is free there and `p` is inside the box; `None` otherwise.
     pub fn point_clearance(&self, field: &DistanceField, p: [f64; 3]) -> Option<f64> {
-        let inside =
-            (0..3).all(|a| p[a] >= self.lo[a] + FK_TOLERANCE && p[a] <= self.hi[a] - FK_TOLERANCE);
-        if !inside {
+        if !self.inside(p) {
             return None;
         }
         let c = field.clearance(p);
@@ -72,6 +70,11 @@ impl HeadLattice {
         }
         let e = exact_clearance(field, p, self.r_min, self.r_pref + self.h);
         (e > self.r_min).then_some(e)
+    }
+
+    /// Whether `p` is inside the map's box (by the FK tolerance).
+    pub(super) fn inside(&self, p: [f64; 3]) -> bool {
+        (0..3).all(|a| p[a] >= self.lo[a] + FK_TOLERANCE && p[a] <= self.hi[a] - FK_TOLERANCE)
     }
 
     /// Whether the sphere of radius `r_min` is free at `p` (exact test).

@@ -39,6 +39,7 @@
 
 mod clearance;
 mod flood;
+mod guide;
 mod nodes;
 mod pull;
 mod regions;
@@ -293,7 +294,8 @@ impl HeadLattice {
             map: KeyMap::default(),
         };
         let mut expanded = 0;
-        match self.search(&mut nodes, start, goal, 2, &limit) {
+        let guide = guide::Guide::new(self, field, start, goal);
+        match self.search(&mut nodes, start, goal, 2, &limit, &guide) {
             Search::Found(keys, n) => {
                 return self.finish(ctx_min, &mut nodes, start, goal, keys, n)
             }
@@ -307,7 +309,7 @@ impl HeadLattice {
         for n in nodes.map.values_mut() {
             (n.g, n.parent, n.closed, n.flooded) = (f64::INFINITY, u64::MAX, false, false);
         }
-        match self.search(&mut nodes, start, goal, 1, &limit) {
+        match self.search(&mut nodes, start, goal, 1, &limit, &guide) {
             Search::Found(keys, n) => {
                 self.finish(ctx_min, &mut nodes, start, goal, keys, n + expanded)
             }

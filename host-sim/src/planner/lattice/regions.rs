@@ -172,11 +172,21 @@ fn row_runs(field: &DistanceField, [y, z]: [usize; 2], threshold: f64) -> Vec<[u
     let g = field.grid();
     let r = g.resolution();
     let o = g.origin();
+    // The field's bound is at most r (sqrt(3) - 1) / 2 below the true distance of a
+    // centre (the nearest obstacle centre's cube is within sqrt(n) - 1/2 voxels).
+    let slack = r * (3f64.sqrt() - 1.0) / 2.0 + ROUND_EPS;
     let mut runs = Vec::new();
     let mut open: Option<u32> = None;
-    for x in 0..g.dims()[0] {
-        let i = [o[0] + x as i32, o[1] + y as i32, o[2] + z as i32];
-        let free = relaxed_free(field, i, r, threshold);
+    let row = g.obstacle_row(y, z).zip(field.row_bounds(y, z));
+    for (x, (obstacle, &lb)) in row.enumerate() {
+        let lb = lb as f64;
+        let free = !obstacle
+            && (lb > threshold
+                || (lb + slack > threshold && {
+                    let i = [o[0] + x as i32, o[1] + y as i32, o[2] + z as i32];
+                    let c = g.voxel_center(i);
+                    exact_clearance(field, c, threshold, threshold + r) > threshold
+                }));
         match (free, open) {
             (true, None) => open = Some(x as u32),
             (false, Some(x0)) => {
@@ -190,26 +200,6 @@ fn row_runs(field: &DistanceField, [y, z]: [usize; 2], threshold: f64) -> Vec<[u
         runs.push([x0, g.dims()[0] as u32 - 1]);
     }
     runs
-}
-
-/// Whether voxel `i` (lattice index) is relaxed-free: not an obstacle, and its
-/// centre farther than `threshold` from every obstacle cube.
-fn relaxed_free(field: &DistanceField, i: [i32; 3], r: f64, threshold: f64) -> bool {
-    if field.grid().is_obstacle(i) {
-        return false;
-    }
-    let lb = field.voxel_clearance(i);
-    if lb > threshold {
-        return true;
-    }
-    // The field's bound is at most r (sqrt(3) - 1) / 2 below the true distance of a
-    // centre (the nearest obstacle centre's cube is within sqrt(n) - 1/2 voxels).
-    let ub = lb + r * (3f64.sqrt() - 1.0) / 2.0 + ROUND_EPS;
-    if ub <= threshold {
-        return false;
-    }
-    let c = field.grid().voxel_center(i);
-    exact_clearance(field, c, threshold, threshold + r) > threshold
 }
 
 /// The root of `i`, halving the path on the way.
