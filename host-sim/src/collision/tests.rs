@@ -35,8 +35,11 @@ fn open_space_and_a_wall() {
     let line = Shape::line(4, 0.0); // trails along -x
                                     // 0.35 m from the wall: accepted (the bound loses some of the 0.15 m of slack).
     assert_eq!(ctx.check_config([2.65, 1.95, 0.95], &line), Ok(()));
-    // 0.25 m from the wall at voxel faces: truly free, but the bound cannot prove it.
-    assert!(ctx.check_config([2.75, 2.0, 1.0], &line).is_err());
+    // 0.25 m from the wall at voxel faces: truly free; the field's bound alone cannot
+    // prove it, the exact measure of the cubes nearby does.
+    assert_eq!(ctx.check_config([2.75, 2.0, 1.0], &line), Ok(()));
+    // 0.19 m from the wall: below r_u + clearance (0.2 m), refused.
+    assert!(ctx.check_config([2.81, 2.0, 1.0], &line).is_err());
     // Head sphere reaches the wall: 3.0 - 2.85 = 0.15 <= r_u.
     assert!(matches!(
         ctx.check_config([2.85, 2.0, 1.0], &line),
@@ -82,7 +85,7 @@ fn open_space_and_a_wall() {
     assert!(!ctx.is_head_segment_free([2.0, 2.0, 1.0], [3.5, 2.0, 1.0]));
     assert!((ctx.clearance([2.5, 2.0, 1.0]) - 0.5).abs() < 0.1);
     let st = ctx.stats();
-    assert_eq!(st.configs, 5);
+    assert_eq!(st.configs, 6);
     assert_eq!(st.translations, 2);
     assert_eq!(st.shape_changes, 2);
     assert_eq!(st.head_points, 2);

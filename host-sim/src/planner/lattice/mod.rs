@@ -47,7 +47,7 @@ mod search;
 #[cfg(test)]
 mod tests;
 
-pub use clearance::exact_clearance;
+pub use crate::collision::exact::exact_clearance;
 pub use regions::Regions;
 
 use crate::collision::{CollisionContext, FK_TOLERANCE};
@@ -209,7 +209,7 @@ impl HeadLattice {
     }
 
     /// The voxel (local indices) whose closed cube holds lattice point `k`.
-    fn voxel_of(&self, k: u64) -> [usize; 3] {
+    pub(super) fn voxel_of(&self, k: u64) -> [usize; 3] {
         let i = Self::unpack(k);
         [0, 1, 2].map(|a| ((i[a] / 2).min(self.n[a] / 2 - 1)).max(0) as usize)
     }
@@ -294,7 +294,10 @@ impl HeadLattice {
             map: KeyMap::default(),
         };
         let mut expanded = 0;
-        let guide = guide::Guide::new(self, field, start, goal);
+        let regions = self.regions(field);
+        let starts = self.anchors(&mut nodes, start, 1);
+        let goals = self.anchors(&mut nodes, goal, 1);
+        let guide = guide::Guide::new(self, regions, &starts, &goals, goal);
         match self.search(&mut nodes, start, goal, 2, &limit, &guide) {
             Search::Found(keys, n) => {
                 return self.finish(ctx_min, &mut nodes, start, goal, keys, n)

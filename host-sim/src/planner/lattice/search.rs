@@ -142,7 +142,7 @@ impl HeadLattice {
         goal: [f64; 3],
         stride: i64,
         limit: &Limit,
-        guide: &Guide,
+        guide: &Guide<'_>,
     ) -> Search {
         let starts = self.anchors(nodes, start, stride);
         if starts.is_empty() {
@@ -162,7 +162,7 @@ impl HeadLattice {
             if c < n.g {
                 n.g = c;
                 open.push(Open {
-                    f: c + HEURISTIC_WEIGHT * guide.estimate(self.point(s)),
+                    f: c + HEURISTIC_WEIGHT * guide.estimate(s, self.point(s)),
                     k: s,
                 });
             }
@@ -226,7 +226,7 @@ impl HeadLattice {
                     nn.g = ng;
                     nn.parent = k;
                     open.push(Open {
-                        f: ng + HEURISTIC_WEIGHT * guide.estimate(pn),
+                        f: ng + HEURISTIC_WEIGHT * guide.estimate(n, pn),
                         k: n,
                     });
                 }
