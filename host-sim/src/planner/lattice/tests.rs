@@ -142,6 +142,41 @@ fn labelled_regions_refuse_a_sealed_wall_and_keep_a_one_voxel_hole() {
     assert_eq!(lat.separation(c.field(), a, b), None);
 }
 
+#[test]
+fn the_coarse_guide_leads_through_the_door_not_the_wall() {
+    // A 0.2 m wall across x at 2.0-2.2 m with a 0.6 m door at y 3.0-3.6 m; start and
+    // goal 2 m apart on either side of the wall, 2.5 m from the door.
+    let res = 0.1;
+    let mut g = boxed(res, [40, 40, 20]);
+    for wx in 20..22 {
+        wall_with_hole(&mut g, wx, 30..36, 1..15);
+    }
+    let c = ctx(g, 0.0);
+    let lat = HeadLattice::new(&c, 0.0, 2.0);
+    let (a, b) = ([1.0, 1.0, 1.0], [3.2, 1.0, 1.0]);
+    let mut nodes = Nodes {
+        lat: &lat,
+        field: c.field(),
+        map: KeyMap::default(),
+    };
+    let starts = lat.anchors(&mut nodes, a, 1);
+    let goals = lat.anchors(&mut nodes, b, 1);
+    let guide = super::guide::Guide::new(&lat, lat.regions(c.field()), &starts, &goals, b);
+    let door = [2.1, 3.3, 1.0];
+    let around = dist(a, door) + dist(door, b);
+    let h = guide.estimate(starts[0], lat.point(starts[0]));
+    // The way round (5.1 m), give or take a block, not the straight line (2.2 m).
+    assert!((h - around).abs() < 0.8, "estimate {h}, way round {around}");
+    // And the route takes the door.
+    let LatticeOutcome::Found(r) = lat.route(&c, a, b) else {
+        panic!("no route");
+    };
+    assert!(r
+        .points
+        .iter()
+        .any(|p| p[1] > 2.9 && (2.0..2.2).contains(&p[0])));
+}
+
 /// Reference: a breadth-first flood over the whole lattice with the same exact
 /// test, from the start's anchors to the goal's.
 fn flood_connects(
