@@ -14,6 +14,13 @@
 //! `R`, and only where it does not are the obstacle cubes near the point measured one
 //! by one ([`exact_clearance`]). Points are 26-connected.
 //!
+//! Once per map, setup labels the free regions of a relaxed voxel set
+//! ([`Regions`]): a query whose start and goal lie in different regions is refused at
+//! once (no lattice route can exist), whatever the map's size. The same sweep builds a
+//! coarse graph of free-space pieces per block, and a Dijkstra over it from the goal
+//! ([`guide`]) gives the A* a heuristic that knows the way through doors, where the
+//! straight line would flood every room that faces the goal across a wall.
+//!
 //! A query is an A* from the lattice points next to the start to those next to the
 //! goal. Each step costs its length times `1 + w max(0, 1 - (c - r_u) / c_ref)`, `c`
 //! the clearance of the point it enters, plus a surcharge where `c` is below the
