@@ -61,9 +61,9 @@ pub struct Regions {
     /// Segments: runs of relaxed-free voxels along x, cut where they cross a block
     /// boundary; `[x0, x1]` inclusive, local indices.
     segs: Vec<[u32; 2]>,
-    /// Region of each segment (the smallest segment index in it).
+    /// Region of each coarse node (the smallest node index in it).
     region: Vec<u32>,
-    /// Voxels per region, indexed by the region's segment index.
+    /// Voxels per region, indexed by the region's node index.
     size: Vec<u64>,
     /// Coarse node of each segment: the segments of one block that are connected
     /// within it.
@@ -122,8 +122,9 @@ impl Regions {
             node: Vec::new(),
             coarse: CoarseGraph::default(),
         };
-        regions.join_rows();
-        regions.build_coarse(field);
+        let across = regions.join_rows();
+        let voxels = regions.build_coarse(field, &across);
+        regions.label_regions(&voxels);
         regions
     }
 
@@ -177,28 +178,19 @@ impl Regions {
         }
     }
 
-    /// Union-find over the segments: every touching pair joins a region, and a pair
-    /// within one block joins a coarse node. Sets every segment's region and node and
-    /// every region's size.
-    fn join_rows(&mut self) {
+    /// Union-find over the segments: a touching pair within one block joins a coarse
+    /// node. Sets every segment's node; returns the touching pairs across blocks.
+    fn join_rows(&mut self) -> Vec<(u32, u32)> {
         let n = self.segs.len();
-        let mut global: Vec<u32> = (0..n as u32).collect();
         let mut local: Vec<u32> = (0..n as u32).collect();
+        let mut across = Vec::new();
         self.each_touching(|i, j, same_block| {
-            union(&mut global, i as u32, j as u32);
             if same_block {
                 union(&mut local, i as u32, j as u32);
+            } else {
+                across.push((i as u32, j as u32));
             }
         });
-        let mut size = vec![0u64; n];
-        self.region = (0..n)
-            .map(|i| {
-                let root = find(&mut global, i as u32);
-                size[root as usize] += (self.segs[i][1] - self.segs[i][0] + 1) as u64;
-                root
-            })
-            .collect();
-        self.size = size;
         // Coarse nodes: the local roots, numbered in order.
         let mut number = vec![u32::MAX; n];
         let mut count = 0u32;
@@ -212,11 +204,35 @@ impl Regions {
                 number[root]
             })
             .collect();
+        across
+    }
+
+    /// The regions: the connected components of the coarse graph (its nodes are
+    /// connected pieces, its edges every adjacency between them), with their sizes.
+    fn label_regions(&mut self, voxels: &[f64]) {
+        let nodes = voxels.len();
+        let mut parent: Vec<u32> = (0..nodes as u32).collect();
+        for a in 0..nodes {
+            let edges = self.coarse.edge_start[a] as usize..self.coarse.edge_start[a + 1] as usize;
+            for &(b, _) in &self.coarse.edges[edges] {
+                union(&mut parent, a as u32, b);
+            }
+        }
+        let mut size = vec![0u64; nodes];
+        self.region = (0..nodes)
+            .map(|a| {
+                let root = find(&mut parent, a as u32);
+                size[root as usize] += voxels[a] as u64;
+                root
+            })
+            .collect();
+        self.size = size;
     }
 
     /// The coarse graph: node centres from the segments, edges where segments of two
     /// nodes touch across a block boundary.
-    fn build_coarse(&mut self, field: &DistanceField) {
+    /// Returns the voxels of each node.
+    fn build_coarse(&mut self, field: &DistanceField, across: &[(u32, u32)]) -> Vec<f64> {
         let nodes = self.node.iter().map(|&k| k as usize + 1).max().unwrap_or(0);
         let mut sum = vec![[0f64; 3]; nodes];
         let mut count = vec![0f64; nodes];
@@ -244,11 +260,10 @@ impl Regions {
         // Neighbour lists; a node has a few dozen neighbours at most, and the same
         // pair comes up row after row, so a linear check dedups cheaply.
         let mut adjacent: Vec<Vec<u32>> = vec![Vec::new(); nodes];
-        let node = &self.node;
-        self.each_touching(|i, j, same_block| {
-            let (a, b) = (node[i], node[j]);
-            if same_block || a == b {
-                return;
+        for &(i, j) in across {
+            let (a, b) = (self.node[i as usize], self.node[j as usize]);
+            if a == b {
+                continue;
             }
             for (from, to) in [(a, b), (b, a)] {
                 let list = &mut adjacent[from as usize];
@@ -256,7 +271,7 @@ impl Regions {
                     list.push(to);
                 }
             }
-        });
+        }
         let mut edge_start = Vec::with_capacity(nodes + 1);
         let mut edges = Vec::new();
         for (a, list) in adjacent.iter_mut().enumerate() {
@@ -274,6 +289,7 @@ impl Regions {
             edges,
             block_m: self.block as f64 * r,
         };
+        count
     }
 
     /// The segment holding voxel `v` (local indices), when it is relaxed-free.
@@ -291,7 +307,8 @@ impl Regions {
     /// The region holding voxel `v` (local indices), `None` when it is not
     /// relaxed-free.
     pub fn region_of(&self, v: [usize; 3]) -> Option<u32> {
-        self.segment_of(v).map(|i| self.region[i])
+        self.segment_of(v)
+            .map(|i| self.region[self.node[i] as usize])
     }
 
     /// The coarse node holding voxel `v` (local indices), `None` when it is not
