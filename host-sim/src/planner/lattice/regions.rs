@@ -13,6 +13,12 @@
 //! - is not itself an obstacle (else `d(p) = 0`), and
 //! - has `d(c) > R - r sqrt(3) / 2` (the distance is 1-Lipschitz).
 //!
+//! The labelling only ever needs MORE free voxels than that (more voxels can only
+//! join regions), so it needs no exact measure: a voxel counts as relaxed-free when it
+//! is not an obstacle and the distance field's bound at its centre, plus the most the
+//! bound can lose there (`r (sqrt(3) - 1) / 2`: the nearest obstacle centre's cube is
+//! within `sqrt(n) - 1/2` voxels), exceeds `R - r sqrt(3) / 2`.
+//!
 //! Call such voxels RELAXED-FREE. Lattice neighbours differ by at most one index per
 //! axis, so their voxels are equal or 26-neighbours. Hence a lattice route maps to a
 //! 26-connected walk through relaxed-free voxels, and when the start's lattice
@@ -39,7 +45,6 @@
 
 use rayon::prelude::*;
 
-use crate::collision::exact::exact_clearance;
 use crate::map::distance::DistanceField;
 
 /// Allowance for rounding in the relaxed test (m): relaxing further is always safe.
@@ -346,22 +351,14 @@ fn cut(runs: Vec<[u32; 2]>, block: u32) -> Vec<[u32; 2]> {
 fn row_runs(field: &DistanceField, [y, z]: [usize; 2], threshold: f64) -> Vec<[u32; 2]> {
     let g = field.grid();
     let r = g.resolution();
-    let o = g.origin();
     // The field's bound is at most r (sqrt(3) - 1) / 2 below the true distance of a
-    // centre (the nearest obstacle centre's cube is within sqrt(n) - 1/2 voxels).
-    let slack = r * (3f64.sqrt() - 1.0) / 2.0 + ROUND_EPS;
+    // centre (see the module docs): a voxel it cannot rule out counts as free.
+    let bar = (threshold - r * (3f64.sqrt() - 1.0) / 2.0 - ROUND_EPS) as f32;
     let mut runs = Vec::new();
     let mut open: Option<u32> = None;
     let row = g.obstacle_row(y, z).zip(field.row_bounds(y, z));
     for (x, (obstacle, &lb)) in row.enumerate() {
-        let lb = lb as f64;
-        let free = !obstacle
-            && (lb > threshold
-                || (lb + slack > threshold && {
-                    let i = [o[0] + x as i32, o[1] + y as i32, o[2] + z as i32];
-                    let c = g.voxel_center(i);
-                    exact_clearance(field, c, threshold, threshold + r) > threshold
-                }));
+        let free = !obstacle && lb > bar;
         match (free, open) {
             (true, None) => open = Some(x as u32),
             (false, Some(x0)) => {
