@@ -33,6 +33,19 @@ fn half_metre_windows_at_45_degrees_plan_for_5_and_6_units() {
 }
 
 #[test]
+fn half_metre_tunnels_plan_for_5_and_6_units() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, n) in [
+        ("passage:w=0.5,angle=30,wall=1.2", 5u8),
+        ("passage:w=0.55,angle=-45,offset=0.2,wall=1.5", 6),
+    ] {
+        let sc = scenarios::build(name).unwrap();
+        witness(&sc, &aerial_chain_core::ChainParams::new(n)).unwrap();
+        plan_and_verify(name, n, dir.path());
+    }
+}
+
+#[test]
 fn family_names_parse_and_build() {
     let spec = PassageSpec::parse("w=0.55,angle=30,door=0.7").unwrap();
     let sc = scenarios::build(&spec.name()).unwrap();

@@ -117,7 +117,7 @@ pub fn markdown(results: &[RunResult], redrawn: usize, meta: &str) -> String {
     let mut s = String::new();
     s += "# Robustness: the hard-case family (`arc bench robust`)\n\n";
     s += &format!(
-        "{n} random instances of `passage:` (windows 0.45-0.6 m, walls 0.1-0.3 m, approach 0-60 degrees either way, \
+        "{n} random instances of `passage:` (windows 0.45-0.6 m in walls of 0.1-0.3 m, or one in five a tunnel 0.5-0.6 m square and 0.6-1.5 m long; approach 0-60 degrees either way, \
          offsets up to 0.3 m, a second wall with a door in half), N = 4..8, `arc plan`'s defaults. \
          Every instance has a witness checked by the exact verifier; {redrawn} draws without one were redrawn.\n\n"
     );
