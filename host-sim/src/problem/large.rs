@@ -16,9 +16,9 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use super::scenarios::Scenario;
+use super::scenarios::{fill, shell_box, Scenario};
 use super::ProblemError;
-use crate::map::grid::{Cell, Grid};
+use crate::map::grid::Cell;
 
 /// Allowed resolutions of `campus:RES` (m).
 pub const CAMPUS_RESOLUTIONS: std::ops::RangeInclusive<f64> = 0.1..=0.4;
@@ -61,34 +61,6 @@ pub fn build(name: &str) -> Option<Result<Scenario, ProblemError>> {
     } else {
         hall(res)
     }))
-}
-
-/// A box of `size` metres at `res`, free inside a shell of `shell` metres.
-fn shell_box(size: [f64; 3], res: f64, shell: f64) -> Grid {
-    let dims = size.map(|s| (s / res).round() as usize);
-    let mut g = Grid::new(res, [0; 3], dims, Cell::Occupied, true)
-        .expect("generated sizes are positive and within the grid's limits");
-    let e = 1e-6;
-    g.fill_box(
-        [shell + e; 3],
-        [
-            size[0] - shell - e,
-            size[1] - shell - e,
-            size[2] - shell - e,
-        ],
-        Cell::Free,
-    );
-    g
-}
-
-/// Sets the voxels whose centres lie in `lo..hi` to `state`.
-fn fill(g: &mut Grid, lo: [f64; 3], hi: [f64; 3], state: Cell) {
-    let e = 1e-6;
-    g.fill_box(
-        [lo[0] + e, lo[1] + e, lo[2] + e],
-        [hi[0] - e, hi[1] - e, hi[2] - e],
-        state,
-    );
 }
 
 /// Campus block pitch (m): a 12 m building and an 8 m street.

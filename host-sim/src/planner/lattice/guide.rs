@@ -16,10 +16,10 @@
 //! lattice keeps apart, or the anchors lie outside every piece), the guide steps
 //! aside and the A* falls back on the straight-line distance.
 
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use super::regions::Regions;
+use super::search::Open;
 use super::{dist, HeadLattice};
 
 /// Coarse distances to one goal.
@@ -35,24 +35,6 @@ pub(super) struct Guide<'a> {
     /// The Dijkstra's radius when it stopped: unsettled nodes are at least this far.
     reach: f64,
     goal: [f64; 3],
-}
-
-/// Heap entry, nearest first.
-#[derive(PartialEq)]
-struct Entry {
-    d: f32,
-    k: u32,
-}
-impl Eq for Entry {}
-impl Ord for Entry {
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.d.total_cmp(&self.d).then_with(|| o.k.cmp(&self.k))
-    }
-}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
 }
 
 impl<'a> Guide<'a> {
@@ -100,13 +82,16 @@ impl<'a> Guide<'a> {
                 let d = dist(coarse.centre[n as usize], self.goal) as f32;
                 if d < cost[n as usize] {
                     cost[n as usize] = d;
-                    heap.push(Entry { d, k: n });
+                    heap.push(Open {
+                        f: d as f64,
+                        k: n as u64,
+                    });
                 }
             }
         }
         let mut remaining = targets.len();
-        while let Some(Entry { d, k }) = heap.pop() {
-            let k = k as usize;
+        while let Some(Open { f, k }) = heap.pop() {
+            let (d, k) = (f as f32, k as usize);
             if self.dist[k].is_finite() {
                 continue;
             }
@@ -125,7 +110,10 @@ impl<'a> Guide<'a> {
                 if self.dist[j as usize].is_infinite() && nd < cost[j as usize] {
                     cost[j as usize] = nd;
                     self.next[j as usize] = k as u32;
-                    heap.push(Entry { d: nd, k: j });
+                    heap.push(Open {
+                        f: nd as f64,
+                        k: j as u64,
+                    });
                 }
             }
         }

@@ -38,11 +38,11 @@ impl Limit {
     }
 }
 
-/// Open-list entry, lowest `f` first.
+/// Open-list entry, lowest `f` first (ties: the lower key).
 #[derive(PartialEq)]
-struct Open {
-    f: f64,
-    k: u64,
+pub(super) struct Open {
+    pub(super) f: f64,
+    pub(super) k: u64,
 }
 impl Eq for Open {}
 impl Ord for Open {
