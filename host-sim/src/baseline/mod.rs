@@ -54,7 +54,7 @@ use std::time::{Duration, Instant};
 use serde_json::json;
 
 use crate::collision::CollisionContext;
-use crate::plan::{Plan, Timing};
+use crate::plan::{Plan, Timings};
 use crate::planner::{Planner, Query, Solution, SolutionStats, Step, Termination};
 pub use error::PrmError;
 use roadmap::{valid_tolerance, Roadmap};
@@ -67,12 +67,8 @@ pub type PrmSolution = Solution<PrmStats>;
 /// Counters and timings of a roadmap and one query.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PrmStats {
-    /// Roadmap build time: sampling and neighbours (s).
-    pub roadmap_s: f64,
-    /// Query time (s).
-    pub planning_s: f64,
-    /// Of the query time, spent in edge checks (s).
-    pub collision_s: f64,
+    /// Roadmap build (sampling and neighbours), query and edge-check times.
+    pub timings: Timings,
     /// Vertices in the roadmap (goal samples included).
     pub vertices: usize,
     /// Of them, goal samples.
@@ -200,8 +196,8 @@ impl Planner for FullStatePrm {
         self.roadmap = Some(roadmap);
         let (steps, q) = result?;
         let after = self.ctx.stats();
-        stats.planning_s = began.elapsed().as_secs_f64();
-        stats.collision_s = q.collision_s;
+        stats.timings.planning_s = began.elapsed().as_secs_f64();
+        stats.timings.collision_s = q.timings.collision_s;
         stats.iterations = q.iterations;
         stats.edges_checked = q.edges_checked;
         stats.edges_blocked = q.edges_blocked;
@@ -241,13 +237,12 @@ impl SolutionStats for PrmStats {
         ]
     }
 
-    fn timing(&self) -> Timing {
-        Timing {
-            roadmap_s: self.roadmap_s,
-            planning_s: self.planning_s,
-            collision_s: self.collision_s,
-            rest: "search_s",
-        }
+    fn timings(&self) -> Timings {
+        self.timings
+    }
+
+    fn rest_name(&self) -> &'static str {
+        "search_s"
     }
 
     /// Which planner made the plan, and whether its roadmap was cut short.

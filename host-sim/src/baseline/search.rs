@@ -57,7 +57,7 @@ impl LazySearch<'_> {
         r.graph.truncate(n, false);
         let (steps, path_edges) = result?;
         self.stats.path_edges = path_edges;
-        self.stats.collision_s = self.collision.as_secs_f64();
+        self.stats.timings.collision_s = self.collision.as_secs_f64();
         Ok((steps, self.stats))
     }
 

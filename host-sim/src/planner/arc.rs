@@ -23,18 +23,14 @@ use super::{
     Termination,
 };
 use crate::collision::CollisionContext;
-use crate::plan::{Plan, Timing};
+use crate::plan::{Plan, Timings};
 use crate::tables::ShapeTables;
 
 /// Counters and timings of one query.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Stats {
-    /// Roadmap build time (s).
-    pub roadmap_s: f64,
-    /// Query time (s).
-    pub planning_s: f64,
-    /// Of the query time, spent in collision checks (s).
-    pub collision_s: f64,
+    /// Roadmap build, query and collision-check times.
+    pub timings: Timings,
     /// Head edges flown.
     pub edges: usize,
     /// Shape-change waypoints.
@@ -301,8 +297,8 @@ impl ArcPlanner {
         stats.lattice_expanded = lattice_expanded;
         stats.lattice_s = lattice_s;
         stats.route_points = route.as_ref().map_or(0, |r| r.points.len());
-        stats.roadmap_s = self.roadmap_s;
-        stats.planning_s = query_began.elapsed().as_secs_f64();
+        stats.timings.roadmap_s = self.roadmap_s;
+        stats.timings.planning_s = query_began.elapsed().as_secs_f64();
         (stats.roadmap_vertices, stats.roadmap_edges) = size;
         Ok(Solution { steps, stats })
     }
@@ -348,7 +344,10 @@ impl Planner for ArcPlanner {
             .as_ref()
             .map_or((0, 0), |r| (r.vertex_count(), r.edge_count()));
         Stats {
-            roadmap_s: self.roadmap_s,
+            timings: Timings {
+                roadmap_s: self.roadmap_s,
+                ..Default::default()
+            },
             roadmap_vertices,
             roadmap_edges,
             ..Default::default()
@@ -377,13 +376,12 @@ impl SolutionStats for Stats {
         ]
     }
 
-    fn timing(&self) -> Timing {
-        Timing {
-            roadmap_s: self.roadmap_s,
-            planning_s: self.planning_s,
-            collision_s: self.collision_s,
-            rest: "shape_search_s",
-        }
+    fn timings(&self) -> Timings {
+        self.timings
+    }
+
+    fn rest_name(&self) -> &'static str {
+        "shape_search_s"
     }
 
     /// Where each waypoint's shape came from, and the smallest clearance margin in

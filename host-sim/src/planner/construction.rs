@@ -203,7 +203,7 @@ impl<'p> Construction<'p> {
                 self.stats.min_margin_at = Some(at);
             }
         }
-        self.stats.collision_s = self.checker.time.as_secs_f64();
+        self.stats.timings.collision_s = self.checker.time.as_secs_f64();
         Ok((self.steps, self.stats))
     }
 

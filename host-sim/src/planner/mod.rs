@@ -46,7 +46,7 @@ pub use refine::{Quality, Refinement};
 pub use settings::{Mode, Preference, Settings};
 
 use crate::collision::CollisionContext;
-use crate::plan::{Plan, Timing};
+use crate::plan::{Plan, Timings};
 
 /// What a planner is asked: from a start configuration of the chain to a goal region
 /// for the head.
@@ -124,7 +124,9 @@ pub trait SolutionStats {
     /// The counters, in the order the plan file lists them.
     fn counts(&self) -> Vec<(&'static str, u64)>;
     /// Where the time went.
-    fn timing(&self) -> Timing;
+    fn timings(&self) -> Timings;
+    /// The name of the query's time outside collision checks in the plan file.
+    fn rest_name(&self) -> &'static str;
     /// Adds what else this planner records about the solution `steps` to `plan`.
     fn annotate(&self, steps: &[Step], plan: &mut Plan);
 }

@@ -42,7 +42,7 @@ pub fn to_plan<S: SolutionStats>(
         (resolution, unknown_is_occupied),
         steps,
         &st.counts(),
-        &st.timing(),
+        (&st.timings(), st.rest_name()),
     );
     st.annotate(&solution.steps, &mut plan);
     plan

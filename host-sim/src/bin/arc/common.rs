@@ -359,7 +359,8 @@ pub fn start_shape(params: &ChainParams, name: &str, yaw: f32) -> Result<Shape, 
 pub fn read_plan(
     path: &std::path::Path,
 ) -> Result<(aerial_chain::plan::Plan, String, ChainParams), CliError> {
-    let plan = aerial_chain::plan::Plan::read(path).map_err(|e| CliError::input(e.to_string()))?;
+    let plan =
+        aerial_chain::plan::Plan::read(path).map_err(|e| CliError::input(e.to_string()))?;
     let name = crate::fsutil::input_name(path);
     let params = plan
         .check()

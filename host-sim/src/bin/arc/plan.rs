@@ -261,10 +261,10 @@ pub fn run(a: PlanArgs) -> CliResult {
     report.line(format_args!(
         "  setup {:.1} ms, roadmap {:.1} ms ({} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
         setup_s * 1e3,
-        s.roadmap_s * 1e3,
+        s.timings.roadmap_s * 1e3,
         s.roadmap_vertices,
-        s.planning_s * 1e3,
-        s.collision_s * 1e3,
+        s.timings.planning_s * 1e3,
+        s.timings.collision_s * 1e3,
         s.collision_checks
     ));
     print_quality(&report, &quality, refinement.as_ref());

@@ -16,6 +16,7 @@
 //! include some contention; both planners of a study run in the same batch, so their
 //! ratio is fair.
 
+mod error;
 pub mod paper;
 pub mod plot;
 mod report;
@@ -23,6 +24,7 @@ pub mod robust;
 pub mod scale;
 mod statistics;
 
+pub use error::StudyError;
 pub use report::{fmt_ms, ms, runs_csv, summary_csv, write_out};
 pub use statistics::{summarize, Spread, Summary};
 
@@ -112,9 +114,10 @@ impl Method {
 /// Start and goal of a query (at the default goal tolerance).
 pub use aerial_chain::planner::Query;
 
-/// One benchmark run.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RunSpec {
+/// What names a group of runs (a row of a results table): the runs of a group share
+/// their key and differ in their seeds.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct RunKey {
     /// Which study it belongs to (`table1`, `scale-units`, ...).
     pub study: String,
     /// Built-in scenario name.
@@ -127,6 +130,44 @@ pub struct RunSpec {
     pub vertices: usize,
     /// Random shapes `N_SRS` (ARCplanner; 0 for LSC only).
     pub srs: usize,
+}
+
+impl RunKey {
+    /// The group of `study` on `scenario` with N = `units`, `method` and its budgets
+    /// (roadmap vertices, `N_SRS`).
+    pub fn new(
+        study: &str,
+        scenario: &str,
+        units: u8,
+        method: Method,
+        (vertices, srs): (usize, usize),
+    ) -> Self {
+        Self {
+            study: study.into(),
+            scenario: scenario.into(),
+            units,
+            method,
+            vertices,
+            srs,
+        }
+    }
+
+    /// The run of this group with `seed` under `time_limit`, on the scenario's own query.
+    pub fn run(&self, seed: u64, time_limit: Option<f64>) -> RunSpec {
+        RunSpec {
+            key: self.clone(),
+            seed,
+            time_limit,
+            query: None,
+        }
+    }
+}
+
+/// One benchmark run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunSpec {
+    /// Its group.
+    pub key: RunKey,
     /// Seed of the roadmap (and of the SRS).
     pub seed: u64,
     /// Time limit of the query, and of the PRM's roadmap build (s).
@@ -287,15 +328,19 @@ pub const WIDE_WINDOW: &str = "window-wide:";
 /// A built-in scenario ([`scenarios::build`]), or the bench-only variant
 /// `window-wide:W`: `window` with its opening widened to `W` x `W` metres (`0.8..=2.4`,
 /// same centre), where a full-state PRM has a chance (see [`paper`]).
-pub fn build_scenario(name: &str) -> Result<Scenario, String> {
+pub fn build_scenario(name: &str) -> Result<Scenario, StudyError> {
     let Some(w) = name.strip_prefix(WIDE_WINDOW) else {
-        return scenarios::build(name).map_err(|e| e.to_string());
+        return Ok(scenarios::build(name)?);
+    };
+    let wide = |why: String| StudyError::WideWindow {
+        name: name.into(),
+        why,
     };
     let w: f64 = w
         .parse()
-        .map_err(|_| format!("{name}: the opening {w:?} is not a number"))?;
+        .map_err(|_| wide(format!("the opening {w:?} is not a number")))?;
     if !(0.8..=2.4).contains(&w) {
-        return Err(format!("{name}: the opening must be 0.8 to 2.4 m"));
+        return Err(wide("the opening must be 0.8 to 2.4 m".into()));
     }
     let mut sc = scenarios::window();
     let (h, e) = (0.5 * w, 1e-6);
@@ -316,13 +361,14 @@ pub struct Envs(BTreeMap<String, Env>);
 
 impl Envs {
     /// Builds every scenario the specs name.
-    pub fn for_specs(specs: &[RunSpec]) -> Result<Self, String> {
+    pub fn for_specs(specs: &[RunSpec]) -> Result<Self, StudyError> {
         let mut m = BTreeMap::new();
         for s in specs {
-            if !m.contains_key(&s.scenario) {
-                let scenario = build_scenario(&s.scenario)?;
+            let name = &s.key.scenario;
+            if !m.contains_key(name) {
+                let scenario = build_scenario(name)?;
                 let field = Arc::new(DistanceField::new(scenario.grid.clone()));
-                m.insert(s.scenario.clone(), Env { scenario, field });
+                m.insert(name.clone(), Env { scenario, field });
             }
         }
         Ok(Self(m))
@@ -335,20 +381,20 @@ impl Envs {
 }
 
 /// A collision context of its own (fresh counters) for a run.
-pub fn context(env: &Env, units: u8) -> Result<CollisionContext, String> {
+pub fn context(env: &Env, units: u8) -> Result<CollisionContext, StudyError> {
     let params = ChainParams::new(units)
         .validate()
-        .map_err(|e| format!("N = {units}: {e}"))?;
-    CollisionContext::new(env.field.clone(), params, DEFAULT_CLEARANCE).map_err(|e| e.to_string())
+        .map_err(|why| StudyError::Chain { units, why })?;
+    Ok(CollisionContext::new(
+        env.field.clone(),
+        params,
+        DEFAULT_CLEARANCE,
+    )?)
 }
 
 /// The scenario's own query for `units`: its start, LI at its start yaw, its goal.
-pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, String> {
-    Ok(Query::new(
-        sc.start,
-        sc.start_shape(units).map_err(|e| e.to_string())?,
-        sc.goal,
-    ))
+pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, StudyError> {
+    Ok(Query::new(sc.start, sc.start_shape(units)?, sc.goal))
 }
 
 /// A query for a chain that may not fit at the scenario's start as a straight line
@@ -359,7 +405,7 @@ pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, String> {
 /// is valid. The goal is the scenario's. PN comes second because its body bends
 /// evenly, so the chain can slide along it (follow-the-leader); the serpentines are
 /// zig-zags at the bend limit, along which no unit can slide.
-pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, String> {
+pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, StudyError> {
     let params = *ctx.params();
     let lib = library(&params);
     let mut positions = vec![sc.start];
@@ -401,30 +447,28 @@ pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, Str
             }
         }
     }
-    Err(format!(
-        "no library shape of N = {} fits within 1.5 m of {}'s start",
-        params.units, sc.name
-    ))
+    Err(StudyError::NoFittingStart {
+        units: params.units,
+        scenario: sc.name.clone(),
+    })
 }
 
 /// Runs one spec.
 pub fn run_one(envs: &Envs, spec: &RunSpec) -> RunResult {
-    let Some(env) = envs.get(&spec.scenario) else {
-        return RunResult::failed(
-            spec,
-            "error",
-            format!("scenario {} not built", spec.scenario),
-        );
+    let key = &spec.key;
+    let Some(env) = envs.get(&key.scenario) else {
+        let e = StudyError::NotBuilt(key.scenario.clone());
+        return RunResult::failed(spec, "error", e.to_string());
     };
-    let ctx = match context(env, spec.units) {
+    let ctx = match context(env, key.units) {
         Ok(c) => c,
-        Err(e) => return RunResult::failed(spec, "error", e),
+        Err(e) => return RunResult::failed(spec, "error", e.to_string()),
     };
     let query = match spec.query {
         Some(q) => q,
-        None => match default_query(&env.scenario, spec.units) {
+        None => match default_query(&env.scenario, key.units) {
             Ok(q) => q,
-            Err(e) => return RunResult::failed(spec, "error", e),
+            Err(e) => return RunResult::failed(spec, "error", e.to_string()),
         },
     };
     let stop = Termination {
@@ -433,7 +477,7 @@ pub fn run_one(envs: &Envs, spec: &RunSpec) -> RunResult {
             .time_limit
             .and_then(|t| Duration::try_from_secs_f64(t).ok()),
     };
-    match spec.method {
+    match key.method {
         Method::Arc(mode) => run_arc(env, ctx, spec, mode, query, stop),
         Method::FullPrm => run_prm(env, ctx, spec, query, stop),
     }
@@ -463,10 +507,10 @@ fn run_planner<P: Planner>(
             r.message = e.to_string();
         }
         Ok(sol) => {
-            let t = sol.stats.timing();
+            let t = sol.stats.timings();
             r.success = true;
             r.collision_s = Some(t.collision_s);
-            r.search_s = Some((t.planning_s - t.collision_s).max(0.0));
+            r.search_s = Some(t.rest_s());
             let g = &env.scenario.grid;
             let plan = to_plan(sol, &params, g.resolution(), g.unknown_is_occupied());
             r.waypoints = Some(plan.waypoints.len());
@@ -489,7 +533,7 @@ fn run_arc(
     let tables = ShapeTables::build(
         params,
         &TableSettings {
-            srs: spec.srs,
+            srs: spec.key.srs,
             seed: spec.seed,
             ..Default::default()
         },
@@ -501,7 +545,7 @@ fn run_arc(
         Err(e) => return RunResult::failed(spec, "error", e.to_string()),
     };
     let settings = Settings {
-        vertices: spec.vertices,
+        vertices: spec.key.vertices,
         mode: mode.mode(),
         follow_step: mode.follow_step(),
         seed: spec.seed,
@@ -516,7 +560,7 @@ fn run_arc(
     let stops = (Termination::default(), stop);
     let (mut r, res) = run_planner(env, spec, &mut planner, &q, stops);
     r.tables_s = tables_s;
-    r.roadmap_vertices = spec.vertices;
+    r.roadmap_vertices = spec.key.vertices;
     if let Ok(sol) = res {
         let s = &sol.stats;
         r.roadmap_vertices = s.roadmap_vertices;
@@ -537,7 +581,7 @@ fn run_prm(
     stop: Termination,
 ) -> RunResult {
     let settings = PrmSettings {
-        vertices: spec.vertices,
+        vertices: spec.key.vertices,
         seed: spec.seed,
         ..Default::default()
     };
@@ -574,19 +618,17 @@ pub fn run_all(
     threads: Option<usize>,
     what: &str,
     log: bool,
-) -> Result<Vec<RunResult>, String> {
+) -> Result<Vec<RunResult>, StudyError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| format!("thread pool: {e}"))?;
+        .build()?;
     let total = specs.len();
     let bar = if log && std::io::stderr().is_terminal() {
         let b = indicatif::ProgressBar::new(total as u64);
         b.set_style(
             indicatif::ProgressStyle::with_template(
                 "{msg} [{bar:40}] {pos}/{len} runs ({elapsed}, eta {eta})",
-            )
-            .map_err(|e| e.to_string())?
+            )?
             .progress_chars("=> "),
         );
         b.set_message(what.to_string());
@@ -686,17 +728,7 @@ mod tests {
 
     #[test]
     fn unknown_scenario_is_an_error() {
-        let spec = RunSpec {
-            study: "t".into(),
-            scenario: "nowhere".into(),
-            units: 4,
-            method: Method::FullPrm,
-            vertices: 10,
-            srs: 0,
-            seed: 1,
-            time_limit: None,
-            query: None,
-        };
+        let spec = RunKey::new("t", "nowhere", 4, Method::FullPrm, (10, 0)).run(1, None);
         assert!(Envs::for_specs(std::slice::from_ref(&spec)).is_err());
         let envs = Envs(BTreeMap::new());
         let r = run_one(&envs, &spec);

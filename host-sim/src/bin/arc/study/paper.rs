@@ -10,7 +10,7 @@
 
 use std::fmt::Write as _;
 
-use super::{fmt_ms, ms, ArcMode, Method, RunSpec, Summary};
+use super::{fmt_ms, ms, ArcMode, Method, RunKey, RunSpec, Summary};
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,19 +92,9 @@ pub fn specs(o: &PaperOptions) -> Vec<RunSpec> {
             continue;
         }
         for mode in MODES {
-            for seed in 1..=o.seeds {
-                v.push(RunSpec {
-                    study: study.into(),
-                    scenario: scenario.into(),
-                    units,
-                    method: Method::Arc(mode),
-                    vertices: o.vertices,
-                    srs: if mode == ArcMode::Lsc { 0 } else { o.srs },
-                    seed,
-                    time_limit: o.time_limit,
-                    query: None,
-                });
-            }
+            let srs = if mode == ArcMode::Lsc { 0 } else { o.srs };
+            let key = RunKey::new(study, scenario, units, Method::Arc(mode), (o.vertices, srs));
+            v.extend((1..=o.seeds).map(|seed| key.run(seed, o.time_limit)));
         }
     }
     if !o.tables.contains(&3) {
@@ -118,34 +108,13 @@ pub fn specs(o: &PaperOptions) -> Vec<RunSpec> {
                 && o.tables.contains(&1)
                 && ABLATION.contains(&("table1", "window", units));
             for mode in TABLE3_ARC.into_iter().filter(|_| !in_table1) {
-                for seed in 1..=o.seeds {
-                    v.push(RunSpec {
-                        study: study.into(),
-                        scenario: scenario.clone(),
-                        units,
-                        method: Method::Arc(mode),
-                        vertices: o.vertices,
-                        srs: o.srs,
-                        seed,
-                        time_limit: o.time_limit,
-                        query: None,
-                    });
-                }
+                let budgets = (o.vertices, o.srs);
+                let key = RunKey::new(study, &scenario, units, Method::Arc(mode), budgets);
+                v.extend((1..=o.seeds).map(|seed| key.run(seed, o.time_limit)));
             }
             for &m in &o.prm_vertices {
-                for seed in 1..=o.seeds {
-                    v.push(RunSpec {
-                        study: study.into(),
-                        scenario: scenario.clone(),
-                        units,
-                        method: Method::FullPrm,
-                        vertices: m,
-                        srs: 0,
-                        seed,
-                        time_limit: o.time_limit,
-                        query: None,
-                    });
-                }
+                let key = RunKey::new(study, &scenario, units, Method::FullPrm, (m, 0));
+                v.extend((1..=o.seeds).map(|seed| key.run(seed, o.time_limit)));
             }
         }
     }
@@ -202,10 +171,11 @@ fn find<'a>(
     vertices: Option<usize>,
 ) -> Option<&'a Summary> {
     sums.iter().find(|s| {
-        s.scenario == scenario
-            && s.units == units
-            && s.method == method
-            && vertices.is_none_or(|v| s.vertices == v)
+        let k = &s.key;
+        k.scenario == scenario
+            && k.units == units
+            && k.method == method
+            && vertices.is_none_or(|v| k.vertices == v)
     })
 }
 
@@ -252,11 +222,14 @@ pub fn speedups(sums: &[Summary], o: &PaperOptions) -> Vec<Speedup> {
         let arc = find(sums, scenario, units, Method::Arc(mode), None);
         let prm = sums
             .iter()
-            .filter(|s| &s.scenario == scenario && s.units == units && s.method == Method::FullPrm)
+            .filter(|s| {
+                let k = &s.key;
+                &k.scenario == scenario && k.units == units && k.method == Method::FullPrm
+            })
             .max_by(|a, b| {
                 a.success_rate()
                     .total_cmp(&b.success_rate())
-                    .then(b.vertices.cmp(&a.vertices))
+                    .then(b.key.vertices.cmp(&a.key.vertices))
             });
         if let (Some(a), Some(p)) = (arc, prm) {
             let ok_total = (p.successes > 0).then_some(p.total_ok.median);
@@ -264,7 +237,7 @@ pub fn speedups(sums: &[Summary], o: &PaperOptions) -> Vec<Speedup> {
                 scenario: scenario.clone(),
                 arc: mode,
                 units,
-                prm_vertices: p.vertices,
+                prm_vertices: p.key.vertices,
                 prm_success: p.success_rate(),
                 arc_success: a.success_rate(),
                 prm_total_s: p.total_all.median,
@@ -416,15 +389,15 @@ fn table3(s: &mut String, sums: &[Summary], o: &PaperOptions) {
                 }
             }
             for (g, p) in rows {
-                let (name, budget) = match g.method {
-                    Method::FullPrm => ("full-state PRM", format!("M_F = {}", g.vertices)),
+                let (name, budget) = match g.key.method {
+                    Method::FullPrm => ("full-state PRM", format!("M_F = {}", g.key.vertices)),
                     Method::Arc(ArcMode::Follow) => (
                         "ARCplanner + follow",
-                        format!("M_VT = {}, N_SRS = {}", g.vertices, g.srs),
+                        format!("M_VT = {}, N_SRS = {}", g.key.vertices, g.key.srs),
                     ),
                     Method::Arc(_) => (
                         "ARCplanner",
-                        format!("M_VT = {}, N_SRS = {}", g.vertices, g.srs),
+                        format!("M_VT = {}, N_SRS = {}", g.key.vertices, g.key.srs),
                     ),
                 };
                 let _ = writeln!(
@@ -502,14 +475,17 @@ fn profile_table(s: &mut String, sums: &[Summary]) {
         "| scenario | N | shapes | t_G (ms) | t_P (ms) | collision (ms) | search (ms) | collision share |"
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
-    for g in sums.iter().filter(|g| matches!(g.method, Method::Arc(_))) {
+    for g in sums
+        .iter()
+        .filter(|g| matches!(g.key.method, Method::Arc(_)))
+    {
         let share = g.collision.median / (g.collision.median + g.search.median);
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} | {} |",
-            g.scenario,
-            g.units,
-            g.method.label(),
+            g.key.scenario,
+            g.key.units,
+            g.key.method.label(),
             fmt_ms(g.roadmap.median),
             if g.planning.n > 0 {
                 fmt_ms(g.planning.median)

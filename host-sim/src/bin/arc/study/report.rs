@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::{RunResult, Spread, Summary};
+use super::{RunKey, RunResult, Spread, StudyError, Summary};
 
 pub(super) fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {
@@ -15,6 +15,16 @@ pub(super) fn csv_field(s: &str) -> String {
 
 fn opt<T: ToString>(v: Option<T>) -> String {
     v.map(|x| x.to_string()).unwrap_or_default()
+}
+
+/// The columns `study,scenario,units,method,vertices,srs` of both CSV files.
+fn key_cells(k: &RunKey) -> String {
+    let (study, scenario) = (csv_field(&k.study), csv_field(&k.scenario));
+    let (units, method) = (k.units, k.method.label());
+    format!(
+        "{study},{scenario},{units},{method},{},{}",
+        k.vertices, k.srs
+    )
 }
 
 /// One line per run.
@@ -29,13 +39,8 @@ pub fn runs_csv(results: &[RunResult]) -> String {
         let start = p.query.map(|q| q.start);
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            csv_field(&p.study),
-            csv_field(&p.scenario),
-            p.units,
-            p.method.label(),
-            p.vertices,
-            p.srs,
+            "{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            key_cells(&p.key),
             p.seed,
             opt(p.time_limit),
             opt(start.map(|s| s[0])),
@@ -96,13 +101,8 @@ pub fn summary_csv(sums: &[Summary]) -> String {
     for g in sums {
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{},{},{}",
-            csv_field(&g.study),
-            csv_field(&g.scenario),
-            g.units,
-            g.method.label(),
-            g.vertices,
-            g.srs,
+            "{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{},{},{}",
+            key_cells(&g.key),
             opt(g.time_limit),
             g.runs,
             g.successes,
@@ -159,9 +159,13 @@ pub fn write_out(
     dir: &std::path::Path,
     name: &str,
     bytes: &[u8],
-) -> Result<std::path::PathBuf, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+) -> Result<std::path::PathBuf, StudyError> {
+    let failed = |path: &std::path::Path| {
+        let path = path.to_path_buf();
+        move |source| StudyError::Write { path, source }
+    };
+    std::fs::create_dir_all(dir).map_err(failed(dir))?;
     let p = dir.join(name);
-    crate::fsutil::write_atomic(&p, bytes).map_err(|e| format!("{}: {e}", p.display()))?;
+    crate::fsutil::write_atomic(&p, bytes).map_err(failed(&p))?;
     Ok(p)
 }

@@ -17,7 +17,7 @@ use aerial_chain::picture::{palette, Colour};
 use aerial_chain_core::lsc::library;
 
 use super::plot::{self, Chart, Curve};
-use super::{fitting_query, ArcMode, Envs, Method, Query, RunSpec, Summary};
+use super::{fitting_query, ArcMode, Envs, Method, Query, RunKey, RunSpec, StudyError, Summary};
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
@@ -88,20 +88,14 @@ pub fn corridor_name(l: f64) -> String {
 pub type StartChoice = (u8, Query, String);
 
 /// Every run of the study (N first, then the corridors), and the start chosen per N.
-pub fn specs(o: &ScaleOptions) -> Result<(Vec<RunSpec>, Vec<StartChoice>), String> {
-    let window: Vec<RunSpec> = vec![RunSpec {
-        study: "scale-units".into(),
-        scenario: "window".into(),
-        units: 3,
-        method: Method::Arc(ArcMode::Follow),
-        vertices: o.vertices,
-        srs: o.srs,
-        seed: 1,
-        time_limit: o.time_limit,
-        query: None,
-    }];
+pub fn specs(o: &ScaleOptions) -> Result<(Vec<RunSpec>, Vec<StartChoice>), StudyError> {
+    let follow = Method::Arc(ArcMode::Follow);
+    let by_units = |n| RunKey::new("scale-units", "window", n, follow, (o.vertices, o.srs));
+    let window = vec![by_units(3).run(1, o.time_limit)];
     let envs = Envs::for_specs(&window)?;
-    let env = envs.get("window").ok_or("window not built")?;
+    let env = envs
+        .get("window")
+        .ok_or_else(|| StudyError::NotBuilt("window".into()))?;
     let mut v = Vec::new();
     let mut starts = Vec::new();
     for &n in &o.units {
@@ -118,40 +112,29 @@ pub fn specs(o: &ScaleOptions) -> Result<(Vec<RunSpec>, Vec<StartChoice>), Strin
             })
             .map_or("?", |e| e.kind.name());
         starts.push((n, q, name.to_string()));
-        for seed in 1..=o.seeds {
-            v.push(RunSpec {
-                study: "scale-units".into(),
-                scenario: "window".into(),
-                units: n,
-                method: Method::Arc(ArcMode::Follow),
-                vertices: o.vertices,
-                srs: o.srs,
-                seed,
-                time_limit: o.time_limit,
-                query: Some(q),
-            });
-        }
+        let key = by_units(n);
+        v.extend((1..=o.seeds).map(|seed| RunSpec {
+            query: Some(q),
+            ..key.run(seed, o.time_limit)
+        }));
     }
     for &l in &o.lengths {
-        for seed in 1..=o.seeds {
-            v.push(RunSpec {
-                study: "scale-map".into(),
-                scenario: corridor_name(l),
-                units: o.corridor_units,
-                method: Method::Arc(ArcMode::Follow),
-                vertices: o.corridor_vertices(l),
-                srs: o.srs,
-                seed,
-                time_limit: o.time_limit,
-                query: None,
-            });
-        }
+        let budgets = (o.corridor_vertices(l), o.srs);
+        let key = RunKey::new(
+            "scale-map",
+            &corridor_name(l),
+            o.corridor_units,
+            follow,
+            budgets,
+        );
+        v.extend((1..=o.seeds).map(|seed| key.run(seed, o.time_limit)));
     }
     Ok((v, starts))
 }
 
 fn corridor_length(s: &Summary) -> f64 {
-    s.scenario
+    s.key
+        .scenario
         .strip_prefix("corridor:")
         .and_then(|l| l.parse().ok())
         .unwrap_or(f64::NAN)
@@ -182,12 +165,12 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
         "| N | start (m) | start shape, yaw (deg) | success | verified | t_G (ms) | t_P (ms) | t_P CPU (ms) | shape changes | replans | time-limited |"
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
-    for g in sums.iter().filter(|g| g.study == "scale-units") {
-        let st = starts.iter().find(|x| x.0 == g.units);
+    for g in sums.iter().filter(|g| g.key.study == "scale-units") {
+        let st = starts.iter().find(|x| x.0 == g.key.units);
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} |",
-            g.units,
+            g.key.units,
             st.map_or("-".into(), |x| format!(
                 "({:.1}, {:.1}, {:.1})",
                 x.1.start[0], x.1.start[1], x.1.start[2]
@@ -215,12 +198,12 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
         "| L (m) | M_VT | success | verified | t_G (ms) | t_P (ms) | t_P CPU (ms) | shape changes | replans | time-limited |"
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
-    for g in sums.iter().filter(|g| g.study == "scale-map") {
+    for g in sums.iter().filter(|g| g.key.study == "scale-map") {
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} |",
             corridor_length(g),
-            g.vertices,
+            g.key.vertices,
             g.outcome_cells(),
             g.time_limited
         );
@@ -234,9 +217,12 @@ const GREEN: Colour = palette::LSC;
 
 /// The figure: time and success against N (left) and against corridor length (right).
 pub fn figure(sums: &[Summary], corridor_units: u8) -> String {
-    let by_n: Vec<&Summary> = sums.iter().filter(|g| g.study == "scale-units").collect();
-    let by_l: Vec<&Summary> = sums.iter().filter(|g| g.study == "scale-map").collect();
-    let n = |g: &Summary| g.units as f64;
+    let by_n: Vec<&Summary> = sums
+        .iter()
+        .filter(|g| g.key.study == "scale-units")
+        .collect();
+    let by_l: Vec<&Summary> = sums.iter().filter(|g| g.key.study == "scale-map").collect();
+    let n = |g: &Summary| g.key.units as f64;
     let times = |v: &[&Summary]| {
         v.iter()
             .flat_map(|g| [g.planning.q3, g.roadmap.q3, g.planning.q1, g.roadmap.q1])
