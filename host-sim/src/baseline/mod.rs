@@ -54,7 +54,7 @@ use std::time::{Duration, Instant};
 use serde_json::json;
 
 use crate::collision::CollisionContext;
-use crate::plan::{Plan, Timings};
+use crate::plan_file::{Plan, Timings};
 use crate::planner::{Planner, Query, Solution, SolutionStats, Step, Termination};
 pub use error::PrmError;
 use roadmap::{valid_tolerance, Roadmap};

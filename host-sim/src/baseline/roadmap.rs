@@ -10,7 +10,7 @@ use rand_pcg::Pcg64;
 use super::metric::{embed, embedding_dim, Neighbours};
 use super::{prm_star_k, PrmSettings, PrmStats};
 use crate::collision::CollisionContext;
-use crate::plan::Timings;
+use crate::plan_file::Timings;
 use crate::planner::graph::{Edge, EdgeState, LazyGraph};
 
 /// The roadmap: vertices, their embeddings and neighbour lists.

@@ -23,7 +23,7 @@ use super::{
     Termination,
 };
 use crate::collision::CollisionContext;
-use crate::plan::{Plan, Timings};
+use crate::plan_file::{Plan, Timings};
 use crate::tables::ShapeTables;
 
 /// Counters and timings of one query.

@@ -46,7 +46,7 @@ pub use refine::{Quality, Refinement};
 pub use settings::{Mode, Preference, Settings};
 
 use crate::collision::CollisionContext;
-use crate::plan::{Plan, Timings};
+use crate::plan_file::{Plan, Timings};
 
 /// What a planner is asked: from a start configuration of the chain to a goal region
 /// for the head.

@@ -26,7 +26,7 @@ use aerial_chain_core::ChainParams;
 use super::ProblemError;
 use crate::collision::verify_plan;
 use crate::map::grid::{Cell, Grid};
-use crate::plan::Plan;
+use crate::plan_file::Plan;
 use crate::problem::scenarios::Scenario;
 
 /// Parameters of one instance.

@@ -31,7 +31,7 @@ use aerial_chain_core::{ChainParams, Shape};
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
 use crate::map::octomap::{MapFileError, OcTree};
-use crate::plan::{ChainSection, MapSection, MapSource, Plan, Waypoint};
+use crate::plan_file::{ChainSection, MapSection, MapSource, Plan, Waypoint};
 
 /// Resolution of every built-in scenario (m).
 pub const RESOLUTION: f64 = 0.1;
@@ -367,7 +367,7 @@ impl Scenario {
         let s_end = route.length();
         let mut shape = self.start_shape(params.units)?;
         let mut plan = Plan {
-            format: crate::plan::FORMAT.into(),
+            format: crate::plan_file::FORMAT.into(),
             chain: ChainSection::from_params(&params),
             map: MapSection {
                 source: MapSource::scenario(&self.name),

@@ -13,7 +13,7 @@ use aerial_chain::collision::CollisionContext;
 use aerial_chain::map::DistanceField;
 use aerial_chain::map::Grid;
 use aerial_chain::map::OcTree;
-use aerial_chain::plan::{MapSource, Plan};
+use aerial_chain::plan_file::{MapSource, Plan};
 use aerial_chain::planner::Query;
 use aerial_chain::problem::scenarios::{self, Scenario};
 
@@ -121,7 +121,7 @@ pub struct MapArgs {
 /// Why a plan cannot be trusted under the user's assumptions: it was made with
 /// unknown space free, and the user did not say `--unknown-free`. The checker's
 /// assumptions come from the person running it, never from the file under test.
-pub fn looser_assumption(plan: &aerial_chain::plan::Plan, map: &MapArgs) -> Option<String> {
+pub fn looser_assumption(plan: &aerial_chain::plan_file::Plan, map: &MapArgs) -> Option<String> {
     (!plan.map.unknown_is_occupied && !map.unknown_free).then(|| {
         "the plan was made with unknown space free (map.unknown_is_occupied: false), \
          but it is checked with unknown space occupied; give --unknown-free to check it \
@@ -358,9 +358,9 @@ pub fn start_shape(params: &ChainParams, name: &str, yaw: f32) -> Result<Shape, 
 /// messages, and its chain's parameters.
 pub fn read_plan(
     path: &std::path::Path,
-) -> Result<(aerial_chain::plan::Plan, String, ChainParams), CliError> {
+) -> Result<(aerial_chain::plan_file::Plan, String, ChainParams), CliError> {
     let plan =
-        aerial_chain::plan::Plan::read(path).map_err(|e| CliError::input(e.to_string()))?;
+        aerial_chain::plan_file::Plan::read(path).map_err(|e| CliError::input(e.to_string()))?;
     let name = crate::fsutil::input_name(path);
     let params = plan
         .check()

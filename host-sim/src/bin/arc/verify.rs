@@ -8,7 +8,7 @@ use super::checks;
 use super::common::{looser_assumption, parse_point, MapArgs};
 use super::{CliError, CliResult};
 use aerial_chain::collision::verify_plan;
-use aerial_chain::plan::Plan;
+use aerial_chain::plan_file::Plan;
 
 /// `arc verify`
 #[derive(Args, Debug)]

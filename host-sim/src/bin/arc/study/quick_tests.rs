@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use crate::study::{self as bench, ArcMode, Method, RunKey};
 use crate::CliError;
 use aerial_chain::collision::verify_plan;
-use aerial_chain::plan::Plan;
+use aerial_chain::plan_file::Plan;
 use aerial_chain::problem::scenarios;
 
 /// Runs the command line in-process with `args` (the program name is added).
