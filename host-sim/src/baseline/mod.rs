@@ -123,7 +123,7 @@ impl FullStatePrm {
     /// Refuses a query of another chain, from an invalid start, or to a goal that
     /// cannot hold the head.
     fn check_query(&self, query: &Query) -> Result<(), PrmError> {
-        let (start, start_shape, goal) = (query.start, &query.start_shape, query.goal);
+        let ((start, goal), start_shape) = (query.ends(), &query.start_shape);
         if start_shape.units() != self.ctx.params().n() {
             return Err(PrmError::StartInvalid(format!(
                 "the start shape has {} units, the chain {}",
@@ -166,7 +166,7 @@ impl Planner for FullStatePrm {
             return;
         }
         let began = Instant::now();
-        let goal = (query.goal, query.goal_tol);
+        let goal = (query.ends().1, query.goal_tol);
         let roadmap = Roadmap::build(&self.ctx, &self.settings, goal, stop.time_limit);
         self.roadmap = Some(roadmap);
         self.roadmap_s = began.elapsed().as_secs_f64();

@@ -5,6 +5,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use aerial_chain_core::{ChainParams, Shape};
+use nalgebra::Point3;
 
 use super::search::dist3;
 use super::*;
@@ -36,9 +37,9 @@ fn easy(
         ..Default::default()
     };
     let mut prm = FullStatePrm::new(ctx.clone(), settings).unwrap();
-    let start = [2.0, 4.0, 1.5];
+    let start = Point3::new(2.0, 4.0, 1.5);
     let shape = Shape::line(units, std::f32::consts::FRAC_PI_2);
-    let goal = [2.5, 2.0, 1.5];
+    let goal = Point3::new(2.5, 2.0, 1.5);
     let stop = Termination {
         time_limit: Some(Duration::from_secs(60)),
     };
@@ -130,18 +131,21 @@ fn bad_input_is_an_error_not_a_panic() {
     assert!(matches!(r, Err(PrmError::StartInvalid(_))));
     // Start inside the wall.
     let r = prm.solve(
-        &Query::new([4.1, 1.0, 1.5], Shape::line(3, yaw), sc.goal),
+        &Query::new(Point3::new(4.1, 1.0, 1.5), Shape::line(3, yaw), sc.goal),
         stop,
     );
     assert!(matches!(r, Err(PrmError::StartInvalid(_))));
     // Goal outside the map, or not finite.
     let s = Shape::line(3, yaw);
     assert!(matches!(
-        prm.solve(&Query::new(sc.start, s, [100.0, 0.0, 0.0]), stop),
+        prm.solve(&Query::new(sc.start, s, Point3::new(100.0, 0.0, 0.0)), stop),
         Err(PrmError::GoalInvalid(_))
     ));
     assert!(matches!(
-        prm.solve(&Query::new(sc.start, s, [f64::NAN, 0.0, 0.0]), stop),
+        prm.solve(
+            &Query::new(sc.start, s, Point3::new(f64::NAN, 0.0, 0.0)),
+            stop
+        ),
         Err(PrmError::GoalInvalid(_))
     ));
     // A goal tolerance that is not a number.

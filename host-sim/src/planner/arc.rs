@@ -199,10 +199,10 @@ impl ArcPlanner {
     /// Refuses a query whose start configuration is not valid or whose goal cannot
     /// hold the head (at the smallest clearance).
     fn check_query(&self, query: &Query) -> Result<(), PlanError> {
+        let (start, goal) = query.ends();
         self.ctx_min
-            .check_config(query.start, &query.start_shape)
+            .check_config(start, &query.start_shape)
             .map_err(|c| PlanError::StartInvalid(c.to_string()))?;
-        let goal = query.goal;
         if !self.ctx_min.is_head_free(goal) {
             let why = if self.ctx.field().grid().in_bounds(goal) {
                 format!(
@@ -224,7 +224,7 @@ impl ArcPlanner {
         query: &Query,
         stop: Termination,
     ) -> Result<Solution<Stats>, PlanError> {
-        let (start, goal) = (query.start, query.goal);
+        let (start, goal) = query.ends();
         // The time limit covers the roadmap too (when it is built here) and growth.
         let began = Instant::now();
         let deadline = stop.deadline(began);

@@ -36,6 +36,7 @@ pub(crate) mod srs_connect;
 use std::time::{Duration, Instant};
 
 use aerial_chain_core::Shape;
+use nalgebra::Point3;
 
 pub use arc::{ArcPlanner, Stats};
 pub use candidates::Source;
@@ -53,11 +54,11 @@ use crate::plan_file::{Plan, Timings};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Query {
     /// Head start position (m).
-    pub start: [f64; 3],
+    pub start: Point3<f64>,
     /// Start shape.
     pub start_shape: Shape,
     /// Head goal position (m).
-    pub goal: [f64; 3],
+    pub goal: Point3<f64>,
     /// Goal tolerance: the head ends within this distance of the goal (m).
     pub goal_tol: f64,
 }
@@ -67,13 +68,19 @@ impl Query {
     pub const DEFAULT_GOAL_TOL: f64 = 0.3;
 
     /// A query from `start` in `start_shape` to `goal`, at the default tolerance.
-    pub fn new(start: [f64; 3], start_shape: Shape, goal: [f64; 3]) -> Self {
+    pub fn new(start: Point3<f64>, start_shape: Shape, goal: Point3<f64>) -> Self {
         Self {
             start,
             start_shape,
             goal,
             goal_tol: Self::DEFAULT_GOAL_TOL,
         }
+    }
+
+    /// The head's start and goal as the arrays the collision checks and the roadmaps
+    /// take.
+    pub fn ends(&self) -> ([f64; 3], [f64; 3]) {
+        (self.start.into(), self.goal.into())
     }
 }
 

@@ -253,11 +253,11 @@ impl PassageSpec {
                 ang = self.angle_deg
             ),
             grid: g,
-            start,
+            start: start.into(),
             start_yaw: a,
-            goal,
+            goal: goal.into(),
             default_units: 5,
-            route,
+            route: super::scenarios::points(&route),
         })
     }
 }

@@ -304,11 +304,11 @@ impl QueryArgs {
         let params = chain.params(units)?;
         let start = self
             .start
-            .or(sc.map(|s| s.start))
+            .or(sc.map(|s| s.start.into()))
             .ok_or_else(|| CliError::input("--start is required with --map"))?;
         let goal = self
             .goal
-            .or(sc.map(|s| s.goal))
+            .or(sc.map(|s| s.goal.into()))
             .ok_or_else(|| CliError::input("--goal is required with --map"))?;
         if let Some(d) = self.start_yaw_deg {
             // The shape holds angles as f32.
@@ -327,9 +327,9 @@ impl QueryArgs {
             .unwrap_or(0.0);
         let shape = start_shape(&params, &self.start_shape, yaw as f32)?;
         let query = Query {
-            start,
+            start: start.into(),
             start_shape: shape,
-            goal,
+            goal: goal.into(),
             goal_tol,
         };
         Ok((params, query))

@@ -289,7 +289,7 @@ pub fn run(a: PlanArgs) -> CliResult {
             grid,
             &plan,
             &format!("ARCplanner on {}", a.problem.map.name()),
-            Some(query.goal),
+            Some(query.goal.into()),
         )
         .save(pic)
         .map_err(|e| CliError::input(e.to_string()))?;

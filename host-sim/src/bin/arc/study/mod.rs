@@ -408,7 +408,8 @@ pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, StudyError> {
 pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, StudyError> {
     let params = *ctx.params();
     let lib = library(&params);
-    let mut positions = vec![sc.start];
+    let start: [f64; 3] = sc.start.into();
+    let mut positions = vec![start];
     let mut ring = Vec::new();
     for i in -15i32..=15 {
         for j in -15i32..=15 {
@@ -421,9 +422,9 @@ pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, Stu
     ring.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
     positions.extend(ring.iter().map(|&(_, i, j)| {
         [
-            sc.start[0] + 0.1 * i as f64,
-            sc.start[1] + 0.1 * j as f64,
-            sc.start[2],
+            start[0] + 0.1 * i as f64,
+            start[1] + 0.1 * j as f64,
+            start[2],
         ]
     }));
     let yaw0 = sc.start_yaw as f32;
@@ -442,7 +443,7 @@ pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, Stu
                     .shape
                     .rotated(aerial_chain_core::angle::diff(e.shape.head_yaw(), yaw));
                 if ctx.check_config(p, &shape).is_ok() {
-                    return Ok(Query::new(p, shape, sc.goal));
+                    return Ok(Query::new(p.into(), shape, sc.goal));
                 }
             }
         }
@@ -718,7 +719,7 @@ mod tests {
         for n in [3u8, 12, 16] {
             let ctx = context(&env, n).unwrap();
             let q = fitting_query(&env.scenario, &ctx).unwrap();
-            assert!(ctx.check_config(q.start, &q.start_shape).is_ok());
+            assert!(ctx.check_config(q.start.into(), &q.start_shape).is_ok());
         }
         // A short chain keeps the scenario's own start.
         let ctx = context(&env, 4).unwrap();
