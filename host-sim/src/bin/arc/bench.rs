@@ -8,7 +8,7 @@ use clap::{Args, Subcommand};
 use super::checks;
 use super::common::{write_plan, ProblemArgs};
 use super::{CliError, CliResult};
-use crate::study::{self, paper, robust, scale, RunResult, RunSpec, Summary};
+use crate::study::{self, paper, robust, scale, Budgets, RunResult, RunSpec, Summary};
 use aerial_chain::baseline::{FullStatePrm, PrmError, PrmSettings};
 use aerial_chain::collision::{verify_plan, DEFAULT_CLEARANCE};
 use aerial_chain::planner::{to_plan, Planner, Termination};
@@ -191,11 +191,18 @@ fn check_study(a: &StudyArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-fn time_limit(a: &StudyArgs, default: Option<f64>) -> Option<f64> {
-    match a.time_limit {
-        Some(0.0) => None,
-        Some(t) => Some(t),
-        None => default,
+/// The study's budgets: `base`, with what the command line sets instead (a time limit
+/// of 0: none).
+fn budgets(a: &StudyArgs, base: Budgets) -> Budgets {
+    Budgets {
+        seeds: a.seeds.unwrap_or(base.seeds),
+        vertices: a.vertices.unwrap_or(base.vertices),
+        srs: a.srs.unwrap_or(base.srs),
+        time_limit: match a.time_limit {
+            Some(0.0) => None,
+            Some(t) => Some(t),
+            None => base.time_limit,
+        },
     }
 }
 
@@ -273,12 +280,9 @@ fn run_paper(a: PaperArgs) -> CliResult {
         paper::PaperOptions::full()
     };
     let o = paper::PaperOptions {
-        seeds: a.study.seeds.unwrap_or(base.seeds),
-        vertices: a.study.vertices.unwrap_or(base.vertices),
-        srs: a.study.srs.unwrap_or(base.srs),
+        budgets: budgets(&a.study, base.budgets),
         prm_vertices: a.prm_vertices.clone().unwrap_or(base.prm_vertices),
         prm_units: a.prm_units.clone().unwrap_or(base.prm_units),
-        time_limit: time_limit(&a.study, base.time_limit),
         tables: a.tables.clone().unwrap_or(base.tables),
         wide_windows: match &a.wide_window {
             Some(v) if v.as_slice() == [0.0] => Vec::new(),
@@ -332,9 +336,8 @@ fn run_scale(a: ScaleArgs) -> CliResult {
         scale::ScaleOptions::full()
     };
     let o = scale::ScaleOptions {
-        seeds: a.study.seeds.unwrap_or(base.seeds),
+        budgets: budgets(&a.study, base.budgets),
         units: a.units.clone().unwrap_or(base.units),
-        vertices: a.study.vertices.unwrap_or(base.vertices),
         lengths: a.lengths.clone().unwrap_or(base.lengths),
         corridor_units: base.corridor_units,
         corridor_vertices_per_m: match a.corridor_density {
@@ -342,8 +345,6 @@ fn run_scale(a: ScaleArgs) -> CliResult {
             Some(d) => Some(d),
             None => base.corridor_vertices_per_m,
         },
-        srs: a.study.srs.unwrap_or(base.srs),
-        time_limit: time_limit(&a.study, base.time_limit),
     };
     if let Some(n) = o.units.iter().find(|n| !(2..=16).contains(*n)) {
         return Err(CliError::input(format!(

@@ -163,6 +163,52 @@ impl RunKey {
     }
 }
 
+/// What every row of a study gets: seeds, roadmap size, random shapes, time limit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Budgets {
+    /// Seeds per row (`1..=seeds`).
+    pub seeds: u64,
+    /// Head roadmap vertices `M_VT`.
+    pub vertices: usize,
+    /// Random shapes `N_SRS`.
+    pub srs: usize,
+    /// Time limit per run (s).
+    pub time_limit: Option<f64>,
+}
+
+impl Budgets {
+    /// The paper's: 20 seeds, `M_VT = 1500`, `N_SRS = 500`, 60 s per run.
+    pub fn full() -> Self {
+        Self {
+            seeds: 20,
+            vertices: 1500,
+            srs: 500,
+            time_limit: Some(60.0),
+        }
+    }
+
+    /// A smoke run's: `seeds` seeds, `M_VT = 300`, `N_SRS = 100`, 2 s per run.
+    pub fn quick(seeds: u64) -> Self {
+        Self {
+            seeds,
+            vertices: 300,
+            srs: 100,
+            time_limit: Some(2.0),
+        }
+    }
+
+    /// The time limit as the reports print it.
+    pub fn time_limit_text(&self) -> String {
+        self.time_limit.map_or("none".into(), |t| t.to_string())
+    }
+
+    /// The runs of the group `key`, one per seed.
+    pub fn runs<'a>(&self, key: &'a RunKey) -> impl Iterator<Item = RunSpec> + 'a {
+        let time_limit = self.time_limit;
+        (1..=self.seeds).map(move |seed| key.run(seed, time_limit))
+    }
+}
+
 /// One benchmark run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunSpec {

@@ -10,23 +10,17 @@
 
 use std::fmt::Write as _;
 
-use super::{fmt_ms, ms, ArcMode, Method, RunKey, RunSpec, Summary};
+use super::{fmt_ms, ms, ArcMode, Budgets, Method, RunKey, RunSpec, Summary};
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PaperOptions {
-    /// Seeds per configuration.
-    pub seeds: u64,
-    /// Head roadmap vertices `M_VT`.
-    pub vertices: usize,
-    /// Random shapes `N_SRS`.
-    pub srs: usize,
+    /// Seeds, `M_VT`, `N_SRS` and the time limit of every run.
+    pub budgets: Budgets,
     /// Vertex budgets `M_F` of the full-state PRM.
     pub prm_vertices: Vec<usize>,
     /// Chain sizes of Table 3 (window).
     pub prm_units: Vec<u8>,
-    /// Time limit per run (s).
-    pub time_limit: Option<f64>,
     /// Which tables to run (1, 2, 3).
     pub tables: Vec<u8>,
     /// Also run Table 3 on `window-wide:W` for each of these `W` (the window widened to
@@ -40,12 +34,9 @@ impl PaperOptions {
     /// per run.
     pub fn full() -> Self {
         Self {
-            seeds: 20,
-            vertices: 1500,
-            srs: 500,
+            budgets: Budgets::full(),
             prm_vertices: vec![1500, 15000],
             prm_units: vec![5],
-            time_limit: Some(60.0),
             tables: vec![1, 2, 3],
             wide_windows: vec![1.0, 1.2, 1.4, 1.6],
         }
@@ -54,12 +45,9 @@ impl PaperOptions {
     /// A smoke run: 2 seeds, small budgets, 2 s per run.
     pub fn quick() -> Self {
         Self {
-            seeds: 2,
-            vertices: 300,
-            srs: 100,
+            budgets: Budgets::quick(2),
             prm_vertices: vec![100, 300],
             prm_units: vec![4],
-            time_limit: Some(2.0),
             tables: vec![1, 2, 3],
             wide_windows: vec![1.6],
         }
@@ -92,9 +80,10 @@ pub fn specs(o: &PaperOptions) -> Vec<RunSpec> {
             continue;
         }
         for mode in MODES {
-            let srs = if mode == ArcMode::Lsc { 0 } else { o.srs };
-            let key = RunKey::new(study, scenario, units, Method::Arc(mode), (o.vertices, srs));
-            v.extend((1..=o.seeds).map(|seed| key.run(seed, o.time_limit)));
+            let b = &o.budgets;
+            let srs = if mode == ArcMode::Lsc { 0 } else { b.srs };
+            let key = RunKey::new(study, scenario, units, Method::Arc(mode), (b.vertices, srs));
+            v.extend(b.runs(&key));
         }
     }
     if !o.tables.contains(&3) {
@@ -108,13 +97,13 @@ pub fn specs(o: &PaperOptions) -> Vec<RunSpec> {
                 && o.tables.contains(&1)
                 && ABLATION.contains(&("table1", "window", units));
             for mode in TABLE3_ARC.into_iter().filter(|_| !in_table1) {
-                let budgets = (o.vertices, o.srs);
+                let budgets = (o.budgets.vertices, o.budgets.srs);
                 let key = RunKey::new(study, &scenario, units, Method::Arc(mode), budgets);
-                v.extend((1..=o.seeds).map(|seed| key.run(seed, o.time_limit)));
+                v.extend(o.budgets.runs(&key));
             }
             for &m in &o.prm_vertices {
                 let key = RunKey::new(study, &scenario, units, Method::FullPrm, (m, 0));
-                v.extend((1..=o.seeds).map(|seed| key.run(seed, o.time_limit)));
+                v.extend(o.budgets.runs(&key));
             }
         }
     }
@@ -294,10 +283,10 @@ fn ablation_tables(s: &mut String, sums: &[Summary], o: &PaperOptions) {
             s,
             "## {title}\n\nM_VT = {}, N_SRS = {} (0 for LSC only), {} seeds, time limit {} s per run. \
              Paper: t_GT = {} s.\n",
-            o.vertices,
-            o.srs,
-            o.seeds,
-            o.time_limit.map_or("none".into(), |t| t.to_string()),
+            o.budgets.vertices,
+            o.budgets.srs,
+            o.budgets.seeds,
+            o.budgets.time_limit_text(),
             PAPER_TGT
                 .iter()
                 .find(|r| r.0 == scenario)
@@ -344,7 +333,7 @@ fn table3(s: &mut String, sums: &[Summary], o: &PaperOptions) {
          as a failure and its time as spent). `window` is Table 1's room (0.8 m x 0.8 m window); \
          `{}W` is the same room with the window widened to W x W m (bench-only variant), \
          where the full-state PRM can pass.\n",
-        o.time_limit.map_or("none".into(), |t| t.to_string()),
+        o.budgets.time_limit_text(),
         super::WIDE_WINDOW
     );
     let _ = writeln!(
