@@ -103,37 +103,26 @@ fn closed_box(size: [f64; 3]) -> Grid {
     let mut g = Grid::new(RESOLUTION, [0; 3], dims, Cell::Occupied, true)
         .expect("scenario sizes are small and positive");
     let eps = 1e-6;
-    g.fill_box(
-        [WALL + eps; 3],
-        [
-            size[0] - WALL - eps,
-            size[1] - WALL - eps,
-            size[2] - WALL - eps,
-        ],
-        Cell::Free,
-    );
+    g.fill_box([WALL + eps; 3], size.map(|s| s - WALL - eps), Cell::Free);
     g
 }
 
-/// Occupies the voxels whose centres lie in the box `lo..hi` (shrunk by a hair so that
-/// a box given by its faces on the lattice takes exactly the voxels inside it).
-fn solid(g: &mut Grid, lo: [f64; 3], hi: [f64; 3]) {
+/// Sets the voxels whose centres lie in the box `lo..hi` to `cell` (the box shrunk by a
+/// hair so that a box given by its faces on the lattice takes exactly the voxels inside
+/// it).
+pub(super) fn fill(g: &mut Grid, lo: [f64; 3], hi: [f64; 3], cell: Cell) {
     let e = 1e-6;
-    g.fill_box(
-        [lo[0] + e, lo[1] + e, lo[2] + e],
-        [hi[0] - e, hi[1] - e, hi[2] - e],
-        Cell::Occupied,
-    );
+    g.fill_box(lo.map(|v| v + e), hi.map(|v| v - e), cell);
 }
 
-/// Frees the voxels whose centres lie in the box `lo..hi` (see [`solid`]).
+/// Occupies the voxels whose centres lie in the box `lo..hi` (see [`fill`]).
+fn solid(g: &mut Grid, lo: [f64; 3], hi: [f64; 3]) {
+    fill(g, lo, hi, Cell::Occupied);
+}
+
+/// Frees the voxels whose centres lie in the box `lo..hi` (see [`fill`]).
 fn open(g: &mut Grid, lo: [f64; 3], hi: [f64; 3]) {
-    let e = 1e-6;
-    g.fill_box(
-        [lo[0] + e, lo[1] + e, lo[2] + e],
-        [hi[0] - e, hi[1] - e, hi[2] - e],
-        Cell::Free,
-    );
+    fill(g, lo, hi, Cell::Free);
 }
 
 /// Env 1 of the paper: two rooms joined by a small window.

@@ -191,6 +191,15 @@ fn check_study(a: &StudyArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// A study's defaults: its smoke run's with `--quick`, else the full study's.
+fn defaults<O>(a: &StudyArgs, quick: fn() -> O, full: fn() -> O) -> O {
+    if a.quick {
+        quick()
+    } else {
+        full()
+    }
+}
+
 /// The study's budgets: `base`, with what the command line sets instead (a time limit
 /// of 0: none).
 fn budgets(a: &StudyArgs, base: Budgets) -> Budgets {
@@ -274,11 +283,11 @@ fn publish(dir: &Path, md: &str, files: &[(&str, &[u8])]) -> CliResult {
 
 fn run_paper(a: PaperArgs) -> CliResult {
     check_study(&a.study)?;
-    let base = if a.study.quick {
-        paper::PaperOptions::quick()
-    } else {
-        paper::PaperOptions::full()
-    };
+    let base = defaults(
+        &a.study,
+        paper::PaperOptions::quick,
+        paper::PaperOptions::full,
+    );
     let o = paper::PaperOptions {
         budgets: budgets(&a.study, base.budgets),
         prm_vertices: a.prm_vertices.clone().unwrap_or(base.prm_vertices),
@@ -330,11 +339,11 @@ fn run_paper(a: PaperArgs) -> CliResult {
 
 fn run_scale(a: ScaleArgs) -> CliResult {
     check_study(&a.study)?;
-    let base = if a.study.quick {
-        scale::ScaleOptions::quick()
-    } else {
-        scale::ScaleOptions::full()
-    };
+    let base = defaults(
+        &a.study,
+        scale::ScaleOptions::quick,
+        scale::ScaleOptions::full,
+    );
     let o = scale::ScaleOptions {
         budgets: budgets(&a.study, base.budgets),
         units: a.units.clone().unwrap_or(base.units),

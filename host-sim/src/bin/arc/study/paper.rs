@@ -119,20 +119,13 @@ pub fn table3_scenarios(o: &PaperOptions) -> Vec<(&'static str, String)> {
     v
 }
 
-/// The paper's planning times `t_P` (s) for Tables 1 and 2: (scenario, N, mode, t_P).
-pub const PAPER_TP: [(&str, u8, ArcMode, f64); 12] = [
-    ("window", 4, ArcMode::Lsc, 11.3),
-    ("window", 4, ArcMode::Srs, 23.0),
-    ("window", 4, ArcMode::Both, 4.4),
-    ("window", 5, ArcMode::Lsc, 46.1),
-    ("window", 5, ArcMode::Srs, 54.4),
-    ("window", 5, ArcMode::Both, 4.4),
-    ("maze", 5, ArcMode::Lsc, 1.5),
-    ("maze", 5, ArcMode::Srs, 9.5),
-    ("maze", 5, ArcMode::Both, 1.27),
-    ("maze", 6, ArcMode::Lsc, 32.7),
-    ("maze", 6, ArcMode::Srs, 14.2),
-    ("maze", 6, ArcMode::Both, 7.9),
+/// The paper's planning times `t_P` (s) for Tables 1 and 2: (scenario, N, `t_P` of
+/// LSC, SRS and Both).
+pub const PAPER_TP: [(&str, u8, [f64; 3]); 4] = [
+    ("window", 4, [11.3, 23.0, 4.4]),
+    ("window", 5, [46.1, 54.4, 4.4]),
+    ("maze", 5, [1.5, 9.5, 1.27]),
+    ("maze", 6, [32.7, 14.2, 7.9]),
 ];
 
 /// The paper's head roadmap build times `t_GT` (s): Env 1 and Env 2.
@@ -146,10 +139,16 @@ pub const PAPER_TABLE3: [(&str, usize, f64, f64, f64); 3] = [
 ];
 
 fn paper_tp(scenario: &str, units: u8, mode: ArcMode) -> Option<f64> {
+    let column = match mode {
+        ArcMode::Lsc => 0,
+        ArcMode::Srs => 1,
+        ArcMode::Both => 2,
+        ArcMode::Follow => return None,
+    };
     PAPER_TP
         .iter()
-        .find(|r| r.0 == scenario && r.1 == units && r.2 == mode)
-        .map(|r| r.3)
+        .find(|r| r.0 == scenario && r.1 == units)
+        .map(|r| r.2[column])
 }
 
 fn find<'a>(
