@@ -116,14 +116,7 @@ fn bad_input_is_an_error_not_a_panic() {
         ..Default::default()
     };
     assert!(FullStatePrm::new(ctx.clone(), bad_k).is_err());
-    let mut prm = FullStatePrm::new(
-        ctx,
-        PrmSettings {
-            vertices: 50,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let mut prm = prm_of(ctx, 50);
     let stop = Termination::default();
     let yaw = sc.start_yaw as f32;
     // Another chain's shape.
@@ -162,17 +155,19 @@ fn bad_input_is_an_error_not_a_panic() {
     assert_eq!(sol.steps.len(), 1);
 }
 
+/// A PRM of `vertices` vertices, the other settings the defaults.
+fn prm_of(ctx: CollisionContext, vertices: usize) -> FullStatePrm {
+    let settings = PrmSettings {
+        vertices,
+        ..Default::default()
+    };
+    FullStatePrm::new(ctx, settings).expect("valid settings")
+}
+
 #[test]
 fn too_sparse_roadmap_fails_cleanly() {
     let (ctx, sc) = window_ctx(5);
-    let mut prm = FullStatePrm::new(
-        ctx,
-        PrmSettings {
-            vertices: 20,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let mut prm = prm_of(ctx, 20);
     let shape = sc.start_shape(5).unwrap();
     let r = prm.solve(
         &Query::new(sc.start, shape, sc.goal),

@@ -8,6 +8,8 @@ use clap::{Args, Subcommand};
 use super::checks;
 use super::common::{write_plan, ProblemArgs};
 use super::{CliError, CliResult};
+use crate::study::paper::PaperOptions;
+use crate::study::scale::ScaleOptions;
 use crate::study::{self, paper, robust, scale, Budgets, RunResult, RunSpec, Summary};
 use aerial_chain::baseline::{FullStatePrm, PrmError, PrmSettings};
 use aerial_chain::collision::{verify_plan, DEFAULT_CLEARANCE};
@@ -283,12 +285,8 @@ fn publish(dir: &Path, md: &str, files: &[(&str, &[u8])]) -> CliResult {
 
 fn run_paper(a: PaperArgs) -> CliResult {
     check_study(&a.study)?;
-    let base = defaults(
-        &a.study,
-        paper::PaperOptions::quick,
-        paper::PaperOptions::full,
-    );
-    let o = paper::PaperOptions {
+    let base = defaults(&a.study, PaperOptions::quick, PaperOptions::full);
+    let o = PaperOptions {
         budgets: budgets(&a.study, base.budgets),
         prm_vertices: a.prm_vertices.clone().unwrap_or(base.prm_vertices),
         prm_units: a.prm_units.clone().unwrap_or(base.prm_units),
@@ -339,12 +337,8 @@ fn run_paper(a: PaperArgs) -> CliResult {
 
 fn run_scale(a: ScaleArgs) -> CliResult {
     check_study(&a.study)?;
-    let base = defaults(
-        &a.study,
-        scale::ScaleOptions::quick,
-        scale::ScaleOptions::full,
-    );
-    let o = scale::ScaleOptions {
+    let base = defaults(&a.study, ScaleOptions::quick, ScaleOptions::full);
+    let o = ScaleOptions {
         budgets: budgets(&a.study, base.budgets),
         units: a.units.clone().unwrap_or(base.units),
         lengths: a.lengths.clone().unwrap_or(base.lengths),
@@ -462,10 +456,7 @@ fn run_robust(a: RobustArgs) -> CliResult {
 
 fn run_prm(a: PrmArgs) -> CliResult {
     let time_limit = check_prm(&a)?;
-    let (loaded, params, query) = a.problem.load()?;
-    let grid = loaded.grid.clone();
-    let source = loaded.source.clone();
-    let ctx = loaded.into_context(params, a.clearance)?;
+    let (ctx, params, query, source) = a.problem.context(a.clearance)?;
     let settings = PrmSettings {
         vertices: a.vertices,
         k: a.k,
@@ -493,9 +484,10 @@ fn run_prm(a: PrmArgs) -> CliResult {
             ))
         }
     })?;
+    let grid = prm.context().field().grid();
     let mut plan = to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
     plan.map.source = source;
-    let report = verify_plan(&grid, &plan);
+    let report = verify_plan(grid, &plan);
     let s = &sol.stats;
     let lines = write_plan(
         &plan,

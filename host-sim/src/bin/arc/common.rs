@@ -245,6 +245,19 @@ impl ProblemArgs {
                 .resolve(&self.chain, loaded.scenario.as_ref(), self.goal_tol)?;
         Ok((loaded, params, query))
     }
+
+    /// Loads the problem ([`Self::load`]) for a planner: the collision context at
+    /// `clearance` (the map inside it), the chain, the query, and the map as plans
+    /// record it.
+    pub fn context(
+        &self,
+        clearance: f64,
+    ) -> Result<(CollisionContext, ChainParams, Query, MapSource), CliError> {
+        let (loaded, params, query) = self.load()?;
+        let source = loaded.source.clone();
+        let ctx = loaded.into_context(params, clearance)?;
+        Ok((ctx, params, query, source))
+    }
 }
 
 /// Writes `plan` to `out` and opens the report that follows it with a line naming the

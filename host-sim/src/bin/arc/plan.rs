@@ -192,11 +192,10 @@ pub fn run(a: PlanArgs) -> CliResult {
     // Setup (map, distance field, shape tables) is timed apart: the time limit
     // covers what follows it (docs/promises.md).
     let setup = Instant::now();
-    let (loaded, params, query) = a.problem.load()?;
+    let (ctx, params, query, source) = a.problem.context(a.clearance)?;
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
-    let (resolution, unknown_occ) = (loaded.grid.resolution(), loaded.grid.unknown_is_occupied());
-    let source = loaded.source.clone();
-    let ctx = loaded.into_context(params, a.clearance)?;
+    let grid = ctx.field().grid();
+    let (resolution, unknown_occ) = (grid.resolution(), grid.unknown_is_occupied());
     let settings = Settings {
         vertices: a.vertices,
         r_t: a.r_t,
