@@ -390,14 +390,11 @@ fn table3(s: &mut String, sums: &[Summary], o: &PaperOptions) {
                 };
                 let _ = writeln!(
                     s,
-                    "| {scenario} | {units} | {name} | {budget} | {} | {} | {} | {}/{} | {}/{} | {} | {} | {} | {} | {} |",
+                    "| {scenario} | {units} | {name} | {budget} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                     num(p.0),
                     num(p.1),
                     if p.2.is_nan() { "-".into() } else { pct(p.2) },
-                    g.successes,
-                    g.runs,
-                    g.verified,
-                    g.successes,
+                    g.success_cells(),
                     ms(&g.roadmap),
                     ms(&g.planning),
                     ms(&g.planning_all),

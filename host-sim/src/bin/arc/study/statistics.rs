@@ -97,17 +97,20 @@ impl Summary {
     /// t_P, t_P CPU, shape changes, replans.
     pub fn outcome_cells(&self) -> String {
         format!(
-            "{}/{} | {}/{} | {} | {} | {} | {} | {}",
-            self.successes,
-            self.runs,
-            self.verified,
-            self.successes,
+            "{} | {} | {} | {} | {} | {}",
+            self.success_cells(),
             ms(&self.roadmap),
             ms(&self.planning),
             ms(&self.planning_cpu),
             count(&self.shape_changes),
             count(&self.replans)
         )
+    }
+
+    /// The success and verified cells: `successes/runs | verified/successes`.
+    pub fn success_cells(&self) -> String {
+        let (ok, runs, verified) = (self.successes, self.runs, self.verified);
+        format!("{ok}/{runs} | {verified}/{ok}")
     }
 
     /// Success rate (0..=1).
