@@ -69,14 +69,10 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    fn v(x: f32, y: f32, z: f32) -> Vector3<f32> {
-        Vector3::new(x, y, z)
-    }
-
     #[test]
     fn known_cases() {
         // A point and its distance to the segment from (-1, 0, 0) to (1, 0, 0).
-        let (a, b) = (v(-1.0, 0.0, 0.0), v(1.0, 0.0, 0.0));
+        let (a, b) = (Vector3::new(-1.0, 0.0, 0.0), Vector3::new(1.0, 0.0, 0.0));
         for (p, want) in [([0.0, 1.0, 0.0], 1.0), ([3.0, 0.0, 0.0], 2.0)] {
             let d = point_segment_distance(&p.into(), &a, &b);
             assert!((d - want).abs() < 1e-6, "{p:?}: {d}");
@@ -107,7 +103,7 @@ mod tests {
         /// The closed form never exceeds a dense brute-force sampling, and is close to it.
         #[test]
         fn segment_distance_matches_brute_force(c in proptest::array::uniform12(-2.0f32..2.0)) {
-            let (p1, q1, p2, q2) = (v(c[0], c[1], c[2]), v(c[3], c[4], c[5]), v(c[6], c[7], c[8]), v(c[9], c[10], c[11]));
+            let (p1, q1, p2, q2) = (Vector3::new(c[0], c[1], c[2]), Vector3::new(c[3], c[4], c[5]), Vector3::new(c[6], c[7], c[8]), Vector3::new(c[9], c[10], c[11]));
             let d = segment_segment_distance(&p1, &q1, &p2, &q2);
             let mut best = f32::MAX;
             for i in 0..=200 {
