@@ -13,6 +13,14 @@ fn zeta(xi: [f64; 3], eta: &[f64]) -> Vec<f64> {
 }
 
 /// The default simulation, `min_time` seconds at least, with one `gust`.
+/// The default settings, flying at least `min_time` s.
+fn flying_for(min_time: f64) -> SimConfig {
+    SimConfig {
+        min_time,
+        ..Default::default()
+    }
+}
+
 /// The default settings with one gust, flying at least `min_time` s: from `start`
 /// for `duration` s, `force` on `unit` (`None`: on every unit).
 fn with_gust(
@@ -52,10 +60,7 @@ fn bent(n: usize) -> Vec<f64> {
 #[test]
 fn hover_equilibrium_holds() {
     let p = ChainParams::new(5);
-    let cfg = SimConfig {
-        min_time: 5.0,
-        ..Default::default()
-    };
+    let cfg = flying_for(5.0);
     let f = simulate(&p, &[zeta([1.0, 2.0, 3.0], &bent(5))], &cfg, None).unwrap();
     let r = &f.report;
     assert!(r.success(), "{r:?}");
@@ -205,10 +210,7 @@ fn progress_counts_the_steps_flown() {
     use super::flight::{simulate_with_progress, Progress};
     use std::sync::atomic::Ordering;
     let p = ChainParams::new(3);
-    let cfg = SimConfig {
-        min_time: 1.0,
-        ..Default::default()
-    };
+    let cfg = flying_for(1.0);
     let progress = Progress::default();
     let f = simulate_with_progress(
         &p,
