@@ -14,7 +14,7 @@
 //! - [`tables`]: [`tables::ShapeTables`], the LSC, SRS and G_SRS of a chain;
 //! - [`planner`]: [`planner::Planner`], [`planner::Query`], [`planner::ArcPlanner`],
 //!   [`planner::to_plan`]; [`baseline`]: [`baseline::FullStatePrm`];
-//! - [`plan`]: [`plan::Plan`], the `arc-plan/1` file;
+//! - [`plan_file`]: [`plan_file::Plan`], the `arc-plan/1` file;
 //! - [`sim`]: [`sim::simulate`], [`sim::Flight`];
 //! - [`picture`]: figures, plan and map pictures (SVG, PNG).
 //!
@@ -51,7 +51,7 @@ pub mod collision;
 mod fsutil;
 pub mod map;
 pub mod picture;
-pub mod plan;
+pub mod plan_file;
 pub mod plan_picture;
 pub mod planner;
 pub mod problem;

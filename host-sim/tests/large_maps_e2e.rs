@@ -4,7 +4,7 @@
 
 mod support;
 
-use aerial_chain::plan::Plan;
+use aerial_chain::plan_file::Plan;
 use aerial_chain::problem::scenarios;
 use support::{assert_verified_to_goal, plan_scenario, plan_verified};
 
@@ -28,7 +28,7 @@ fn hall_crossing_and_corridor_hop_plan_with_defaults() {
     plan_scenario("hall", 5, &flags, &out).unwrap_or_else(|e| panic!("hop: {e}"));
     let hop = Plan::read(&out).unwrap();
     let mut at = sc.clone();
-    at.goal = [25.0, 20.0, 1.3];
+    at.goal = nalgebra::Point3::new(25.0, 20.0, 1.3);
     assert_verified_to_goal(&at, &hop, "hall hop");
 }
 

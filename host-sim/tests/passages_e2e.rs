@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use aerial_chain::plan::Plan;
+use aerial_chain::plan_file::Plan;
 use aerial_chain::problem::passages::{witness, PassageSpec};
 use aerial_chain::problem::scenarios;
 mod support;

@@ -136,15 +136,15 @@ fn a_plan_into_a_wall_fails_with_exit_1() {
     let sc = aerial_chain::problem::scenarios::build("window").unwrap();
     let params = aerial_chain_core::ChainParams::new(4);
     let shape = sc.start_shape(4).unwrap();
-    let start = sc.start;
-    let goal = [sc.goal[0], start[1], start[2]];
-    let plan = aerial_chain::plan::Plan {
-        format: aerial_chain::plan::FORMAT.into(),
-        chain: aerial_chain::plan::ChainSection::from_params(&params),
-        map: aerial_chain::plan::MapSection::new(sc.grid.resolution(), true),
+    let start: [f64; 3] = sc.start.into();
+    let goal = [sc.goal.x, start[1], start[2]];
+    let plan = aerial_chain::plan_file::Plan {
+        format: aerial_chain::plan_file::FORMAT.into(),
+        chain: aerial_chain::plan_file::ChainSection::from_params(&params),
+        map: aerial_chain::plan_file::MapSection::new(sc.grid.resolution(), true),
         waypoints: vec![
-            aerial_chain::plan::Waypoint::new(start, &shape),
-            aerial_chain::plan::Waypoint::new(goal, &shape),
+            aerial_chain::plan_file::Waypoint::new(start, &shape),
+            aerial_chain::plan_file::Waypoint::new(goal, &shape),
         ],
         stats: Default::default(),
     };

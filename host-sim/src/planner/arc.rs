@@ -23,18 +23,15 @@ use super::{
     Termination,
 };
 use crate::collision::CollisionContext;
-use crate::plan::{Plan, Timing};
+use crate::plan_file::{Plan, Timings};
 use crate::tables::ShapeTables;
 
 /// Counters and timings of one query.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Stats {
-    /// Setup time (s): the head roadmap and the labelled free regions.
-    pub roadmap_s: f64,
-    /// Query time (s).
-    pub planning_s: f64,
-    /// Of the query time, spent in collision checks (s).
-    pub collision_s: f64,
+    /// Setup (the head roadmap and the labelled free regions), query and
+    /// collision-check times.
+    pub timings: Timings,
     /// Head edges flown.
     pub edges: usize,
     /// Shape-change waypoints.
@@ -220,10 +217,10 @@ impl ArcPlanner {
     /// Refuses a query whose start configuration is not valid or whose goal cannot
     /// hold the head (at the smallest clearance).
     fn check_query(&self, query: &Query) -> Result<(), PlanError> {
+        let (start, goal) = query.ends();
         self.ctx_min
-            .check_config(query.start, &query.start_shape)
+            .check_config(start, &query.start_shape)
             .map_err(|c| PlanError::StartInvalid(c.to_string()))?;
-        let goal = query.goal;
         if !self.ctx_min.is_head_free(goal) {
             let why = if self.ctx.field().grid().in_bounds(goal) {
                 format!(
@@ -245,7 +242,7 @@ impl ArcPlanner {
         query: &Query,
         stop: Termination,
     ) -> Result<Solution<Stats>, PlanError> {
-        let (start, goal) = (query.start, query.goal);
+        let (start, goal) = query.ends();
         // The time limit covers the roadmap too (when it is built here) and growth.
         let began = Instant::now();
         let deadline = stop.deadline(began);
@@ -324,8 +321,8 @@ impl ArcPlanner {
         stats.lattice_expanded = lattice_expanded;
         stats.lattice_s = lattice_s;
         stats.route_points = route.as_ref().map_or(0, |r| r.points.len());
-        stats.roadmap_s = self.roadmap_s;
-        stats.planning_s = query_began.elapsed().as_secs_f64();
+        stats.timings.roadmap_s = self.roadmap_s;
+        stats.timings.planning_s = query_began.elapsed().as_secs_f64();
         (stats.roadmap_vertices, stats.roadmap_edges) = size;
         Ok(Solution { steps, stats })
     }
@@ -371,7 +368,10 @@ impl Planner for ArcPlanner {
             .as_ref()
             .map_or((0, 0), |r| (r.vertex_count(), r.edge_count()));
         Stats {
-            roadmap_s: self.roadmap_s,
+            timings: Timings {
+                roadmap_s: self.roadmap_s,
+                ..Default::default()
+            },
             roadmap_vertices,
             roadmap_edges,
             ..Default::default()
@@ -400,13 +400,12 @@ impl SolutionStats for Stats {
         ]
     }
 
-    fn timing(&self) -> Timing {
-        Timing {
-            roadmap_s: self.roadmap_s,
-            planning_s: self.planning_s,
-            collision_s: self.collision_s,
-            rest: "shape_search_s",
-        }
+    fn timings(&self) -> Timings {
+        self.timings
+    }
+
+    fn rest_name(&self) -> &'static str {
+        "shape_search_s"
     }
 
     /// Where each waypoint's shape came from, and the smallest clearance margin in

@@ -16,7 +16,9 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use super::scenarios::{fill, shell_box, Scenario};
+use nalgebra::Point3;
+
+use super::scenarios::{fill, points, shell_box, Scenario};
 use super::ProblemError;
 use crate::map::grid::Cell;
 
@@ -110,16 +112,16 @@ pub fn campus(res: f64) -> Scenario {
                       is --start 40,20,10 --goal 45,20,10 (4 m from every building)."
             .into(),
         grid: g,
-        start: [2.0, 50.0, 2.0],
+        start: Point3::new(2.0, 50.0, 2.0),
         start_yaw: FRAC_PI_2,
-        goal: [98.0, 50.0, 2.0],
+        goal: Point3::new(98.0, 50.0, 2.0),
         default_units: 5,
-        route: vec![
+        route: points(&[
             [2.0, 50.0, 2.0],
             [2.0, 60.0, 2.0],
             [98.0, 60.0, 2.0],
             [98.0, 50.0, 2.0],
-        ],
+        ]),
     }
 }
 
@@ -199,15 +201,15 @@ pub fn hall(res: f64) -> Scenario {
                       --start 20,20,1.3 --start-yaw-deg 0 --goal 25,20,1.3."
             .into(),
         grid: g,
-        start: [3.0, 10.0, 1.3],
+        start: Point3::new(3.0, 10.0, 1.3),
         start_yaw: FRAC_PI_2,
-        goal: [57.0, 30.0, 1.3],
+        goal: Point3::new(57.0, 30.0, 1.3),
         default_units: 5,
-        route: vec![
+        route: points(&[
             [3.0, 10.0, 1.3],
             [3.0, 20.0, 1.3],
             [57.0, 20.0, 1.3],
             [57.0, 30.0, 1.3],
-        ],
+        ]),
     }
 }

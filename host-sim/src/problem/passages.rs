@@ -26,7 +26,7 @@ use aerial_chain_core::ChainParams;
 use super::ProblemError;
 use crate::collision::verify_plan;
 use crate::map::grid::{Cell, Grid};
-use crate::plan::Plan;
+use crate::plan_file::Plan;
 use crate::problem::scenarios::Scenario;
 
 /// Parameters of one instance.
@@ -192,14 +192,7 @@ impl PassageSpec {
         });
         let dims = [sx, ROOM_Y, ROOM_Z].map(|v| (v / r).round() as usize);
         let mut g = Grid::new(r, [0; 3], dims, Cell::Occupied, true)?;
-        let e = 1e-6;
-        let fill = |g: &mut Grid, lo: [f64; 3], hi: [f64; 3], c: Cell| {
-            g.fill_box(
-                [lo[0] + e, lo[1] + e, lo[2] + e],
-                [hi[0] - e, hi[1] - e, hi[2] - e],
-                c,
-            )
-        };
+        let fill = super::scenarios::fill;
         let size = [dims[0] as f64 * r, dims[1] as f64 * r, dims[2] as f64 * r];
         fill(
             &mut g,
@@ -260,11 +253,11 @@ impl PassageSpec {
                 ang = self.angle_deg
             ),
             grid: g,
-            start,
+            start: start.into(),
             start_yaw: a,
-            goal,
+            goal: goal.into(),
             default_units: 5,
-            route,
+            route: super::scenarios::points(&route),
         })
     }
 }

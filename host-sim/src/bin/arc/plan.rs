@@ -192,11 +192,10 @@ pub fn run(a: PlanArgs) -> CliResult {
     // Setup (map, distance field, shape tables) is timed apart: the time limit
     // covers what follows it (docs/promises.md).
     let setup = Instant::now();
-    let (loaded, params, query) = a.problem.load()?;
+    let (ctx, params, query, source) = a.problem.context(a.clearance)?;
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
-    let (resolution, unknown_occ) = (loaded.grid.resolution(), loaded.grid.unknown_is_occupied());
-    let source = loaded.source.clone();
-    let ctx = loaded.into_context(params, a.clearance)?;
+    let grid = ctx.field().grid();
+    let (resolution, unknown_occ) = (grid.resolution(), grid.unknown_is_occupied());
     let settings = Settings {
         vertices: a.vertices,
         r_t: a.r_t,
@@ -261,10 +260,10 @@ pub fn run(a: PlanArgs) -> CliResult {
     report.line(format_args!(
         "  setup {:.1} ms, roadmap {:.1} ms ({} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
         setup_s * 1e3,
-        s.roadmap_s * 1e3,
+        s.timings.roadmap_s * 1e3,
         s.roadmap_vertices,
-        s.planning_s * 1e3,
-        s.collision_s * 1e3,
+        s.timings.planning_s * 1e3,
+        s.timings.collision_s * 1e3,
         s.collision_checks
     ));
     print_quality(&report, &quality, refinement.as_ref());
@@ -289,7 +288,7 @@ pub fn run(a: PlanArgs) -> CliResult {
             grid,
             &plan,
             &format!("ARCplanner on {}", a.problem.map.name()),
-            Some(query.goal),
+            Some(query.goal.into()),
         )
         .save(pic)
         .map_err(|e| CliError::input(e.to_string()))?;

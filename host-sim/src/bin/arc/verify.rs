@@ -8,7 +8,7 @@ use super::checks;
 use super::common::{looser_assumption, parse_point, MapArgs};
 use super::{CliError, CliResult};
 use aerial_chain::collision::verify_plan;
-use aerial_chain::plan::Plan;
+use aerial_chain::plan_file::Plan;
 
 /// `arc verify`
 #[derive(Args, Debug)]
@@ -48,8 +48,8 @@ pub fn run(a: VerifyArgs) -> CliResult {
     let looser = looser_assumption(&plan, &a.map);
     let loaded = a.map.load()?;
     let sc = loaded.scenario.as_ref();
-    let start = a.start.or(sc.map(|s| s.start));
-    let goal = a.goal.or(sc.map(|s| s.goal));
+    let start = a.start.or(sc.map(|s| s.start.into()));
+    let goal = a.goal.or(sc.map(|s| s.goal.into()));
     let report = verify_plan(&loaded.grid, &plan);
     println!(
         "{}: {} waypoints, {} edges ({} translations, {} shape changes), {} configurations checked exactly (unknown space {})",
