@@ -16,11 +16,9 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use nalgebra::Point3;
-
 use super::scenarios::{fill, points, shell_box, Scenario};
 use super::ProblemError;
-use crate::map::grid::Cell;
+use crate::map::grid::{Cell, Grid};
 
 /// Allowed resolutions of `campus:RES` (m).
 pub const CAMPUS_RESOLUTIONS: std::ops::RangeInclusive<f64> = 0.1..=0.4;
@@ -65,6 +63,22 @@ pub fn build(name: &str) -> Option<Result<Scenario, ProblemError>> {
     }))
 }
 
+/// A scenario for the default chain (5 units) that starts at the first point of
+/// `route`, trailing along -y (yaw 90 degrees), and ends at its last.
+fn along(name: String, description: &str, grid: Grid, route: &[[f64; 3]]) -> Scenario {
+    let route = points(route);
+    Scenario {
+        name,
+        description: description.into(),
+        grid,
+        start: route[0],
+        start_yaw: FRAC_PI_2,
+        goal: route[route.len() - 1],
+        default_units: 5,
+        route,
+    }
+}
+
 /// Campus block pitch (m): a 12 m building and an 8 m street.
 const BLOCK: f64 = 20.0;
 /// Where the first building begins (m).
@@ -104,25 +118,20 @@ pub fn campus(res: f64) -> Scenario {
             );
         }
     }
-    Scenario {
-        name: format!("campus:{res}"),
-        description: "A 100 x 100 x 20 m campus: 25 buildings (12 m square, 6-16 m high) on a \
+    along(
+        format!("campus:{res}"),
+        "A 100 x 100 x 20 m campus: 25 buildings (12 m square, 6-16 m high) on a \
                       20 m grid, 8 m streets, lamp posts. The crossing flies 96 m along y = 50 \
                       through the building in its way, around it by the streets; an open-air hop \
-                      is --start 40,20,10 --goal 45,20,10 (4 m from every building)."
-            .into(),
-        grid: g,
-        start: Point3::new(2.0, 50.0, 2.0),
-        start_yaw: FRAC_PI_2,
-        goal: Point3::new(98.0, 50.0, 2.0),
-        default_units: 5,
-        route: points(&[
+                      is --start 40,20,10 --goal 45,20,10 (4 m from every building).",
+        g,
+        &[
             [2.0, 50.0, 2.0],
             [2.0, 60.0, 2.0],
             [98.0, 60.0, 2.0],
             [98.0, 50.0, 2.0],
-        ]),
-    }
+        ],
+    )
 }
 
 /// Hall corridor: y from `CORRIDOR.0` to `CORRIDOR.1` (m), between two 0.2 m walls.
@@ -192,24 +201,19 @@ pub fn hall(res: f64) -> Scenario {
         [size[0], size[1], shell],
         Cell::Occupied,
     );
-    Scenario {
-        name: format!("hall:{res}"),
-        description: "A 60 x 40 x 10 m office hall: a 2 m corridor with ten rooms (6 m x 19 m, \
+    along(
+        format!("hall:{res}"),
+        "A 60 x 40 x 10 m office hall: a 2 m corridor with ten rooms (6 m x 19 m, \
                       full-height walls) on each side, a 1 m x 2.2 m door from each room, a \
                       0.6 m window in every other partition wall. The crossing flies from the \
                       first room on one side to the last on the other; a hop in the corridor is \
-                      --start 20,20,1.3 --start-yaw-deg 0 --goal 25,20,1.3."
-            .into(),
-        grid: g,
-        start: Point3::new(3.0, 10.0, 1.3),
-        start_yaw: FRAC_PI_2,
-        goal: Point3::new(57.0, 30.0, 1.3),
-        default_units: 5,
-        route: points(&[
+                      --start 20,20,1.3 --start-yaw-deg 0 --goal 25,20,1.3.",
+        g,
+        &[
             [3.0, 10.0, 1.3],
             [3.0, 20.0, 1.3],
             [57.0, 20.0, 1.3],
             [57.0, 30.0, 1.3],
-        ]),
-    }
+        ],
+    )
 }
