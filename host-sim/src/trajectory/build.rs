@@ -1,0 +1,266 @@
+//! The generator: a plan's edges timed with smooth ramps, consecutive edges blended
+//! where the blend is admissible.
+//!
+//! Edge `k` advances its progress `s` from 0 to 1: a smoothstep ramp up of length
+//! `U_k`, a cruise at rate `r_k`, a smoothstep ramp down of length `W_k`; it lasts
+//! `D_k = 1/r_k + (U_k + W_k)/2`. At a corner that is not blended, edge `k` ramps down
+//! to rest, and edge `k + 1` starts from rest after it on the next sample time. At a
+//! blended corner the two ramps have one length `R` and overlap exactly: edge `k + 1`
+//! starts `R` before edge `k` ends, so the chain moves by the sum of both and the
+//! velocity passes from one edge's cruise to the other's. During the overlap every rate
+//! is a convex mix of the two cruises (one ramps down as the other ramps up), so speeds
+//! and angle rates stay within their limits; the acceleration is `S'(x)/R` times the
+//! change of velocity, so `R = 1.5 * max(|dV_head| / accel, max_j |d omega_j| /
+//! angular_accel)` keeps it within its limits. A ramp from or to rest is the same rule
+//! with the other velocity zero. The ramps of an edge must fit (`r (U + W) / 2 <= 1`):
+//! where they do not, the edge's cruise is lowered until they do.
+//!
+//! What a blend can break is the chain's validity (the map, self-collision, the bend
+//! limit): the sampled trajectory is checked exactly ([`super::check_samples`]); a
+//! blended corner where the check fails is unblended and the timing redone, until the
+//! whole passes. Without blends the chain is on the plan's own edges, resting on a
+//! sample at every waypoint, so only a plan that is itself inadmissible fails.
+
+use aerial_chain_core::ChainParams;
+
+use super::check::{check_samples, Violation};
+use super::{Plan, Settings, TrajectoryError, MAX_SAMPLES};
+use crate::map::Grid;
+use crate::sim::reference::{max_rate, Reference, Scaling, Segment};
+
+/// Peak of the smoothstep's derivative: a ramp of length `R` that changes a rate by
+/// `dv` accelerates by at most `1.5 dv / R`.
+const RAMP_PEAK: f64 = 1.5;
+
+/// Rounds of lowering cruise rates until every edge's ramps fit.
+const FIT_ROUNDS: usize = 200;
+
+/// A timed trajectory: its samples, and the analytic motion they were taken from.
+#[derive(Clone, Debug)]
+pub struct Trajectory {
+    params: ChainParams,
+    settings: Settings,
+    reference: Reference,
+    times: Vec<f64>,
+    zetas: Vec<Vec<f64>>,
+    corners: usize,
+    blended: usize,
+    stop_go: f64,
+    head_path: f64,
+}
+
+impl Trajectory {
+    /// The chain.
+    pub fn params(&self) -> &ChainParams {
+        &self.params
+    }
+    /// The settings it was made with.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+    /// The analytic motion (what `arc sim` flies): `zeta` and its derivatives at any time.
+    pub fn reference(&self) -> &Reference {
+        &self.reference
+    }
+    /// Sample times (s), from 0 on the uniform grid except inside blends.
+    pub fn times(&self) -> &[f64] {
+        &self.times
+    }
+    /// `zeta` at every sample (angles continuous, not wrapped).
+    pub fn zetas(&self) -> &[Vec<f64>] {
+        &self.zetas
+    }
+    /// Time of the last sample, where the chain rests at the plan's end (s).
+    pub fn duration(&self) -> f64 {
+        self.times.last().copied().unwrap_or(0.0)
+    }
+    /// Places where two edges meet (edges that change nothing left out).
+    pub fn corners(&self) -> usize {
+        self.corners
+    }
+    /// Corners flown blended.
+    pub fn blended(&self) -> usize {
+        self.blended
+    }
+    /// The duration when the chain stops at every waypoint, as `arc sim` timed plans (s).
+    pub fn stop_go_duration(&self) -> f64 {
+        self.stop_go
+    }
+    /// Length of the head's path (m).
+    pub fn head_path_m(&self) -> f64 {
+        self.head_path
+    }
+}
+
+/// Times `plan` within `settings` and blends its corners where the blended motion is
+/// admissible on `grid` (whose choice about unknown space is the one checked). Fails when
+/// the plan breaks its format, cannot be timed, or is not admissible even without blends.
+pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory, TrajectoryError> {
+    let params = plan.check()?;
+    settings.validate()?;
+    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
+    let l = params.link_length as f64;
+    let limits = settings.limits.to_reference();
+    let timed = Reference::new(params.n(), l, &waypoints, &limits)?;
+    let edges: Vec<Segment> = timed.segments().to_vec();
+    let stop_go = timed.duration();
+    let steps = (stop_go / settings.dt).ceil() as usize + edges.len() + 1;
+    if steps > MAX_SAMPLES {
+        return Err(TrajectoryError::TooLong(steps));
+    }
+    let head_path = edges
+        .iter()
+        .map(|s| (s.delta[0].powi(2) + s.delta[1].powi(2) + s.delta[2].powi(2)).sqrt())
+        .sum();
+    let timing = Timing {
+        settings,
+        edges: &edges,
+        max_rates: edges
+            .iter()
+            .map(|e| max_rate(e.kind, l, &e.delta, &limits))
+            .collect(),
+    };
+    // blend[k]: edge k starts blended with edge k - 1 (blend[0] is the start, never).
+    let mut blend: Vec<bool> = (0..edges.len()).map(|k| k > 0 && settings.blend).collect();
+    loop {
+        let segments = timing.segments(&mut blend);
+        let reference = Reference::from_segments(params.n(), &waypoints[0], segments);
+        let (times, zetas) = sample(&reference, settings.dt);
+        let rep = check_samples(grid, &params, &settings.limits, &times, &zetas, 0.0);
+        let Some(v) = rep.violation else {
+            return Ok(Trajectory {
+                params,
+                settings: *settings,
+                reference,
+                times,
+                zetas,
+                corners: edges.len().saturating_sub(1),
+                blended: blend.iter().filter(|b| **b).count(),
+                stop_go,
+                head_path,
+            });
+        };
+        match corner_near(reference.segments(), &blend, &v, settings.dt) {
+            Some(k) => blend[k] = false,
+            None => return Err(TrajectoryError::Inadmissible(v)),
+        }
+    }
+}
+
+/// The samples of `r`: every multiple of `dt` up to the first at or after its end (an
+/// unblended edge starts on one, so the chain is sampled at rest at its waypoint).
+fn sample(r: &Reference, dt: f64) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let last = ((r.duration() / dt) - 1e-9).ceil().max(0.0) as usize;
+    (0..=last)
+        .map(|j| {
+            let t = j as f64 * dt;
+            (t, r.zeta(t))
+        })
+        .unzip()
+}
+
+/// The blended corner whose overlap (two samples either side) holds `v`.
+fn corner_near(segments: &[Segment], blend: &[bool], v: &Violation, dt: f64) -> Option<usize> {
+    let pad = 2.0 * dt;
+    (1..segments.len()).find(|&k| {
+        let prev = &segments[k - 1];
+        blend[k] && v.t >= segments[k].t0 - pad && v.t <= prev.t0 + prev.duration + pad
+    })
+}
+
+/// What timing the edges needs.
+struct Timing<'a> {
+    settings: &'a Settings,
+    edges: &'a [Segment],
+    max_rates: Vec<f64>,
+}
+
+impl Timing<'_> {
+    /// The length of a ramp that takes the chain from cruising along `from` to
+    /// cruising along `to` (`None`: at rest) within the acceleration limits.
+    fn ramp(&self, from: Option<(&Segment, f64)>, to: Option<(&Segment, f64)>) -> f64 {
+        let lim = &self.settings.limits;
+        let v = |e: Option<(&Segment, f64)>, j: usize| e.map_or(0.0, |(s, r)| r * s.delta[j]);
+        let head = (0..3)
+            .map(|j| (v(to, j) - v(from, j)).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let dim = self.edges.first().map_or(0, |e| e.delta.len());
+        let angles = (3..dim).fold(0.0f64, |m, j| m.max((v(to, j) - v(from, j)).abs()));
+        RAMP_PEAK * (head / lim.accel).max(angles / lim.angular_accel)
+    }
+
+    /// Ramps up and down of every edge at cruise rates `rates`.
+    fn ramps(&self, rates: &[f64], blend: &[bool]) -> (Vec<f64>, Vec<f64>) {
+        let m = self.edges.len();
+        let at = |k: usize| Some((&self.edges[k], rates[k]));
+        let up: Vec<f64> = (0..m)
+            .map(|k| match blend[k] {
+                true => self.ramp(at(k - 1), at(k)),
+                false => self.ramp(None, at(k)),
+            })
+            .collect();
+        let down = (0..m)
+            .map(|k| match k + 1 < m && blend[k + 1] {
+                true => up[k + 1],
+                false => self.ramp(at(k), None),
+            })
+            .collect();
+        (up, down)
+    }
+
+    /// The timed segments: cruise rates lowered until every edge's ramps fit (an edge
+    /// that never fits is unblended on both sides, which always fits), then laid out.
+    fn segments(&self, blend: &mut [bool]) -> Vec<Segment> {
+        let m = self.edges.len();
+        let mut rates = self.max_rates.clone();
+        let (up, down) = loop {
+            let mut fitted = false;
+            for _ in 0..FIT_ROUNDS {
+                let (up, down) = self.ramps(&rates, blend);
+                let mut all = true;
+                for k in 0..m {
+                    let excess = rates[k] * (up[k] + down[k]) / 2.0;
+                    if excess > 1.0 {
+                        rates[k] /= excess.sqrt() * 1.001;
+                        all = false;
+                    }
+                }
+                if all {
+                    fitted = true;
+                    break;
+                }
+            }
+            let (up, down) = self.ramps(&rates, blend);
+            if fitted {
+                break (up, down);
+            }
+            for k in 0..m {
+                if rates[k] * (up[k] + down[k]) / 2.0 > 1.0 {
+                    blend[k] = false;
+                    if k + 1 < m {
+                        blend[k + 1] = false;
+                    }
+                }
+            }
+        };
+        let dt = self.settings.dt;
+        let mut end = 0.0f64;
+        let mut out: Vec<Segment> = Vec::with_capacity(m);
+        for k in 0..m {
+            let scaling = Scaling::with_ramps(rates[k], up[k], down[k]);
+            let t0 = match blend[k] {
+                true => end - up[k],
+                false => ((end / dt) - 1e-9).ceil().max(0.0) * dt,
+            };
+            end = t0 + scaling.duration;
+            out.push(Segment {
+                t0,
+                duration: scaling.duration,
+                scaling,
+                ..self.edges[k].clone()
+            });
+        }
+        out
+    }
+}
