@@ -10,11 +10,17 @@ use serde::Serialize;
 
 use super::checks;
 use super::common::{looser_assumption, read_plan, MapArgs, Report};
+use super::trajectory::TimingArgs;
 use super::{CliError, CliResult};
+use aerial_chain::map::Grid;
+use aerial_chain::plan::Plan;
 use aerial_chain::sim::flight_svg;
 use aerial_chain::sim::V3;
 use aerial_chain::sim::{footprint, MapClearance};
-use aerial_chain::sim::{simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig};
+use aerial_chain::sim::{
+    simulate_reference, simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig,
+};
+use aerial_chain::trajectory::{self, Trajectory, TrajectoryError};
 
 /// `arc sim`
 #[derive(Args, Debug)]
@@ -34,15 +40,11 @@ pub struct SimArgs {
     /// Physics and control rate (Hz, at least 500).
     #[arg(long, default_value_t = 500.0)]
     rate: f64,
-    /// Largest speed of any unit on the plan's edges (m/s).
-    #[arg(long, default_value_t = 0.5)]
-    speed: f64,
-    /// Largest head acceleration on translations (m/s^2).
-    #[arg(long, default_value_t = 0.5)]
-    accel: f64,
-    /// Largest rate of any shape angle (degrees/s).
-    #[arg(long, default_value_t = 0.4f64.to_degrees())]
-    angular_rate_deg: f64,
+    /// How the plan is timed: by default a trajectory that blends through corners
+    /// where that is admissible (as `arc trajectory`); `--no-blend` stops at every
+    /// waypoint.
+    #[command(flatten)]
+    timing: TimingArgs,
     /// Distance of the head from the plan's last waypoint that counts as arrived (m).
     #[arg(long, default_value_t = 0.1)]
     goal_tol: f64,
@@ -130,9 +132,7 @@ fn check(a: &SimArgs) -> Result<(), CliError> {
     if !(a.rate.is_finite() && (500.0..=20_000.0).contains(&a.rate)) {
         return Err(checks::bad("--rate", a.rate, "between 500 and 20000 Hz"));
     }
-    checks::positive("--speed", a.speed)?;
-    checks::positive("--accel", a.accel)?;
-    checks::positive("--angular-rate-deg", a.angular_rate_deg)?;
+    a.timing.settings()?;
     checks::positive("--goal-tol", a.goal_tol)?;
     checks::positive("--settle-time", a.settle_time)?;
     if a.record_every == 0 {
@@ -153,14 +153,16 @@ pub fn run(a: SimArgs) -> CliResult {
     let cfg = sim_config(&a)?;
     let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
     let obstacles = MapClearance::new(&loaded.grid, &params);
-    let flight = with_progress(|progress| {
-        simulate_with_progress(&params, &waypoints, &cfg, Some(&obstacles), progress)
-    })
-    .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
-    let r = &flight.report;
     // With `--out -` the flight is standard output; the report goes to standard error.
     let report = Report::new(a.out.as_deref().unwrap_or(Path::new("")));
     let say = |args: std::fmt::Arguments<'_>| report.line(args);
+    let trajectory = timed(&a, &plan, &plan_name, &loaded.grid, &say)?;
+    let flight = with_progress(|progress| match &trajectory {
+        Some(tr) => simulate_reference(&params, tr.reference(), &cfg, Some(&obstacles), progress),
+        None => simulate_with_progress(&params, &waypoints, &cfg, Some(&obstacles), progress),
+    })
+    .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
+    let r = &flight.report;
     say_report(&say, &plan_name, plan.waypoints.len(), r);
     if let Some(path) = &a.out {
         write_flight(path, &a, &plan_name, &flight)?;
@@ -190,6 +192,43 @@ pub fn run(a: SimArgs) -> CliResult {
     )))
 }
 
+/// The trajectory to fly: made from the plan and checked exactly on the map, unless
+/// `--no-blend` asks for the stop at every waypoint; a plan that is not admissible as
+/// a trajectory is flown stopping at every waypoint, and the report says why.
+fn timed(
+    a: &SimArgs,
+    plan: &Plan,
+    plan_name: &str,
+    grid: &Grid,
+    say: &dyn Fn(std::fmt::Arguments<'_>),
+) -> Result<Option<Trajectory>, CliError> {
+    if a.timing.no_blend {
+        say(format_args!(
+            "  timing: stopping at every waypoint (--no-blend)"
+        ));
+        return Ok(None);
+    }
+    match trajectory::build(plan, grid, &a.timing.settings()?) {
+        Ok(tr) => {
+            say(format_args!(
+                "  timing: trajectory of {:.2} s ({:.2} s stopping at every waypoint), {} of {} corners blended",
+                tr.duration(),
+                tr.stop_go_duration(),
+                tr.blended(),
+                tr.corners()
+            ));
+            Ok(Some(tr))
+        }
+        Err(TrajectoryError::Inadmissible(v)) => {
+            say(format_args!(
+                "  timing: stopping at every waypoint: the plan is not admissible as a trajectory ({v})"
+            ));
+            Ok(None)
+        }
+        Err(e) => Err(CliError::input(format!("{plan_name}: {e}"))),
+    }
+}
+
 /// The simulation settings from the command line, checked.
 fn sim_config(a: &SimArgs) -> Result<SimConfig, CliError> {
     let gusts = a
@@ -204,9 +243,11 @@ fn sim_config(a: &SimArgs) -> Result<SimConfig, CliError> {
         gusts,
         ..Default::default()
     };
-    cfg.limits.speed = a.speed;
-    cfg.limits.accel = a.accel;
-    cfg.limits.angular_rate = a.angular_rate_deg.to_radians();
+    let limits = a.timing.limits.limits()?;
+    cfg.limits.speed = limits.speed;
+    cfg.limits.accel = limits.accel;
+    cfg.limits.angular_rate = limits.angular_rate;
+    cfg.limits.angular_accel = limits.angular_accel;
     cfg.validate()
         .map_err(|e| CliError::input(format!("simulation settings: {e}")))?;
     Ok(cfg)
