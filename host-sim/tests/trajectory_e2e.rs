@@ -135,3 +135,39 @@ fn trajectory_command_csv_and_refusals() {
         2,
     );
 }
+
+/// `arc sim --trajectory` flies a trajectory file as it is, to the goal without contact.
+#[test]
+fn a_trajectory_file_is_flown() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (plan, tr, out) = (
+        dir.path().join("plan.json"),
+        dir.path().join("t.json"),
+        dir.path().join("sim.json"),
+    );
+    plan_scenario("window", 4, &["--trajectory", s(&tr)], &plan).expect("plan");
+    arc_ok(&[
+        "sim",
+        "--scenario",
+        "window",
+        "--trajectory",
+        s(&tr),
+        "--out",
+        s(&out),
+    ])
+    .unwrap_or_else(|e| panic!("arc sim --trajectory: {e}"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).expect("sim output")).unwrap();
+    let r = &v["report"];
+    assert_eq!(r["reached_goal"], true);
+    assert_eq!(r["contact"], false);
+    let t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&tr).expect("trajectory")).unwrap();
+    let planned = t["stats"]["duration_s"].as_f64().unwrap();
+    // The 1 s hold at the start, then the trajectory's own time.
+    let flown = r["planned_duration"].as_f64().unwrap();
+    assert!(
+        (flown - (planned + 1.0)).abs() < 1e-6,
+        "{flown} vs {planned}"
+    );
+}

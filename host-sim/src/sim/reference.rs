@@ -469,6 +469,55 @@ impl Reference {
         }
     }
 
+    /// A reference that moves linearly in `zeta` between timed samples (a trajectory
+    /// file's, docs/model.md "Trajectories"; angles along their shortest signed
+    /// difference): the velocity is constant over each interval, the acceleration zero.
+    /// Times must increase; they are counted from the first sample.
+    pub fn from_samples(
+        units: usize,
+        times: &[f64],
+        zetas: &[Vec<f64>],
+    ) -> Result<Self, ReferenceError> {
+        let dim = 2 * units + 2;
+        let (Some(first), Some(&t0)) = (zetas.first(), times.first()) else {
+            return Err(ReferenceError::NoWaypoints);
+        };
+        for (i, z) in zetas.iter().enumerate() {
+            let later = i == 0
+                || times
+                    .get(i)
+                    .zip(times.get(i - 1))
+                    .is_some_and(|(a, b)| a > b);
+            if z.len() != dim || z.iter().any(|v| !v.is_finite()) || !later {
+                return Err(ReferenceError::Waypoint { index: i, dim });
+            }
+        }
+        let segments = zetas
+            .windows(2)
+            .zip(times.windows(2))
+            .enumerate()
+            .map(|(i, (z, t))| {
+                let delta: Vec<f64> = (0..dim)
+                    .map(|j| match j {
+                        0..3 => z[1][j] - z[0][j],
+                        _ => wrap(z[1][j] - z[0][j]),
+                    })
+                    .collect();
+                let h = t[1] - t[0];
+                Segment {
+                    kind: SegmentKind::Translation,
+                    t0: t[0] - t0,
+                    duration: h,
+                    from: z[0].clone(),
+                    delta,
+                    to_waypoint: i + 1,
+                    scaling: Scaling::with_ramps(1.0 / h, 0.0, 0.0),
+                }
+            })
+            .collect();
+        Ok(Self::from_segments(units, first, segments))
+    }
+
     /// The same motion after `hold` seconds at rest at its start.
     pub fn with_start_hold(&self, hold: f64) -> Self {
         if hold <= 0.0 {
@@ -619,6 +668,41 @@ mod tests {
             t += 0.001;
         }
         assert!((wrap(r.sample(r.duration()).links[0].yaw - (-3.0))).abs() < 1e-12);
+    }
+
+    #[test]
+    fn samples_are_flown_through_in_time() {
+        let lim = ReferenceLimits::default();
+        let w = [
+            zeta([0.0; 3], &[3.0, 0.0, 3.0, 0.0, 0.0]),
+            zeta([0.0; 3], &[-3.0, 0.2, -3.0, 0.0, 0.0]),
+            zeta([1.0, -1.0, 0.5], &[-3.0, 0.2, -3.0, 0.0, 0.0]),
+        ];
+        let r = Reference::new(3, 0.5, &w, &lim).unwrap();
+        let times: Vec<f64> = (0..=200)
+            .map(|j| 5.0 + j as f64 * r.duration() / 200.0)
+            .collect();
+        let zetas: Vec<Vec<f64>> = times.iter().map(|t| r.zeta(t - 5.0)).collect();
+        let s = Reference::from_samples(3, &times, &zetas).unwrap();
+        assert!((s.duration() - r.duration()).abs() < 1e-9);
+        for (t, z) in times.iter().zip(&zetas) {
+            let got = s.zeta(t - 5.0);
+            for (a, b) in got.iter().zip(z) {
+                assert!(wrap(a - b).abs() < 1e-9, "{t}: {a} vs {b}");
+            }
+        }
+        let mid = s.sample(0.5 * (times[100] + times[101]) - 5.0);
+        let dt = times[101] - times[100];
+        let (a, b) = (&zetas[100], &zetas[101]);
+        let chord = V3::new(b[0] - a[0], b[1] - a[1], b[2] - a[2]) / dt;
+        assert!(
+            (mid.v - chord).norm() < 1e-9,
+            "constant velocity between samples"
+        );
+        assert!(Reference::from_samples(3, &[], &[]).is_err());
+        let back = [times[1], times[0]];
+        assert!(Reference::from_samples(3, &back, &zetas[..2]).is_err());
+        assert!(Reference::from_samples(4, &times, &zetas).is_err());
     }
 
     #[test]

@@ -15,12 +15,14 @@ use super::{CliError, CliResult};
 use aerial_chain::map::Grid;
 use aerial_chain::plan::Plan;
 use aerial_chain::sim::flight_svg;
+use aerial_chain::sim::Reference;
 use aerial_chain::sim::V3;
 use aerial_chain::sim::{footprint, MapClearance};
 use aerial_chain::sim::{
     simulate_reference, simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig,
 };
-use aerial_chain::trajectory::{self, Trajectory, TrajectoryError};
+use aerial_chain::trajectory::{self, Trajectory, TrajectoryError, TrajectoryFile};
+use aerial_chain_core::ChainParams;
 
 /// `arc sim`
 #[derive(Args, Debug)]
@@ -28,8 +30,16 @@ pub struct SimArgs {
     #[command(flatten)]
     map: MapArgs,
     /// The plan to fly (JSON, arc-plan/1); `-` reads it from standard input.
+    #[arg(
+        long,
+        required_unless_present = "trajectory",
+        conflicts_with = "trajectory"
+    )]
+    plan: Option<PathBuf>,
+    /// A trajectory to fly as it is (JSON, arc-trajectory/1), instead of a plan;
+    /// the chain moves linearly between its samples.
     #[arg(long)]
-    plan: PathBuf,
+    trajectory: Option<PathBuf>,
     /// Write the flight (report and recorded states) as JSON; `-` writes it to
     /// standard output.
     #[arg(long)]
@@ -145,25 +155,57 @@ fn check(a: &SimArgs) -> Result<(), CliError> {
 /// the map or itself.
 pub fn run(a: SimArgs) -> CliResult {
     check(&a)?;
-    let (plan, plan_name, params) = read_plan(&a.plan)?;
-    // The flight is judged under the user's assumption about unknown space, never the
-    // plan's: a plan made with looser assumptions fails (docs/model.md).
-    let looser = looser_assumption(&plan, &a.map);
-    let loaded = a.map.load()?;
     let cfg = sim_config(&a)?;
-    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
-    let obstacles = MapClearance::new(&loaded.grid, &params);
     // With `--out -` the flight is standard output; the report goes to standard error.
     let report = Report::new(a.out.as_deref().unwrap_or(Path::new("")));
     let say = |args: std::fmt::Arguments<'_>| report.line(args);
-    let trajectory = timed(&a, &plan, &plan_name, &loaded.grid, &say)?;
-    let flight = with_progress(|progress| match &trajectory {
-        Some(tr) => simulate_reference(&params, tr.reference(), &cfg, Some(&obstacles), progress),
-        None => simulate_with_progress(&params, &waypoints, &cfg, Some(&obstacles), progress),
+    let (plan_name, waypoints, params, looser, loaded, motion) = match (&a.plan, &a.trajectory) {
+        (Some(path), None) => {
+            let (plan, name, params) = read_plan(path)?;
+            // The flight is judged under the user's assumption about unknown space,
+            // never the plan's: a plan made with looser assumptions fails (docs/model.md).
+            let looser = looser_assumption(&plan, &a.map);
+            let loaded = a.map.load()?;
+            let motion = match timed(&a, &plan, &name, &loaded.grid, &say)? {
+                Some(tr) => Motion::Timed(tr.reference().clone()),
+                None => Motion::Waypoints(plan.waypoints.iter().map(|w| w.zeta.clone()).collect()),
+            };
+            (name, plan.waypoints.len(), params, looser, loaded, motion)
+        }
+        (None, Some(path)) => {
+            let (file, name, params) = read_trajectory(path)?;
+            let looser = (!file.map.unknown_is_occupied && !a.map.unknown_free).then(|| {
+                "the trajectory was made with unknown space free; fly it with --unknown-free"
+                    .to_string()
+            });
+            let loaded = a.map.load()?;
+            let r = Reference::from_samples(params.n(), &file.times(), &file.zetas())
+                .map_err(|e| CliError::input(format!("{name}: {e}")))?;
+            say(format_args!(
+                "  timing: the trajectory's own, {:.2} s",
+                r.duration()
+            ));
+            (
+                name,
+                file.samples.len(),
+                params,
+                looser,
+                loaded,
+                Motion::Timed(r),
+            )
+        }
+        _ => return Err(CliError::input("give --plan or --trajectory")),
+    };
+    let obstacles = MapClearance::new(&loaded.grid, &params);
+    let flight = with_progress(|progress| match &motion {
+        Motion::Timed(r) => simulate_reference(&params, r, &cfg, Some(&obstacles), progress),
+        Motion::Waypoints(w) => {
+            simulate_with_progress(&params, w, &cfg, Some(&obstacles), progress)
+        }
     })
     .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
     let r = &flight.report;
-    say_report(&say, &plan_name, plan.waypoints.len(), r);
+    say_report(&say, &plan_name, waypoints, r);
     if let Some(path) = &a.out {
         write_flight(path, &a, &plan_name, &flight)?;
         if !crate::fsutil::is_stdio(path) {
@@ -190,6 +232,22 @@ pub fn run(a: SimArgs) -> CliResult {
         "{plan_name}: {}",
         why_failed(r, cfg.settle_time)
     )))
+}
+
+/// What is flown: a timed reference, or a plan's waypoints stopping at each.
+enum Motion {
+    Timed(Reference),
+    Waypoints(Vec<Vec<f64>>),
+}
+
+/// Reads a trajectory file and checks its format: the file, its name, its chain.
+fn read_trajectory(path: &Path) -> Result<(TrajectoryFile, String, ChainParams), CliError> {
+    let file = TrajectoryFile::read(path).map_err(|e| CliError::input(e.to_string()))?;
+    let name = crate::fsutil::input_name(path);
+    let params = file
+        .check()
+        .map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    Ok((file, name, params))
 }
 
 /// The trajectory to fly: made from the plan and checked exactly on the map, unless
