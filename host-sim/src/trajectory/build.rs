@@ -15,18 +15,22 @@
 //! with the other velocity zero. The ramps of an edge must fit (`r (U + W) / 2 <= 1`):
 //! where they do not, the edge's cruise is lowered until they do.
 //!
-//! What a blend can break is the chain's validity (the map, self-collision, the bend
+//! Before that, a translation and the shape change beside it may be merged into one
+//! motion, straight in `zeta`, that moves head and shape at once (`super::merge`).
+//!
+//! What a blend or a merge can break is the chain's validity (the map, self-collision, the bend
 //! limit): the sampled trajectory is checked exactly ([`super::check_samples`]); a
-//! blended corner where the check fails is unblended and the timing redone, until the
-//! whole passes. Without blends the chain is on the plan's own edges, resting on a
+//! blended corner where the check fails is unblended, else a merged pair there is split,
+//! and the timing redone, until the whole passes. Without blends the chain is on the plan's own edges, resting on a
 //! sample at every waypoint, so only a plan that is itself inadmissible fails.
 
 use aerial_chain_core::ChainParams;
 
-use super::check::{check_samples, Violation};
+use super::check::{check_with_margin, Violation};
+use super::merge::{self, Demand};
 use super::{Plan, Settings, TrajectoryError, MAX_SAMPLES};
 use crate::map::Grid;
-use crate::sim::reference::{max_rate, Reference, Scaling, Segment};
+use crate::sim::reference::{Reference, Scaling, Segment};
 
 /// Peak of the smoothstep's derivative: a ramp of length `R` that changes a rate by
 /// `dv` accelerates by at most `1.5 dv / R`.
@@ -45,6 +49,7 @@ pub struct Trajectory {
     zetas: Vec<Vec<f64>>,
     corners: usize,
     blended: usize,
+    merged: usize,
     stop_go: f64,
     head_path: f64,
 }
@@ -78,9 +83,13 @@ impl Trajectory {
     pub fn corners(&self) -> usize {
         self.corners
     }
-    /// Corners flown blended.
+    /// Corners flown blended (the next edge ramping up as the one before ramps down).
     pub fn blended(&self) -> usize {
         self.blended
+    }
+    /// Pairs of a translation and a shape change flown at once, as one move.
+    pub fn merged(&self) -> usize {
+        self.merged
     }
     /// The duration when the chain stops at every waypoint, as `arc sim` timed plans (s).
     pub fn stop_go_duration(&self) -> f64 {
@@ -112,21 +121,37 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
         .iter()
         .map(|s| (s.delta[0].powi(2) + s.delta[1].powi(2) + s.delta[2].powi(2)).sqrt())
         .sum();
-    let timing = Timing {
-        settings,
-        edges: &edges,
-        max_rates: edges
-            .iter()
-            .map(|e| max_rate(e.kind, l, &e.delta, &limits))
-            .collect(),
-    };
-    // blend[k]: edge k starts blended with edge k - 1 (blend[0] is the start, never).
+    let demands: Vec<Demand> = edges.iter().map(|e| Demand::of(e, l)).collect();
+    let mut merged = merge::candidates(&edges, settings.blend);
+    // blend[k]: the motion that starts with edge k is blended with the one before.
     let mut blend: Vec<bool> = (0..edges.len()).map(|k| k > 0 && settings.blend).collect();
     loop {
-        let segments = timing.segments(&mut blend);
+        let (motions, firsts, max_rates) = merge::assemble(&edges, &demands, &merged, &limits);
+        let merged_m: Vec<bool> = firsts
+            .iter()
+            .map(|&k| merged.get(k + 1).copied().unwrap_or(false))
+            .collect();
+        let mut blend_m: Vec<bool> = firsts.iter().map(|&k| blend[k]).collect();
+        let timing = Timing {
+            settings,
+            edges: &motions,
+            max_rates,
+        };
+        let segments = timing.segments(&mut blend_m);
+        firsts
+            .iter()
+            .zip(&blend_m)
+            .for_each(|(&k, &b)| blend[k] = b);
         let reference = Reference::from_segments(params.n(), &waypoints[0], segments);
         let (times, zetas) = sample(&reference, settings.dt);
-        let rep = check_samples(grid, &params, &settings.limits, &times, &zetas, 0.0);
+        let windows = windows(reference.segments(), &blend_m, &merged_m, settings.dt);
+        let margin = settings.clearance;
+        let required = |t: f64| match windows.iter().any(|w| w.0 <= t && t <= w.1) {
+            true => margin,
+            false => 0.0,
+        };
+        let lim = &settings.limits;
+        let rep = check_with_margin(grid, &params, lim, (&times, &zetas), margin, &required);
         let Some(v) = rep.violation else {
             return Ok(Trajectory {
                 params,
@@ -135,16 +160,50 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
                 times,
                 zetas,
                 corners: edges.len().saturating_sub(1),
-                blended: blend.iter().filter(|b| **b).count(),
+                blended: blend_m.iter().filter(|b| **b).count(),
+                merged: merged.iter().filter(|b| **b).count(),
                 stop_go,
                 head_path,
             });
         };
-        match corner_near(reference.segments(), &blend, &v, settings.dt) {
-            Some(k) => blend[k] = false,
-            None => return Err(TrajectoryError::Inadmissible(v)),
+        let segs = reference.segments();
+        if let Some(m) = corner_near(segs, &blend_m, &v, settings.dt) {
+            blend[firsts[m]] = false;
+        } else if let Some(m) = motion_near(segs, &v, settings.dt).filter(|&m| merged_m[m]) {
+            merged[firsts[m] + 1] = false;
+        } else {
+            return Err(TrajectoryError::Inadmissible(v));
         }
     }
+}
+
+/// The times (one sample either side) where the motion is not the plan's own: the
+/// overlap of every blended corner and every merged motion.
+fn windows(segments: &[Segment], blend: &[bool], merged: &[bool], dt: f64) -> Vec<(f64, f64)> {
+    let end = |s: &Segment| s.t0 + s.duration;
+    let mut w = Vec::new();
+    for (m, s) in segments.iter().enumerate() {
+        if blend[m] && m > 0 {
+            w.push((s.t0 - dt, end(&segments[m - 1]) + dt));
+        }
+        if merged[m] {
+            w.push((s.t0 - dt, end(s) + dt));
+        }
+    }
+    w
+}
+
+/// The largest change of any angle of `eta` in a change of `zeta` by `delta`.
+pub(super) fn max_angle(delta: &[f64]) -> f64 {
+    delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()))
+}
+
+/// The motion whose time (two samples either side) holds `v`, the last if several.
+fn motion_near(segments: &[Segment], v: &Violation, dt: f64) -> Option<usize> {
+    let pad = 2.0 * dt;
+    (0..segments.len()).rev().find(|&m| {
+        v.t >= segments[m].t0 - pad && v.t <= segments[m].t0 + segments[m].duration + pad
+    })
 }
 
 /// The samples of `r`: every multiple of `dt` up to the first at or after its end (an

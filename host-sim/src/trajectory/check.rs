@@ -87,6 +87,19 @@ pub enum Problem {
     /// A configuration that fails the exact test (limits, self-collision, map, bounds).
     #[error("{0}")]
     Invalid(ExactViolation),
+    /// A valid configuration closer to the map than the generator asks of a blend (never
+    /// raised by [`check_samples`]: the contract asks for validity only).
+    #[error(
+        "{body} keeps {clearance:.4} m from the map, less than the {required} m a blend keeps"
+    )]
+    Clearance {
+        /// The body.
+        body: Body,
+        /// Its clearance (m).
+        clearance: f64,
+        /// The clearance asked for there (m).
+        required: f64,
+    },
 }
 
 /// The first problem of a trajectory, and where.
@@ -155,11 +168,26 @@ pub fn check_samples(
     zetas: &[Vec<f64>],
     horizon: f64,
 ) -> CheckReport {
+    check_with_margin(grid, params, limits, (times, zetas), horizon, &|_| 0.0)
+}
+
+/// [`check_samples`], and every configuration at time `t` must also keep
+/// `required(t)` from the map (the generator's own rule for blends; `horizon` must be at
+/// least as large).
+pub(super) fn check_with_margin(
+    grid: &Grid,
+    params: &ChainParams,
+    limits: &Limits,
+    (times, zetas): (&[f64], &[Vec<f64>]),
+    horizon: f64,
+    required: &dyn Fn(f64) -> f64,
+) -> CheckReport {
     let mut c = Checker {
         grid,
         params,
         limits,
         horizon,
+        required,
         rep: CheckReport {
             ok: false,
             configurations: 0,
@@ -182,6 +210,7 @@ struct Checker<'a> {
     params: &'a ChainParams,
     limits: &'a Limits,
     horizon: f64,
+    required: &'a dyn Fn(f64) -> f64,
     rep: CheckReport,
 }
 
@@ -243,6 +272,14 @@ impl Checker<'_> {
         if self.rep.min_clearance_at.is_none() || c.clearance < self.rep.min_clearance {
             self.rep.min_clearance = c.clearance;
             self.rep.min_clearance_at = Some((t, c.body));
+        }
+        let required = (self.required)(t);
+        if c.clearance < required {
+            return Err(Problem::Clearance {
+                body: c.body,
+                clearance: c.clearance,
+                required,
+            });
         }
         Ok(())
     }

@@ -48,6 +48,9 @@ pub struct TrajectoryStats {
     pub corners: usize,
     /// Corners flown blended.
     pub blended: usize,
+    /// Pairs of a translation and a shape change flown at once.
+    #[serde(default)]
+    pub merged: usize,
 }
 
 /// A trajectory as stored in the file.
@@ -132,6 +135,7 @@ impl TrajectoryFile {
                 head_path_m: trajectory.head_path_m(),
                 corners: trajectory.corners(),
                 blended: trajectory.blended(),
+                merged: trajectory.merged(),
             },
             samples,
         }

@@ -12,11 +12,13 @@
 //!
 //! - `build`: [`build`] and [`Trajectory`], the generator;
 //! - `check`: [`check_samples`], the exact check of sampled motion and its limits;
+//! - `merge`: a translation and a shape change flown at once, where admissible;
 //! - `file`: [`TrajectoryFile`], the `arc-trajectory/1` JSON file and its CSV form.
 
 mod build;
 mod check;
 mod file;
+mod merge;
 #[cfg(test)]
 mod tests;
 
@@ -96,6 +98,10 @@ pub struct Settings {
     pub dt: f64,
     /// Blend consecutive edges where admissible (false: stop at every waypoint).
     pub blend: bool,
+    /// Clearance (m) every body keeps from the map wherever the motion is not the
+    /// plan's own (a blend, a merge), so that a controller's tracking error cannot turn
+    /// a shortcut into a contact; the planner's default margin.
+    pub clearance: f64,
 }
 
 impl Default for Settings {
@@ -104,6 +110,7 @@ impl Default for Settings {
             limits: Limits::default(),
             dt: DEFAULT_DT,
             blend: true,
+            clearance: crate::collision::DEFAULT_CLEARANCE,
         }
     }
 }
@@ -146,6 +153,12 @@ impl Settings {
         self.limits.validate()?;
         if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= 0.1) {
             return Err(TrajectoryError::Dt(self.dt));
+        }
+        if !(self.clearance.is_finite() && self.clearance >= 0.0) {
+            return Err(TrajectoryError::Limit {
+                name: "clearance",
+                value: self.clearance,
+            });
         }
         Ok(())
     }

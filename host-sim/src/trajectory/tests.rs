@@ -114,7 +114,12 @@ fn blended_tour_keeps_every_limit_and_is_faster() {
     let s = Settings::default();
     let tr = build(&plan, &grid, &s).unwrap();
     assert_eq!(tr.corners(), 3);
-    assert_eq!(tr.blended(), 3, "a free room admits every blend");
+    assert_eq!(
+        tr.merged(),
+        1,
+        "the first translation and the rotation fly at once"
+    );
+    assert_eq!(tr.blended(), 2, "a free room admits every blend");
     assert!(
         tr.duration() < 0.8 * tr.stop_go_duration(),
         "{} vs {}",
@@ -148,7 +153,7 @@ fn blended_tour_keeps_every_limit_and_is_faster() {
     );
     // Without blends: the stop-and-go timing, every corner at rest.
     let plain = build(&plan, &grid, &Settings { blend: false, ..s }).unwrap();
-    assert_eq!(plain.blended(), 0);
+    assert_eq!((plain.blended(), plain.merged()), (0, 0));
     assert!((plain.duration() - plain.stop_go_duration()).abs() <= 4.0 * s.dt);
     assert_respects_limits(&grid, &params, &s.limits, plain.times(), plain.zetas());
 }

@@ -70,6 +70,7 @@ impl TimingArgs {
             limits,
             dt: self.dt,
             blend: !self.no_blend,
+            ..Settings::default()
         })
     }
 }
@@ -109,12 +110,13 @@ pub fn write(tr: &Trajectory, plan: &Plan, out: &Path, report: &Report) -> CliRe
         .write(out)
         .map_err(|e| CliError::input(e.to_string()))?;
     report.line(format_args!(
-        "  trajectory {}: {:.2} s ({:.2} s stopping at every waypoint), {} of {} corners blended, head path {:.2} m, {} samples",
+        "  trajectory {}: {:.2} s ({:.2} s stopping at every waypoint), {} of {} corners blended, {} translations and shape changes merged, head path {:.2} m, {} samples",
         crate::fsutil::output_name(out),
         tr.duration(),
         tr.stop_go_duration(),
         tr.blended(),
         tr.corners(),
+        tr.merged(),
         tr.head_path_m(),
         tr.times().len()
     ));
