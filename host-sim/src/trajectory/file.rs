@@ -5,7 +5,6 @@
 //! a checker reads exactly the samples that were checked when they were made.
 
 use std::fmt::Write as _;
-use std::io::Read;
 use std::path::Path;
 
 use aerial_chain_core::ChainParams;
@@ -84,20 +83,13 @@ pub enum FileError {
         /// The cause.
         source: std::io::Error,
     },
-    /// Not JSON of the trajectory's shape.
-    #[error("{path}: not an arc-trajectory/1 JSON file: {source}")]
-    Json {
-        /// The file.
-        path: String,
-        /// The cause.
-        source: serde_json::Error,
-    },
-    /// A rule of the format broken; the text names the field and value.
+    /// Not JSON of the trajectory's shape, or a rule of the format broken; the text
+    /// says which, and names the field and value.
     #[error("{path}: {what}")]
     Invalid {
         /// The file.
         path: String,
-        /// The field and value at fault.
+        /// What is wrong.
         what: String,
     },
 }
@@ -154,30 +146,25 @@ impl TrajectoryFile {
     /// Reads and checks a trajectory file (`-`: standard input).
     pub fn read(path: &Path) -> Result<Self, FileError> {
         let name = fsutil::input_name(path);
-        let mut text = String::new();
-        let read = if fsutil::is_stdio(path) {
-            std::io::stdin().read_to_string(&mut text)
-        } else {
-            std::fs::File::open(path).and_then(|mut f| f.read_to_string(&mut text))
-        };
-        read.map_err(|source| FileError::Io {
-            path: name.clone(),
-            source,
-        })?;
-        Self::parse(&text, &name)
+        match fsutil::read_input(path) {
+            Ok(text) => Self::parse(&text, &name),
+            Err(source) => Err(FileError::Io { path: name, source }),
+        }
     }
 
     /// Parses and checks a trajectory's text; `name` names it in errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, FileError> {
-        let file: Self = serde_json::from_str(text).map_err(|source| FileError::Json {
-            path: name.to_string(),
-            source,
-        })?;
-        file.check().map_err(|what| FileError::Invalid {
-            path: name.to_string(),
-            what,
-        })?;
-        Ok(file)
+        let path = name.to_string();
+        match serde_json::from_str::<Self>(text) {
+            Err(e) => Err(FileError::Invalid {
+                path,
+                what: format!("not an {FORMAT} JSON file: {e}"),
+            }),
+            Ok(file) => match file.check() {
+                Ok(_) => Ok(file),
+                Err(what) => Err(FileError::Invalid { path, what }),
+            },
+        }
     }
 
     /// Checks the format's rules that need no map: the tag, the chain, at least one

@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use super::checks;
 use super::common::{looser_assumption, read_plan, MapArgs, Report};
-use super::trajectory::TimingArgs;
+use super::trajectory::{read_trajectory, TimingArgs};
 use super::{CliError, CliResult};
 use aerial_chain::map::Grid;
 use aerial_chain::plan::Plan;
@@ -21,8 +21,7 @@ use aerial_chain::sim::{footprint, MapClearance};
 use aerial_chain::sim::{
     simulate_reference, simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig,
 };
-use aerial_chain::trajectory::{self, Trajectory, TrajectoryError, TrajectoryFile};
-use aerial_chain_core::ChainParams;
+use aerial_chain::trajectory::{self, Trajectory, TrajectoryError};
 
 /// `arc sim`
 #[derive(Args, Debug)]
@@ -238,16 +237,6 @@ pub fn run(a: SimArgs) -> CliResult {
 enum Motion {
     Timed(Reference),
     Waypoints(Vec<Vec<f64>>),
-}
-
-/// Reads a trajectory file and checks its format: the file, its name, its chain.
-fn read_trajectory(path: &Path) -> Result<(TrajectoryFile, String, ChainParams), CliError> {
-    let file = TrajectoryFile::read(path).map_err(|e| CliError::input(e.to_string()))?;
-    let name = crate::fsutil::input_name(path);
-    let params = file
-        .check()
-        .map_err(|e| CliError::input(format!("{name}: {e}")))?;
-    Ok((file, name, params))
 }
 
 /// The trajectory to fly: made from the plan and checked exactly on the map, unless

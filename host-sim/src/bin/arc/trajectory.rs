@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use aerial_chain_core::ChainParams;
 use clap::Args;
 
 use super::checks;
@@ -121,6 +122,19 @@ pub fn write(tr: &Trajectory, plan: &Plan, out: &Path, report: &Report) -> CliRe
         tr.times().len()
     ));
     Ok(())
+}
+
+/// Reads a trajectory file (`-`: standard input) and checks its format: the file, its
+/// name for messages, its chain.
+pub fn read_trajectory(path: &Path) -> Result<(TrajectoryFile, String, ChainParams), CliError> {
+    let name = crate::fsutil::input_name(path);
+    let text =
+        crate::fsutil::read_input(path).map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    let file = TrajectoryFile::parse(&text, &name).map_err(|e| CliError::input(e.to_string()))?;
+    let params = file
+        .check()
+        .map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    Ok((file, name, params))
 }
 
 /// Runs `arc trajectory`.

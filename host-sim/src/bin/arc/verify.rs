@@ -6,11 +6,11 @@ use clap::Args;
 
 use super::checks;
 use super::common::{looser_assumption, parse_point, MapArgs};
-use super::trajectory::LimitArgs;
+use super::trajectory::{read_trajectory, LimitArgs};
 use super::{CliError, CliResult};
 use aerial_chain::collision::{verify_plan, VerifyOptions};
 use aerial_chain::plan::Plan;
-use aerial_chain::trajectory::{check_samples, TrajectoryFile};
+use aerial_chain::trajectory::check_samples;
 
 /// `arc verify`
 #[derive(Args, Debug)]
@@ -154,11 +154,7 @@ fn ends_where_asked(
 /// between samples exactly (docs/model.md, "Trajectories").
 fn run_trajectory(a: &VerifyArgs, path: &Path) -> CliResult {
     let limits = a.limits.limits()?;
-    let file = TrajectoryFile::read(path).map_err(|e| CliError::input(e.to_string()))?;
-    let name = crate::fsutil::input_name(path);
-    let params = file
-        .check()
-        .map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    let (file, name, params) = read_trajectory(path)?;
     let looser = (!file.map.unknown_is_occupied && !a.map.unknown_free).then(|| {
         "the trajectory was made with unknown space free; check it with --unknown-free".to_string()
     });

@@ -16,6 +16,7 @@
 //! include some contention; both planners of a study run in the same batch, so their
 //! ratio is fair.
 
+pub mod flight;
 pub mod paper;
 pub mod plot;
 mod report;
