@@ -44,17 +44,14 @@ fn trajectory_command_csv_and_refusals() {
     let plan = d.join("plan.json");
     plan_scenario("window", 4, &[], &plan).expect("plan");
     let (json, csv) = (d.join("t.json"), d.join("t.csv"));
+    let make = |out: &std::path::Path, more: &[&str]| {
+        let mut args = vec!["trajectory", "--scenario", "window", "--plan", s(&plan)];
+        args.extend_from_slice(&["--out", s(out)]);
+        args.extend_from_slice(more);
+        expect(&args, d, if more.is_empty() { 0 } else { 2 })
+    };
     for out in [&json, &csv] {
-        arc_ok(&[
-            "trajectory",
-            "--scenario",
-            "window",
-            "--plan",
-            s(&plan),
-            "--out",
-            s(out),
-        ])
-        .expect("arc trajectory");
+        make(out, &[]);
     }
     let text = std::fs::read_to_string(&csv).unwrap();
     let header = text.lines().next().unwrap();
@@ -104,21 +101,7 @@ fn trajectory_command_csv_and_refusals() {
         2,
     );
     assert!(o.stderr.contains("t.csv"), "{}", o.stderr);
-    let o = expect(
-        &[
-            "trajectory",
-            "--scenario",
-            "window",
-            "--plan",
-            s(&plan),
-            "--out",
-            s(&json),
-            "--dt",
-            "0",
-        ],
-        d,
-        2,
-    );
+    let o = make(&json, &["--dt", "0"]);
     assert!(o.stderr.contains("--dt"), "{}", o.stderr);
     expect(&["verify", "--scenario", "window"], d, 2);
     expect(
