@@ -103,6 +103,20 @@ fn trajectory_command_csv_and_refusals() {
     assert!(o.stderr.contains("t.csv"), "{}", o.stderr);
     let o = make(&json, &["--dt", "0"]);
     assert!(o.stderr.contains("--dt"), "{}", o.stderr);
+    let o = expect(
+        &[
+            "plan",
+            "--scenario",
+            "window",
+            "--out",
+            "-",
+            "--trajectory",
+            "-",
+        ],
+        d,
+        2,
+    );
+    assert!(o.stderr.contains("--trajectory -"), "{}", o.stderr);
     expect(&["verify", "--scenario", "window"], d, 2);
     expect(
         &[

@@ -18,11 +18,13 @@
 //! Before that, a translation and the shape change beside it may be merged into one
 //! motion, straight in `zeta`, that moves head and shape at once (`super::merge`).
 //!
-//! What a blend or a merge can break is the chain's validity (the map, self-collision, the bend
-//! limit): the sampled trajectory is checked exactly ([`super::check_samples`]); a
-//! blended corner where the check fails is unblended, else a merged pair there is split,
-//! and the timing redone, until the whole passes. Without blends the chain is on the plan's own edges, resting on a
-//! sample at every waypoint, so only a plan that is itself inadmissible fails.
+//! What a blend or a merge can break is the chain's validity (the map, self-collision,
+//! the bend limit) and the clearance the planner kept: the sampled trajectory is checked
+//! exactly ([`super::check_samples`]), and where the motion is not the plan's own every
+//! body must also keep `Settings::clearance` from the map. A blended corner where the
+//! check fails is unblended, else a merged pair there is split, and the timing redone,
+//! until the whole passes. Without blends the chain is on the plan's own edges, resting
+//! on a sample at every waypoint, so only a plan that is itself inadmissible fails.
 
 use aerial_chain_core::ChainParams;
 

@@ -157,6 +157,12 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
     checks::time_limit(a.time_limit)?;
     checks::srs(a.srs)?;
     a.timing.settings()?;
+    let stdout = |p: &std::path::Path| crate::fsutil::is_stdio(p);
+    if stdout(&a.out) && a.trajectory.as_deref().is_some_and(stdout) {
+        return Err(CliError::input(
+            "--out - and --trajectory - would both write to standard output: name a file for one",
+        ));
+    }
     checks::optional_picture("--picture", a.picture.as_ref())
 }
 

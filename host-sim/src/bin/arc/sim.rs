@@ -273,7 +273,7 @@ fn timed(
             ));
             Ok(None)
         }
-        Err(e) => Err(CliError::input(format!("{plan_name}: {e}"))),
+        Err(e) => Err(super::trajectory::refused(e, plan_name)),
     }
 }
 

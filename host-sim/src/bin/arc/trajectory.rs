@@ -12,7 +12,9 @@ use super::common::{read_plan, MapArgs, Report};
 use super::{CliError, CliResult};
 use aerial_chain::map::Grid;
 use aerial_chain::plan::Plan;
-use aerial_chain::trajectory::{self, Limits, Settings, Trajectory, TrajectoryFile};
+use aerial_chain::trajectory::{
+    self, Limits, Settings, Trajectory, TrajectoryError, TrajectoryFile,
+};
 
 /// The limits a trajectory keeps (docs/model.md, "Trajectories"); `arc sim`'s defaults.
 #[derive(Args, Debug, Clone)]
@@ -99,10 +101,20 @@ pub fn make(
     grid: &Grid,
     settings: &Settings,
 ) -> Result<Trajectory, CliError> {
-    trajectory::build(plan, grid, settings).map_err(|e| match e {
-        trajectory::TrajectoryError::Inadmissible(_) => CliError::failed(format!("{name}: {e}")),
+    trajectory::build(plan, grid, settings).map_err(|e| refused(e, name))
+}
+
+/// Why a trajectory of the plan `name` could not be made, with its exit code: an
+/// inadmissible plan is a "no" (1), everything else bad input (2).
+pub fn refused(e: TrajectoryError, name: &str) -> CliError {
+    match e {
+        TrajectoryError::Inadmissible(_) => CliError::failed(format!("{name}: {e}")),
+        TrajectoryError::TooLong(_) => CliError::input(format!(
+            "{name}: {e}, the memory budget; the length follows from the plan, --speed, \
+             --accel, --angular-rate-deg, --angular-accel-deg and --dt"
+        )),
         _ => CliError::input(format!("{name}: {e}")),
-    })
+    }
 }
 
 /// Writes `tr` (made from `plan`) to `out` and says what it is.
