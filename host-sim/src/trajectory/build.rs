@@ -127,6 +127,8 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
     let mut merged = merge::candidates(&edges, settings.blend);
     // blend[k]: the motion that starts with edge k is blended with the one before.
     let mut blend: Vec<bool> = (0..edges.len()).map(|k| k > 0 && settings.blend).collect();
+    // What the last round checked: its segments, and the first sample it found wrong.
+    let mut last: Option<(Vec<Segment>, usize)> = None;
     loop {
         let (motions, firsts, max_rates) = merge::assemble(&edges, &demands, &merged, &limits);
         let merged_m: Vec<bool> = firsts
@@ -152,9 +154,14 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
             true => margin,
             false => 0.0,
         };
+        // Samples before the first segment that changed passed last round's check.
+        let from = last.as_ref().map_or(0, |(before, bad)| {
+            resume_at(before, reference.segments(), settings.dt).min(bad.saturating_sub(2))
+        });
         let lim = &settings.limits;
-        let rep = check_with_margin(grid, &params, lim, (&times, &zetas), margin, &required);
-        let Some(v) = rep.violation else {
+        let part = (&times[from..], &zetas[from..]);
+        let rep = check_with_margin(grid, &params, lim, part, margin, &required);
+        let Some(mut v) = rep.violation else {
             return Ok(Trajectory {
                 params,
                 settings: *settings,
@@ -168,7 +175,9 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
                 head_path,
             });
         };
+        v.sample += from;
         let segs = reference.segments();
+        last = Some((segs.to_vec(), v.sample));
         if let Some(m) = corner_near(segs, &blend_m, &v, settings.dt) {
             blend[firsts[m]] = false;
         } else if let Some(m) = motion_near(segs, &v, settings.dt).filter(|&m| merged_m[m]) {
@@ -193,6 +202,19 @@ fn windows(segments: &[Segment], blend: &[bool], merged: &[bool], dt: f64) -> Ve
         }
     }
     w
+}
+
+/// The sample from which a trajectory of `now` segments must be checked again when one
+/// of `before` segments passed up to there: two samples before the first segment that
+/// differs (the acceleration at a sample looks one back).
+fn resume_at(before: &[Segment], now: &[Segment], dt: f64) -> usize {
+    let first = before.iter().zip(now).position(|(a, b)| a != b);
+    let t = match first {
+        Some(i) => now[i].t0.min(before[i].t0),
+        None if before.len() == now.len() => return usize::MAX,
+        None => now.get(before.len()).map_or(0.0, |s| s.t0),
+    };
+    ((t / dt).floor().max(0.0) as usize).saturating_sub(2)
 }
 
 /// The largest change of any angle of `eta` in a change of `zeta` by `delta`.
