@@ -69,7 +69,7 @@ impl Trajectory {
     pub fn reference(&self) -> &Reference {
         &self.reference
     }
-    /// Sample times (s), from 0 on the uniform grid except inside blends.
+    /// Sample times (s): the multiples of the sample spacing from 0.
     pub fn times(&self) -> &[f64] {
         &self.times
     }

@@ -4,10 +4,11 @@
 //! Every edge of the plan is timed as `arc sim` times it (a smoothstep speed ramp, a
 //! cruise at the limit, the mirror ramp), and then consecutive edges are blended: the
 //! next edge starts while the one before is still ramping down, so a corner is rounded
-//! and a shape change runs while the head slows down or speeds up. A blend is kept only
-//! where the blended motion is admissible, checked exactly as `arc verify` checks
-//! edges; elsewhere the trajectory keeps the plan's "finish one edge, then start the
-//! next". The result is sampled on a uniform time grid, and the samples are the
+//! and a shape change runs while the head slows down or speeds up; a translation and the
+//! shape change beside it may also be merged into one move. A blend or merge is kept
+//! only where the motion is admissible, checked exactly as `arc verify` checks edges,
+//! and keeps the planner's clearance margin; elsewhere the trajectory keeps the plan's
+//! "finish one edge, then start the next". The result is sampled on a uniform time grid, and the samples are the
 //! trajectory: [`check_samples`] checks them independently of how they were made.
 //!
 //! - `build`: [`build`] and [`Trajectory`], the generator;
