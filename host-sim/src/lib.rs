@@ -16,6 +16,8 @@
 //!   [`planner::to_plan`]; [`baseline`]: [`baseline::FullStatePrm`];
 //! - [`plan_file`]: [`plan_file::Plan`], the `arc-plan/1` file;
 //! - [`sim`]: [`sim::simulate`], [`sim::Flight`];
+//! - [`trajectory`]: [`trajectory::build`], a plan timed and blended into a
+//!   trajectory, its exact check and its file;
 //! - [`picture`]: figures, plan and map pictures (SVG, PNG).
 //!
 //! ```
@@ -58,3 +60,4 @@ pub mod problem;
 mod shape_index;
 pub mod sim;
 pub mod tables;
+pub mod trajectory;

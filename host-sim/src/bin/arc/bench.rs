@@ -29,6 +29,11 @@ pub enum BenchCommand {
     /// Robustness on the hard-case family (`passage:`): random instances with
     /// witnesses, N = 4..8, `arc plan`'s defaults; CSV, markdown and a plot.
     Robust(RobustArgs),
+    /// Flight time of the planner's plans (window, maze, silos, corridor; N = 4..6):
+    /// stopping at every waypoint against the blended trajectory, simulated; CSV,
+    /// markdown and a plot of flight time against head path / speed.
+    #[command(after_help = "Example:\n  arc bench flight --seeds 2 --out-dir out/flight")]
+    Flight(FlightArgs),
     /// One plan by the full-state lazy PRM baseline (arc-plan/1, verified exactly).
     #[command(
         after_help = "Example:\n  arc bench prm --scenario window --units 4 --vertices 15000 --out prm.json"
@@ -117,6 +122,27 @@ pub struct RobustArgs {
     /// Worker threads (default: RAYON_NUM_THREADS, else every core).
     #[arg(long)]
     threads: Option<usize>,
+}
+
+/// `arc bench flight`
+#[derive(Args, Debug)]
+pub struct FlightArgs {
+    /// Scenarios, comma-separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "window,maze,silos,corridor"
+    )]
+    scenarios: Vec<String>,
+    /// Chain sizes, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "4,5,6")]
+    units: Vec<u8>,
+    /// Seeds per scenario and size (1, 2, ...).
+    #[arg(long, default_value_t = 2)]
+    seeds: u64,
+    /// Where CSV, markdown and the plot go.
+    #[arg(long, default_value = "bench-out")]
+    out_dir: PathBuf,
 }
 
 /// `arc bench prm`
@@ -454,6 +480,63 @@ fn run_robust(a: RobustArgs) -> CliResult {
     publish(&a.out_dir, &md, &files)
 }
 
+fn run_flight(a: FlightArgs) -> CliResult {
+    checks::count("--seeds", a.seeds as usize, 1, 1000, "seeds")?;
+    for n in &a.units {
+        checks::count("--units", *n as usize, 2, 16, "units")?;
+    }
+    for s in &a.scenarios {
+        aerial_chain::problem::scenarios::build(s).map_err(|e| CliError::input(e.to_string()))?;
+    }
+    let speed = aerial_chain::trajectory::Limits::default().speed;
+    let t = Instant::now();
+    let mut runs = Vec::new();
+    for sc in &a.scenarios {
+        for &n in &a.units {
+            for seed in 1..=a.seeds {
+                let r = study::flight::run_one(sc, n, seed);
+                eprintln!(
+                    "{sc} N = {n} seed {seed}: path {:.1} m, stop-go {:.1} s, trajectory {:.1} s ({} of {} corners blended, {} merged, made in {:.0} ms){}",
+                    r.head_path_m,
+                    r.before.map_or(f64::NAN, |f| f.time_s),
+                    r.after.map_or(f64::NAN, |f| f.time_s),
+                    r.blended,
+                    r.corners,
+                    r.merged,
+                    r.trajectory_s * 1e3,
+                    if r.error.is_empty() { String::new() } else { format!(": {}", r.error) }
+                );
+                runs.push(r);
+            }
+        }
+    }
+    let md = format!(
+        "{}\nMedians over seeds 1..={}; flight time from the start of the flight (1 s hold included) to arrival; {} build; whole study {:.0} s.\n",
+        study::flight::markdown(&runs, speed),
+        a.seeds,
+        if cfg!(debug_assertions) { "debug" } else { "release" },
+        t.elapsed().as_secs_f64()
+    );
+    let files = [
+        study::write_out(
+            &a.out_dir,
+            "flight_runs.csv",
+            study::flight::csv(&runs, speed).as_bytes(),
+        )?,
+        study::write_out(&a.out_dir, "flight.md", md.as_bytes())?,
+        study::write_out(
+            &a.out_dir,
+            "flight.svg",
+            study::flight::figure(&runs, speed).as_bytes(),
+        )?,
+    ];
+    println!("{md}");
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
 fn run_prm(a: PrmArgs) -> CliResult {
     let time_limit = check_prm(&a)?;
     let (ctx, params, query, source) = a.problem.context(a.clearance)?;
@@ -531,6 +614,7 @@ pub fn run(c: BenchCommand) -> CliResult {
         BenchCommand::Paper(a) => run_paper(a),
         BenchCommand::Scale(a) => run_scale(a),
         BenchCommand::Robust(a) => run_robust(a),
+        BenchCommand::Flight(a) => run_flight(a),
         BenchCommand::Prm(a) => run_prm(*a),
     }
 }

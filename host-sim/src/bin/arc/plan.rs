@@ -9,6 +9,7 @@ use clap::Args;
 
 use super::checks;
 use super::common::{write_plan, ProblemArgs, Report};
+use super::trajectory::TimingArgs;
 use super::{CliError, CliResult};
 use aerial_chain::collision::DEFAULT_CLEARANCE;
 use aerial_chain::planner::{
@@ -93,6 +94,12 @@ pub struct PlanArgs {
     /// Picture of the plan (.svg or .png).
     #[arg(long)]
     picture: Option<PathBuf>,
+    /// Also write the plan's timed trajectory (CSV when the name ends in .csv, else
+    /// JSON, arc-trajectory/1), checked exactly on the map.
+    #[arg(long)]
+    trajectory: Option<PathBuf>,
+    #[command(flatten)]
+    timing: TimingArgs,
 }
 
 /// Smallest follow-the-leader step (m) other than 0 (off).
@@ -149,6 +156,13 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
     checks::length("--clearance-min", a.clearance_min, false)?;
     checks::time_limit(a.time_limit)?;
     checks::srs(a.srs)?;
+    a.timing.settings()?;
+    let stdout = |p: &std::path::Path| crate::fsutil::is_stdio(p);
+    if stdout(&a.out) && a.trajectory.as_deref().is_some_and(stdout) {
+        return Err(CliError::input(
+            "--out - and --trajectory - would both write to standard output: name a file for one",
+        ));
+    }
     checks::optional_picture("--picture", a.picture.as_ref())
 }
 
@@ -280,6 +294,16 @@ pub fn run(a: PlanArgs) -> CliResult {
             s.route_points,
             s.lattice_expanded,
             s.lattice_s * 1e3
+        ));
+    }
+    if let Some(path) = &a.trajectory {
+        let grid = planner.context().field().grid();
+        let began = Instant::now();
+        let tr = super::trajectory::make(&plan, "the plan", grid, &a.timing.settings()?)?;
+        super::trajectory::write(&tr, &plan, path, &report)?;
+        report.line(format_args!(
+            "  trajectory made and checked in {:.1} ms",
+            began.elapsed().as_secs_f64() * 1e3
         ));
     }
     if let Some(pic) = &a.picture {

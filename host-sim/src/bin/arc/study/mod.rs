@@ -17,6 +17,7 @@
 //! ratio is fair.
 
 mod error;
+pub mod flight;
 pub mod paper;
 pub mod plot;
 mod report;
