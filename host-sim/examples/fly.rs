@@ -12,7 +12,7 @@ use aerial_chain::problem::scenarios;
 use aerial_chain::sim::{simulate, FlightReport, MapClearance, SimConfig};
 
 #[path = "plan_on_map.rs"]
-mod plan_on_map;
+pub mod plan_on_map;
 
 use plan_on_map::{plan_on_map, Problem};
 
