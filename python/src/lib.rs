@@ -3,10 +3,10 @@
 //! The Python module `aerial_chain._native` (re-exported by the package `aerial_chain`):
 //! the library `aerial_chain`'s public face, wrapped for Python with PyO3.
 //!
-//! - [`map::Map`]: an OctoMap `.bt` file or a built-in scenario;
-//! - [`plan::plan`] (the ARCplanner with the defaults of `arc plan`), [`plan::Plan`]
-//!   (the `arc-plan/1` file), [`plan::verify`] (the exact verifier of docs/model.md);
-//! - [`sim::simulate`] and [`sim::Flight`], the chain flown by its control stack.
+//! - `map::Map`: an OctoMap `.bt` file or a built-in scenario;
+//! - `plan::plan` (the ARCplanner with the defaults of `arc plan`), `plan::Plan`
+//!   (the `arc-plan/1` file), `plan::verify` (the exact verifier of docs/model.md);
+//! - `sim::simulate` and `sim::Flight`, the chain flown by its control stack.
 //!
 //! Configurations and flights come out as NumPy arrays. Bad input raises one of the
 //! exceptions below, all subclasses of `ArcError`, itself a `ValueError`, with the
