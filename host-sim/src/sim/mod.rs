@@ -42,13 +42,16 @@ pub enum SettingsError {
 }
 
 pub use clearance::{footprint, MapClearance};
+
+// The type of `Sample::units` and `Sample::links`, so that users of a recorded flight
+// (the Python bindings) can name it.
+pub use flight::BodySample;
+
 pub use controller::{ChainController, ControllerConfig};
 pub use dynamics::{BodyState, ChainDynamics, Formulation, UnitCommand, V3};
-// `BodySample` is the type of `Sample::units` and `Sample::links`: re-exported so that
-// users of a recorded flight (the Python bindings) can name it.
 pub use flight::{
-    simulate, simulate_with_progress, BodySample, Flight, FlightReport, Gust, Obstacles, Progress,
-    Sample, SimConfig, SimError,
+    simulate, simulate_with_progress, Flight, FlightReport, Gust, Obstacles, Progress, Sample,
+    SimConfig, SimError,
 };
 pub use model::ChainModel;
 pub use mpc::{HeadMpc, MpcConfig, MpcRef};
