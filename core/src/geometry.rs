@@ -69,55 +69,41 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    fn v(x: f32, y: f32, z: f32) -> Vector3<f32> {
-        Vector3::new(x, y, z)
-    }
-
     #[test]
     fn known_cases() {
-        assert!(
-            (point_segment_distance(&v(0.0, 1.0, 0.0), &v(-1.0, 0.0, 0.0), &v(1.0, 0.0, 0.0))
-                - 1.0)
-                .abs()
-                < 1e-6
-        );
-        assert!(
-            (point_segment_distance(&v(3.0, 0.0, 0.0), &v(-1.0, 0.0, 0.0), &v(1.0, 0.0, 0.0))
-                - 2.0)
-                .abs()
-                < 1e-6
-        );
-        // Crossing segments one unit apart in z.
-        let d = segment_segment_distance(
-            &v(-1.0, 0.0, 0.0),
-            &v(1.0, 0.0, 0.0),
-            &v(0.0, -1.0, 1.0),
-            &v(0.0, 1.0, 1.0),
-        );
-        assert!((d - 1.0).abs() < 1e-6);
-        // Parallel, overlapping.
-        let d = segment_segment_distance(
-            &v(0.0, 0.0, 0.0),
-            &v(2.0, 0.0, 0.0),
-            &v(1.0, 0.5, 0.0),
-            &v(3.0, 0.5, 0.0),
-        );
-        assert!((d - 0.5).abs() < 1e-6);
-        // Degenerate: both points.
-        let d = segment_segment_distance(
-            &v(0.0, 0.0, 0.0),
-            &v(0.0, 0.0, 0.0),
-            &v(0.0, 3.0, 4.0),
-            &v(0.0, 3.0, 4.0),
-        );
-        assert!((d - 5.0).abs() < 1e-6);
+        // A point and its distance to the segment from (-1, 0, 0) to (1, 0, 0).
+        let (a, b) = (Vector3::new(-1.0, 0.0, 0.0), Vector3::new(1.0, 0.0, 0.0));
+        for (p, want) in [([0.0, 1.0, 0.0], 1.0), ([3.0, 0.0, 0.0], 2.0)] {
+            let d = point_segment_distance(&p.into(), &a, &b);
+            assert!((d - want).abs() < 1e-6, "{p:?}: {d}");
+        }
+        // Two segments and their distance: crossing one unit apart in z; parallel and
+        // overlapping; degenerate (both points).
+        let cases: [([[f32; 3]; 4], f32); 3] = [
+            (
+                [[-1., 0., 0.], [1., 0., 0.], [0., -1., 1.], [0., 1., 1.]],
+                1.0,
+            ),
+            (
+                [[0., 0., 0.], [2., 0., 0.], [1., 0.5, 0.], [3., 0.5, 0.]],
+                0.5,
+            ),
+            ([[0.; 3], [0.; 3], [0., 3., 4.], [0., 3., 4.]], 5.0),
+        ];
+        for ([p1, q1, p2, q2], want) in cases {
+            let d = segment_segment_distance(&p1.into(), &q1.into(), &p2.into(), &q2.into());
+            assert!(
+                (d - want).abs() < 1e-6,
+                "{p1:?}-{q1:?} to {p2:?}-{q2:?}: {d}"
+            );
+        }
     }
 
     proptest! {
         /// The closed form never exceeds a dense brute-force sampling, and is close to it.
         #[test]
         fn segment_distance_matches_brute_force(c in proptest::array::uniform12(-2.0f32..2.0)) {
-            let (p1, q1, p2, q2) = (v(c[0], c[1], c[2]), v(c[3], c[4], c[5]), v(c[6], c[7], c[8]), v(c[9], c[10], c[11]));
+            let (p1, q1, p2, q2) = (Vector3::new(c[0], c[1], c[2]), Vector3::new(c[3], c[4], c[5]), Vector3::new(c[6], c[7], c[8]), Vector3::new(c[9], c[10], c[11]));
             let d = segment_segment_distance(&p1, &q1, &p2, &q2);
             let mut best = f32::MAX;
             for i in 0..=200 {

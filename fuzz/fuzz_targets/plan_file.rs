@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 
 use aerial_chain::collision::verify_plan;
 use aerial_chain::map::{Cell, Grid};
-use aerial_chain::plan::Plan;
+use aerial_chain::plan_file::Plan;
 use libfuzzer_sys::fuzz_target;
 
 /// A free 2 x 2 x 1 m room at 0.1 m with one occupied box, built once.

@@ -15,10 +15,11 @@ use std::sync::Arc;
 
 use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use aerial_chain::map::{DistanceField, Grid, OcTree};
-use aerial_chain::plan::{MapSource, Plan};
+use aerial_chain::plan_file::{MapSource, Plan};
 use aerial_chain::planner::{to_plan, ArcPlanner, Planner, Query, Settings, Termination};
 use aerial_chain::tables::{ShapeTables, TableSettings};
 use aerial_chain_core::{ChainParams, Shape};
+use nalgebra::Point3;
 
 /// A planning problem on a map file.
 pub struct Problem<'a> {
@@ -29,11 +30,11 @@ pub struct Problem<'a> {
     /// Units N of the chain.
     pub units: u8,
     /// Head start (m); the chain starts straight, trailing behind the head along `-yaw`.
-    pub start: [f64; 3],
+    pub start: Point3<f64>,
     /// Start yaw (rad).
     pub yaw: f32,
     /// Head goal (m).
-    pub goal: [f64; 3],
+    pub goal: Point3<f64>,
 }
 
 /// Reads the map, plans with the defaults of `arc plan` and verifies the plan exactly:
@@ -93,9 +94,9 @@ pub fn corridor(map: &Path) -> Problem<'_> {
         map,
         unknown_free: true,
         units: 5,
-        start: [-3.0, 0.0, 1.0],
+        start: Point3::new(-3.0, 0.0, 1.0),
         yaw: 0.0,
-        goal: [25.0, 0.0, 1.0],
+        goal: Point3::new(25.0, 0.0, 1.0),
     }
 }
 

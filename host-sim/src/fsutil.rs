@@ -48,6 +48,18 @@ pub fn output_name(path: &Path) -> String {
     }
 }
 
+/// The whole text of `path`, or of standard input when `path` is `-`.
+pub fn read_input(path: &Path) -> std::io::Result<String> {
+    use std::io::Read;
+    let mut text = String::new();
+    if is_stdio(path) {
+        std::io::stdin().read_to_string(&mut text)?;
+    } else {
+        std::fs::File::open(path)?.read_to_string(&mut text)?;
+    }
+    Ok(text)
+}
+
 /// Writes `bytes` to standard output when `path` is `-`, else atomically to the file.
 pub fn write_output(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     if is_stdio(path) {

@@ -14,8 +14,10 @@
 //! - [`tables`]: [`tables::ShapeTables`], the LSC, SRS and G_SRS of a chain;
 //! - [`planner`]: [`planner::Planner`], [`planner::Query`], [`planner::ArcPlanner`],
 //!   [`planner::to_plan`]; [`baseline`]: [`baseline::FullStatePrm`];
-//! - [`plan`]: [`plan::Plan`], the `arc-plan/1` file;
+//! - [`plan_file`]: [`plan_file::Plan`], the `arc-plan/1` file;
 //! - [`sim`]: [`sim::simulate`], [`sim::Flight`];
+//! - [`trajectory`]: [`trajectory::build`], a plan timed and blended into a
+//!   trajectory, its exact check and its file;
 //! - [`picture`]: figures, plan and map pictures (SVG, PNG).
 //!
 //! ```
@@ -51,10 +53,11 @@ pub mod collision;
 mod fsutil;
 pub mod map;
 pub mod picture;
-pub mod plan;
+pub mod plan_file;
 pub mod plan_picture;
 pub mod planner;
 pub mod problem;
 mod shape_index;
 pub mod sim;
 pub mod tables;
+pub mod trajectory;

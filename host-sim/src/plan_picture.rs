@@ -5,7 +5,7 @@
 use crate::collision::exact::positions_f64;
 use crate::map::grid::Grid;
 use crate::picture::{palette, Colour, Figure, Panel};
-use crate::plan::Plan;
+use crate::plan_file::Plan;
 
 /// Obstacles of `grid` projected along axis `drop` over the band `lo..hi` of that
 /// axis, as merged rectangles in the two remaining axes `(u, v)`, each with the

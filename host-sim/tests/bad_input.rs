@@ -45,9 +45,10 @@ const CHAIN: [Flag; 5] = [
     flag("--beta-max-deg", F32_MAX, "xxxxxx"),
 ];
 
-/// A subcommand: its small base command and its numeric flags.
+/// A subcommand: its small base command (arguments apart by spaces) and its numeric
+/// flags.
 struct Case {
-    base: &'static [&'static str],
+    base: &'static str,
     flags: Vec<Flag>,
 }
 
@@ -110,47 +111,15 @@ fn cases() -> Vec<Case> {
     scale.push(flag("--corridor-density", F64_MAX, "-xxxxx"));
     vec![
         Case {
-            base: &[
-                "plan",
-                "--scenario",
-                "window",
-                "--units",
-                "3",
-                "--vertices",
-                "600",
-                "--srs",
-                "50",
-                "--max-growth",
-                "0",
-                "--time-limit",
-                "20",
-                "--out",
-                "p.json",
-            ],
+            base: "plan --scenario window --units 3 --vertices 600 --srs 50 --max-growth 0 --time-limit 20 --out p.json",
             flags: plan,
         },
         Case {
-            base: &[
-                "verify",
-                "--scenario",
-                "window",
-                "--plan",
-                "hover.json",
-                "--goal",
-                "2,4.5,1.5",
-            ],
+            base: "verify --scenario window --plan hover.json --goal 2,4.5,1.5",
             flags: vec![flag("--goal-tol", F64_MAX, "oxxxxx")],
         },
         Case {
-            base: &[
-                "sim",
-                "--scenario",
-                "window",
-                "--plan",
-                "hover.json",
-                "--settle-time",
-                "2",
-            ],
+            base: "sim --scenario window --plan hover.json --settle-time 2",
             flags: vec![
                 flag("--rate", F64_MAX, "xxxxxx"),
                 flag("--speed", F64_MAX, "xxxxoo"),
@@ -162,15 +131,7 @@ fn cases() -> Vec<Case> {
             ],
         },
         Case {
-            base: &[
-                "view",
-                "--scenario",
-                "window",
-                "--plan",
-                "hover.json",
-                "--out",
-                "v.html",
-            ],
+            base: "view --scenario window --plan hover.json --out v.html",
             flags: vec![
                 flag("--goal-tol", F64_MAX, "oxxxxx"),
                 flag("--near", F64_MAX, "xxxxxx"),
@@ -178,38 +139,19 @@ fn cases() -> Vec<Case> {
             ],
         },
         Case {
-            base: &[
-                "bench",
-                "prm",
-                "--scenario",
-                "window",
-                "--units",
-                "3",
-                "--vertices",
-                "200",
-                "--start",
-                "2,4.5,1.5",
-                "--goal",
-                "2.6,4.5,1.5",
-                "--time-limit",
-                "20",
-                "--out",
-                "q.json",
-            ],
+            base: "bench prm --scenario window --units 3 --vertices 200 --start 2,4.5,1.5 --goal 2.6,4.5,1.5 --time-limit 20 --out q.json",
             flags: prm,
         },
         Case {
-            base: &[
-                "tables", "build", "--units", "3", "--srs", "20", "--out", "t.arct",
-            ],
+            base: "tables build --units 3 --srs 20 --out t.arct",
             flags: build,
         },
         Case {
-            base: &["shapes", "--units", "3", "--out", "s.svg"],
+            base: "shapes --units 3 --out s.svg",
             flags: shapes,
         },
         Case {
-            base: &["map", "picture", "--scenario", "window", "--out", "m.svg"],
+            base: "map picture --scenario window --out m.svg",
             flags: vec![
                 flag("--band-min", F64_MAX, "ooxxxx"),
                 flag("--band-max", F64_MAX, "xxxxoo"),
@@ -217,19 +159,19 @@ fn cases() -> Vec<Case> {
             ],
         },
         Case {
-            base: &["bench", "paper", "--quick"],
+            base: "bench paper --quick",
             flags: paper,
         },
         Case {
-            base: &["bench", "scale", "--quick"],
+            base: "bench scale --quick",
             flags: scale,
         },
     ]
 }
 
 /// The base command with `flag` set to `value` (replacing the base's own value).
-fn with(base: &[&'static str], flag: &'static str, value: &'static str) -> Vec<&'static str> {
-    let mut args: Vec<&str> = base.to_vec();
+fn with(base: &'static str, flag: &'static str, value: &'static str) -> Vec<&'static str> {
+    let mut args: Vec<&str> = base.split_whitespace().collect();
     match args.iter().position(|a| *a == flag) {
         Some(i) => args[i + 1] = value,
         None => args.extend([flag, value]),

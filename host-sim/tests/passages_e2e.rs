@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use aerial_chain::plan::Plan;
+use aerial_chain::plan_file::Plan;
 use aerial_chain::problem::passages::{witness, PassageSpec};
 use aerial_chain::problem::scenarios;
 mod support;
@@ -18,12 +18,15 @@ fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
 }
 
 #[test]
-fn half_metre_windows_at_45_degrees_plan_for_5_and_6_units() {
+fn half_metre_windows_at_45_degrees_and_tunnels_plan_for_5_and_6_units() {
     let dir = tempfile::tempdir().unwrap();
     for (name, n) in [
         ("passage:w=0.5,angle=45", 5u8),
         ("passage:w=0.5,angle=45,offset=0.2,wall=0.3", 6),
         ("passage:w=0.5,angle=-45,door=0.6,door_offset=0.2", 6),
+        // Tunnels: a 1.2-1.5 m thick wall.
+        ("passage:w=0.5,angle=30,wall=1.2", 5),
+        ("passage:w=0.55,angle=-45,offset=0.2,wall=1.5", 6),
     ] {
         // Solvable by a witness that does not use the planner.
         let sc = scenarios::build(name).unwrap();

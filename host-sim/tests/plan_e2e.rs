@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use aerial_chain::collision::verify_plan;
-use aerial_chain::plan::Plan;
+use aerial_chain::plan_file::Plan;
 use aerial_chain::problem::scenarios;
 mod support;
 

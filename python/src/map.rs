@@ -8,7 +8,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 
 use aerial_chain::map::{Grid, OcTree};
-use aerial_chain::plan::MapSource;
+use aerial_chain::plan_file::MapSource;
 use aerial_chain::problem::scenarios::{self, Scenario};
 
 use crate::{err, MapError};
@@ -104,7 +104,7 @@ impl Map {
     fn start<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
         self.scenario
             .as_ref()
-            .map(|s| s.start.to_vec().into_pyarray(py))
+            .map(|s| s.start.coords.as_slice().to_vec().into_pyarray(py))
     }
 
     /// The scenario's head goal (array of 3, m); `None` for a map file.
@@ -112,7 +112,7 @@ impl Map {
     fn goal<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
         self.scenario
             .as_ref()
-            .map(|s| s.goal.to_vec().into_pyarray(py))
+            .map(|s| s.goal.coords.as_slice().to_vec().into_pyarray(py))
     }
 
     /// The scenario's start yaw (rad); `None` for a map file.

@@ -30,14 +30,14 @@ use crate::{err, json_to_py, PlanError, VerifyError};
 #[pyclass(module = "aerial_chain", frozen)]
 pub struct Plan {
     /// The plan as the library holds it (checked).
-    pub(crate) plan: aerial_chain::plan::Plan,
+    pub(crate) plan: aerial_chain::plan_file::Plan,
     /// Its chain.
     pub(crate) params: ChainParams,
 }
 
 impl Plan {
     /// Wraps a plan after checking the format rules that need no map.
-    fn checked(plan: aerial_chain::plan::Plan) -> PyResult<Self> {
+    fn checked(plan: aerial_chain::plan_file::Plan) -> PyResult<Self> {
         let params = plan.check().map_err(err::<PlanError>)?;
         Ok(Plan { plan, params })
     }
@@ -48,14 +48,14 @@ impl Plan {
     /// Reads and checks a plan file. Raises `PlanError` naming the file and the field.
     #[staticmethod]
     fn read(path: PathBuf) -> PyResult<Self> {
-        Self::checked(aerial_chain::plan::Plan::read(&path).map_err(err::<PlanError>)?)
+        Self::checked(aerial_chain::plan_file::Plan::read(&path).map_err(err::<PlanError>)?)
     }
 
     /// Parses and checks a plan's JSON text.
     #[staticmethod]
     #[pyo3(signature = (text, name = "<plan>"))]
     fn from_json(text: &str, name: &str) -> PyResult<Self> {
-        Self::checked(aerial_chain::plan::Plan::parse(text, name).map_err(err::<PlanError>)?)
+        Self::checked(aerial_chain::plan_file::Plan::parse(text, name).map_err(err::<PlanError>)?)
     }
 
     /// Writes the plan file (pretty JSON, atomically).
@@ -186,7 +186,7 @@ impl VerifyReport {
 /// assumption about unknown space, a start or an end elsewhere than asked.
 fn query_violation(
     map: &Map,
-    plan: &aerial_chain::plan::Plan,
+    plan: &aerial_chain::plan_file::Plan,
     start: Option<[f64; 3]>,
     goal: Option<[f64; 3]>,
     goal_tol: f64,
@@ -202,12 +202,12 @@ fn query_violation(
     let first = plan.waypoints[0].xi();
     let last = plan.waypoints[plan.waypoints.len() - 1].xi();
     let sc = map.scenario.as_ref();
-    if let Some(s) = start.or(sc.map(|s| s.start)) {
+    if let Some(s) = start.or(sc.map(|s| s.start.coords.into())) {
         if dist(first, s) > 1e-6 {
             return Some(format!("waypoint 0 head {first:?} is not the start {s:?}"));
         }
     }
-    if let Some(g) = goal.or(sc.map(|s| s.goal)) {
+    if let Some(g) = goal.or(sc.map(|s| s.goal.coords.into())) {
         let d = dist(last, g);
         if d.is_nan() || d > goal_tol {
             return Some(format!(
@@ -299,8 +299,12 @@ fn query(map: &Map, params: &ChainParams, asked: Asked) -> PyResult<Query> {
     } = asked;
     let sc = map.scenario.as_ref();
     let need = |what: &str| err::<PlanError>(format!("{what} is required with a map file"));
-    let start = start.or(sc.map(|s| s.start)).ok_or_else(|| need("start"))?;
-    let goal = goal.or(sc.map(|s| s.goal)).ok_or_else(|| need("goal"))?;
+    let start = start
+        .or(sc.map(|s| s.start.coords.into()))
+        .ok_or_else(|| need("start"))?;
+    let goal = goal
+        .or(sc.map(|s| s.goal.coords.into()))
+        .ok_or_else(|| need("goal"))?;
     let yaw = start_yaw.or(sc.map(|s| s.start_yaw)).unwrap_or(0.0) as f32;
     if !yaw.is_finite() {
         return Err(err::<PlanError>(format!(
@@ -324,9 +328,9 @@ fn query(map: &Map, params: &ChainParams, asked: Asked) -> PyResult<Query> {
         None => Shape::line(params.units, yaw),
     };
     Ok(Query {
-        start,
+        start: start.into(),
         start_shape: shape,
-        goal,
+        goal: goal.into(),
         goal_tol,
     })
 }
@@ -387,7 +391,7 @@ pub fn plan(
         seed,
         ..Settings::default()
     };
-    let plan = py.detach(|| -> Result<aerial_chain::plan::Plan, String> {
+    let plan = py.detach(|| -> Result<aerial_chain::plan_file::Plan, String> {
         let tables = TableSettings {
             srs,
             seed: srs_seed,

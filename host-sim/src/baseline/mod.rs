@@ -54,7 +54,7 @@ use std::time::{Duration, Instant};
 use serde_json::json;
 
 use crate::collision::CollisionContext;
-use crate::plan::{Plan, Timing};
+use crate::plan_file::{Plan, Timings};
 use crate::planner::{Planner, Query, Solution, SolutionStats, Step, Termination};
 pub use error::PrmError;
 use roadmap::{valid_tolerance, Roadmap};
@@ -67,12 +67,8 @@ pub type PrmSolution = Solution<PrmStats>;
 /// Counters and timings of a roadmap and one query.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PrmStats {
-    /// Roadmap build time: sampling and neighbours (s).
-    pub roadmap_s: f64,
-    /// Query time (s).
-    pub planning_s: f64,
-    /// Of the query time, spent in edge checks (s).
-    pub collision_s: f64,
+    /// Roadmap build (sampling and neighbours), query and edge-check times.
+    pub timings: Timings,
     /// Vertices in the roadmap (goal samples included).
     pub vertices: usize,
     /// Of them, goal samples.
@@ -127,7 +123,7 @@ impl FullStatePrm {
     /// Refuses a query of another chain, from an invalid start, or to a goal that
     /// cannot hold the head.
     fn check_query(&self, query: &Query) -> Result<(), PrmError> {
-        let (start, start_shape, goal) = (query.start, &query.start_shape, query.goal);
+        let ((start, goal), start_shape) = (query.ends(), &query.start_shape);
         if start_shape.units() != self.ctx.params().n() {
             return Err(PrmError::StartInvalid(format!(
                 "the start shape has {} units, the chain {}",
@@ -170,7 +166,7 @@ impl Planner for FullStatePrm {
             return;
         }
         let began = Instant::now();
-        let goal = (query.goal, query.goal_tol);
+        let goal = (query.ends().1, query.goal_tol);
         let roadmap = Roadmap::build(&self.ctx, &self.settings, goal, stop.time_limit);
         self.roadmap = Some(roadmap);
         self.roadmap_s = began.elapsed().as_secs_f64();
@@ -200,8 +196,8 @@ impl Planner for FullStatePrm {
         self.roadmap = Some(roadmap);
         let (steps, q) = result?;
         let after = self.ctx.stats();
-        stats.planning_s = began.elapsed().as_secs_f64();
-        stats.collision_s = q.collision_s;
+        stats.timings.planning_s = began.elapsed().as_secs_f64();
+        stats.timings.collision_s = q.timings.collision_s;
         stats.iterations = q.iterations;
         stats.edges_checked = q.edges_checked;
         stats.edges_blocked = q.edges_blocked;
@@ -241,13 +237,12 @@ impl SolutionStats for PrmStats {
         ]
     }
 
-    fn timing(&self) -> Timing {
-        Timing {
-            roadmap_s: self.roadmap_s,
-            planning_s: self.planning_s,
-            collision_s: self.collision_s,
-            rest: "search_s",
-        }
+    fn timings(&self) -> Timings {
+        self.timings
+    }
+
+    fn rest_name(&self) -> &'static str {
+        "search_s"
     }
 
     /// Which planner made the plan, and whether its roadmap was cut short.

@@ -10,6 +10,7 @@ use rand_pcg::Pcg64;
 use super::metric::{embed, embedding_dim, Neighbours};
 use super::{prm_star_k, PrmSettings, PrmStats};
 use crate::collision::CollisionContext;
+use crate::plan_file::Timings;
 use crate::planner::graph::{Edge, EdgeState, LazyGraph};
 
 /// The roadmap: vertices, their embeddings and neighbour lists.
@@ -106,7 +107,10 @@ impl Roadmap {
     pub(super) fn stats(&self, roadmap_s: f64) -> PrmStats {
         let g = &self.graph;
         PrmStats {
-            roadmap_s,
+            timings: Timings {
+                roadmap_s,
+                ..Default::default()
+            },
             vertices: self.xi.len(),
             goal_samples: self.goal_samples,
             sample_tries: self.tries,

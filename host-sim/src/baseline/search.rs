@@ -33,8 +33,8 @@ pub(super) fn dist3(a: [f64; 3], b: [f64; 3]) -> f64 {
 impl LazySearch<'_> {
     /// Plans `query` over the roadmap: the waypoints and the query's counters.
     pub(super) fn run(mut self, query: &Query) -> Result<(Vec<Step>, PrmStats), PrmError> {
-        let (start, start_shape, goal, tol) =
-            (query.start, query.start_shape, query.goal, query.goal_tol);
+        let (start, goal) = query.ends();
+        let (start_shape, tol) = (query.start_shape, query.goal_tol);
         let first = Step {
             xi: start,
             shape: start_shape,
@@ -57,7 +57,7 @@ impl LazySearch<'_> {
         r.graph.truncate(n, false);
         let (steps, path_edges) = result?;
         self.stats.path_edges = path_edges;
-        self.stats.collision_s = self.collision.as_secs_f64();
+        self.stats.timings.collision_s = self.collision.as_secs_f64();
         Ok((steps, self.stats))
     }
 

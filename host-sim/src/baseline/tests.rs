@@ -5,6 +5,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use aerial_chain_core::{ChainParams, Shape};
+use nalgebra::Point3;
 
 use super::search::dist3;
 use super::*;
@@ -36,9 +37,9 @@ fn easy(
         ..Default::default()
     };
     let mut prm = FullStatePrm::new(ctx.clone(), settings).unwrap();
-    let start = [2.0, 4.0, 1.5];
+    let start = Point3::new(2.0, 4.0, 1.5);
     let shape = Shape::line(units, std::f32::consts::FRAC_PI_2);
-    let goal = [2.5, 2.0, 1.5];
+    let goal = Point3::new(2.5, 2.0, 1.5);
     let stop = Termination {
         time_limit: Some(Duration::from_secs(60)),
     };
@@ -115,14 +116,7 @@ fn bad_input_is_an_error_not_a_panic() {
         ..Default::default()
     };
     assert!(FullStatePrm::new(ctx.clone(), bad_k).is_err());
-    let mut prm = FullStatePrm::new(
-        ctx,
-        PrmSettings {
-            vertices: 50,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let mut prm = prm_of(ctx, 50);
     let stop = Termination::default();
     let yaw = sc.start_yaw as f32;
     // Another chain's shape.
@@ -130,18 +124,21 @@ fn bad_input_is_an_error_not_a_panic() {
     assert!(matches!(r, Err(PrmError::StartInvalid(_))));
     // Start inside the wall.
     let r = prm.solve(
-        &Query::new([4.1, 1.0, 1.5], Shape::line(3, yaw), sc.goal),
+        &Query::new(Point3::new(4.1, 1.0, 1.5), Shape::line(3, yaw), sc.goal),
         stop,
     );
     assert!(matches!(r, Err(PrmError::StartInvalid(_))));
     // Goal outside the map, or not finite.
     let s = Shape::line(3, yaw);
     assert!(matches!(
-        prm.solve(&Query::new(sc.start, s, [100.0, 0.0, 0.0]), stop),
+        prm.solve(&Query::new(sc.start, s, Point3::new(100.0, 0.0, 0.0)), stop),
         Err(PrmError::GoalInvalid(_))
     ));
     assert!(matches!(
-        prm.solve(&Query::new(sc.start, s, [f64::NAN, 0.0, 0.0]), stop),
+        prm.solve(
+            &Query::new(sc.start, s, Point3::new(f64::NAN, 0.0, 0.0)),
+            stop
+        ),
         Err(PrmError::GoalInvalid(_))
     ));
     // A goal tolerance that is not a number.
@@ -158,17 +155,19 @@ fn bad_input_is_an_error_not_a_panic() {
     assert_eq!(sol.steps.len(), 1);
 }
 
+/// A PRM of `vertices` vertices, the other settings the defaults.
+fn prm_of(ctx: CollisionContext, vertices: usize) -> FullStatePrm {
+    let settings = PrmSettings {
+        vertices,
+        ..Default::default()
+    };
+    FullStatePrm::new(ctx, settings).expect("valid settings")
+}
+
 #[test]
 fn too_sparse_roadmap_fails_cleanly() {
     let (ctx, sc) = window_ctx(5);
-    let mut prm = FullStatePrm::new(
-        ctx,
-        PrmSettings {
-            vertices: 20,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let mut prm = prm_of(ctx, 20);
     let shape = sc.start_shape(5).unwrap();
     let r = prm.solve(
         &Query::new(sc.start, shape, sc.goal),

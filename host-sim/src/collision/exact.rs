@@ -6,6 +6,7 @@ use aerial_chain_core::kinematics::positions_into;
 use aerial_chain_core::validity::{check_shape, Body, Violation};
 use aerial_chain_core::{ChainParams, Shape};
 
+use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 
 /// Distance from point `p` to the closed box `lo..hi`.
@@ -308,6 +309,50 @@ pub fn check_config_exact(
         }
     }
     Ok(best)
+}
+
+/// The exact distance from `p` to the nearest obstacle voxel cube of the field's grid,
+/// when it is above `stop` and below `cap`; otherwise some value `<= stop` (the first
+/// cube found within `stop`) or `>= cap`. The voxels are visited in rings around the
+/// one holding `p`, nearest first, so a blocked point is settled after a few.
+pub fn exact_clearance(field: &DistanceField, p: [f64; 3], stop: f64, cap: f64) -> f64 {
+    let g = field.grid();
+    let r = g.resolution();
+    let c0 = g.lattice_index(p);
+    let rings = (cap / r).ceil() as i32 + 1;
+    let mut best = cap;
+    for k in 0..=rings {
+        // Every cube of ring k is at least (k - 1) r away.
+        if (k - 1) as f64 * r >= best {
+            break;
+        }
+        for dz in -k..=k {
+            for dy in -k..=k {
+                for dx in -k..=k {
+                    if dx.abs().max(dy.abs()).max(dz.abs()) != k {
+                        continue;
+                    }
+                    let i = [c0[0] + dx, c0[1] + dy, c0[2] + dz];
+                    if !g.is_obstacle(i) {
+                        continue;
+                    }
+                    let c = g.voxel_center(i);
+                    let d = point_box_distance(
+                        p,
+                        [c[0] - r / 2.0, c[1] - r / 2.0, c[2] - r / 2.0],
+                        [c[0] + r / 2.0, c[1] + r / 2.0, c[2] + r / 2.0],
+                    );
+                    if d < best {
+                        best = d;
+                        if d <= stop {
+                            return d;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    best
 }
 
 #[cfg(test)]

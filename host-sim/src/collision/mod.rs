@@ -165,6 +165,8 @@ pub struct CollisionContext {
     clearance: f64,
     min_step: f64,
     unit_r: f64,
+    /// Most the distance field's bound can lose near obstacles, `r_v sqrt(3)` (m).
+    field_loss: f64,
     link_r: f64,
     counters: Arc<Counters>,
 }
@@ -238,6 +240,7 @@ impl CollisionContext {
         let min_step = field.grid().resolution() / 64.0;
         Ok(Self {
             unit_r: params.unit_radius as f64 + clearance + FK_TOLERANCE,
+            field_loss: field.grid().resolution() * 3f64.sqrt(),
             link_r: params.link_radius as f64 + clearance + FK_TOLERANCE,
             field,
             params,
@@ -315,9 +318,25 @@ impl CollisionContext {
     }
 
     /// A proven lower bound at `p`, from one lookup when that already exceeds `need`.
+    /// Where the field's bound falls short of `need` by less than what it can lose
+    /// (`r_v sqrt(3)` next to obstacles), the obstacle cubes nearby are measured one by
+    /// one: at a coarse resolution a unit centred in an opening is otherwise refused
+    /// although it is clear of both sides.
     #[inline]
     fn bound(&self, p: [f64; 3], need: f64) -> f64 {
-        self.field.clearance_above(p, need)
+        let c = self.field.clearance_above(p, need);
+        if c > need || c + self.field_loss < need {
+            return c;
+        }
+        let r_v = self.field.grid().resolution();
+        let e = exact::exact_clearance(&self.field, p, need, need + r_v);
+        // Below `need`, `exact_clearance` may give a cube that is not the nearest: only
+        // a value above `need` is a proven distance.
+        if e > need {
+            e
+        } else {
+            c
+        }
     }
 
     /// Whether the head's unit sphere (grown by the clearance margin) is free at `p`

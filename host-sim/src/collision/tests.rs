@@ -35,8 +35,11 @@ fn open_space_and_a_wall() {
     let line = Shape::line(4, 0.0); // trails along -x
                                     // 0.35 m from the wall: accepted (the bound loses some of the 0.15 m of slack).
     assert_eq!(ctx.check_config([2.65, 1.95, 0.95], &line), Ok(()));
-    // 0.25 m from the wall at voxel faces: truly free, but the bound cannot prove it.
-    assert!(ctx.check_config([2.75, 2.0, 1.0], &line).is_err());
+    // 0.25 m from the wall at voxel faces: truly free; the field's bound alone cannot
+    // prove it, the exact measure of the cubes nearby does.
+    assert_eq!(ctx.check_config([2.75, 2.0, 1.0], &line), Ok(()));
+    // 0.19 m from the wall: below r_u + clearance (0.2 m), refused.
+    assert!(ctx.check_config([2.81, 2.0, 1.0], &line).is_err());
     // Head sphere reaches the wall: 3.0 - 2.85 = 0.15 <= r_u.
     assert!(matches!(
         ctx.check_config([2.85, 2.0, 1.0], &line),
@@ -82,7 +85,7 @@ fn open_space_and_a_wall() {
     assert!(!ctx.is_head_segment_free([2.0, 2.0, 1.0], [3.5, 2.0, 1.0]));
     assert!((ctx.clearance([2.5, 2.0, 1.0]) - 0.5).abs() < 0.1);
     let st = ctx.stats();
-    assert_eq!(st.configs, 5);
+    assert_eq!(st.configs, 6);
     assert_eq!(st.translations, 2);
     assert_eq!(st.shape_changes, 2);
     assert_eq!(st.head_points, 2);
@@ -169,6 +172,37 @@ fn boxes() -> impl Strategy<Value = Vec<([f64; 3], [f64; 3])>> {
 
 /// A random shape within the pitch limit (it may still self-collide or break the bend
 /// limit: the checks must agree on that too).
+/// Obstacle boxes: lower and upper corners (m).
+type Boxes = Vec<([f64; 3], [f64; 3])>;
+
+/// A random map (its obstacle boxes, whether unknown space is occupied) and chain
+/// (`N`, and 31 numbers in `-1..1` for its shape: [`shape`]).
+fn scene() -> impl Strategy<Value = (Boxes, bool, u8, Vec<f32>)> {
+    (
+        boxes(),
+        any::<bool>(),
+        2u8..7,
+        proptest::collection::vec(-1.0f32..1.0, 31),
+    )
+}
+
+/// The map and a context of chain `n` on it, with no clearance.
+fn context(
+    b: &[([f64; 3], [f64; 3])],
+    unknown_occ: bool,
+    n: u8,
+) -> (Arc<DistanceField>, ChainParams, CollisionContext) {
+    let f = map(b, unknown_occ);
+    let p = ChainParams::new(n);
+    let ctx = CollisionContext::new(f.clone(), p, 0.0).unwrap();
+    (f, p, ctx)
+}
+
+/// A head position in the map's free interior from `u` in the unit cube.
+fn head_at(u: [f64; 3]) -> [f64; 3] {
+    [0.3 + u[0] * 3.4, 0.3 + u[1] * 3.4, 0.2 + u[2] * 1.6]
+}
+
 fn shape(n: u8, raw: &[f32]) -> Shape {
     let mut s = Shape::line(n, raw[0] * 3.1);
     for k in 0..n as usize - 1 {
@@ -183,17 +217,11 @@ proptest! {
     /// The fast check never accepts a configuration the exact check rejects.
     #[test]
     fn fast_config_is_conservative(
-        b in boxes(),
-        unknown_occ in any::<bool>(),
-        n in 2u8..7,
-        raw in proptest::collection::vec(-1.0f32..1.0, 31),
+        (b, unknown_occ, n, raw) in scene(),
         head in proptest::array::uniform3(0.0f64..1.0),
     ) {
-        let f = map(&b, unknown_occ);
-        let p = ChainParams::new(n);
-        let ctx = CollisionContext::new(f.clone(), p, 0.0).unwrap();
-        let s = shape(n, &raw);
-        let h = [0.3 + head[0] * 3.4, 0.3 + head[1] * 3.4, 0.2 + head[2] * 1.6];
+        let (f, p, ctx) = context(&b, unknown_occ, n);
+        let (s, h) = (shape(n, &raw), head_at(head));
         if ctx.check_config(h, &s).is_ok() {
             let z = zeta(h, &s);
             let r = check_config_exact(f.grid(), &p, h, &z[3..], 0.2);
@@ -204,22 +232,16 @@ proptest! {
     /// The fast edge checks never accept an edge whose exact sampling finds a problem.
     #[test]
     fn fast_edges_are_conservative(
-        b in boxes(),
-        unknown_occ in any::<bool>(),
-        n in 2u8..7,
-        raw in proptest::collection::vec(-1.0f32..1.0, 31),
+        (b, unknown_occ, n, raw) in scene(),
         raw2 in proptest::collection::vec(-1.0f32..1.0, 31),
         head in proptest::array::uniform3(0.0f64..1.0),
         to in proptest::array::uniform3(0.0f64..1.0),
         translate in any::<bool>(),
     ) {
-        let f = map(&b, unknown_occ);
-        let p = ChainParams::new(n);
-        let ctx = CollisionContext::new(f.clone(), p, 0.0).unwrap();
-        let s = shape(n, &raw);
-        let h = [0.3 + head[0] * 3.4, 0.3 + head[1] * 3.4, 0.2 + head[2] * 1.6];
+        let (f, p, ctx) = context(&b, unknown_occ, n);
+        let (s, h) = (shape(n, &raw), head_at(head));
         if translate {
-            let h2 = [0.3 + to[0] * 3.4, 0.3 + to[1] * 3.4, 0.2 + to[2] * 1.6];
+            let h2 = head_at(to);
             if ctx.check_translation(h, h2, &s).is_ok() {
                 let r = check_edge_exact(f.grid(), &p, &zeta(h, &s), &zeta(h2, &s), 0.2);
                 prop_assert!(r.is_ok(), "fast accepted translation, exact found {:?}", r);

@@ -17,7 +17,7 @@ use aerial_chain_core::validity::Body;
 
 use super::exact::{check_config_exact, ExactViolation};
 use crate::map::grid::Grid;
-use crate::plan::Plan;
+use crate::plan_file::Plan;
 use aerial_chain_core::ChainParams;
 
 /// Tolerance for "stays" when classifying an edge (docs/model.md).
@@ -439,7 +439,7 @@ pub fn check_edge_exact(
 mod tests {
     use super::*;
     use crate::map::grid::{Cell, Grid};
-    use crate::plan::{ChainSection, MapSection, Waypoint, FORMAT};
+    use crate::plan_file::{ChainSection, MapSection, Waypoint, FORMAT};
     use aerial_chain_core::Shape;
 
     fn plan(points: &[([f64; 3], Shape)]) -> Plan {

@@ -393,6 +393,12 @@ impl DistanceField {
         }
     }
 
+    /// The bounds of [`Self::voxel_clearance`] along row `(y, z)` (local indices), x first.
+    pub(crate) fn row_bounds(&self, y: usize, z: usize) -> &[f32] {
+        let start = self.grid.linear([0, y, z]);
+        &self.lb[start..start + self.grid.dims()[0]]
+    }
+
     /// Bytes held by the grid and the field.
     pub fn memory_bytes(&self) -> usize {
         self.lb.len() * 4 + self.grid.dims().iter().product::<usize>()

@@ -346,6 +346,19 @@ impl Grid {
         self.is_obstacle(self.lattice_index(p))
     }
 
+    /// Whether each voxel of row `(y, z)` (local indices) is an obstacle, x first.
+    pub(crate) fn obstacle_row(&self, y: usize, z: usize) -> impl Iterator<Item = bool> + '_ {
+        let start = self.linear([0, y, z]);
+        let unknown = self.unknown_is_occupied;
+        self.cells[start..start + self.dims[0]]
+            .iter()
+            .map(move |&v| match Cell::from_u8(v) {
+                Cell::Occupied => true,
+                Cell::Free => false,
+                Cell::Unknown => unknown,
+            })
+    }
+
     /// The raw states, x fastest, then y, then z.
     pub fn cells(&self) -> impl ExactSizeIterator<Item = Cell> + '_ {
         self.cells.iter().map(|&v| Cell::from_u8(v))

@@ -23,18 +23,15 @@ use super::{
     Termination,
 };
 use crate::collision::CollisionContext;
-use crate::plan::{Plan, Timing};
+use crate::plan_file::{Plan, Timings};
 use crate::tables::ShapeTables;
 
 /// Counters and timings of one query.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Stats {
-    /// Roadmap build time (s).
-    pub roadmap_s: f64,
-    /// Query time (s).
-    pub planning_s: f64,
-    /// Of the query time, spent in collision checks (s).
-    pub collision_s: f64,
+    /// Setup (the head roadmap and the labelled free regions), query and
+    /// collision-check times.
+    pub timings: Timings,
     /// Head edges flown.
     pub edges: usize,
     /// Shape-change waypoints.
@@ -132,6 +129,9 @@ impl ArcPlanner {
     fn setup_until(&mut self, deadline: Option<Instant>) {
         if self.roadmap.is_none() {
             let t = Instant::now();
+            if self.settings.head_lattice {
+                self.lattice.regions(self.ctx.field());
+            }
             self.build_roadmap(self.settings.vertices, deadline);
             self.roadmap_s = t.elapsed().as_secs_f64();
         }
@@ -177,13 +177,27 @@ impl ArcPlanner {
         *s += t.elapsed().as_secs_f64();
         match outcome {
             lattice::LatticeOutcome::Found(r) if r.points.len() >= 2 => Ok(Some(r)),
-            lattice::LatticeOutcome::Separated { side, visited } => Err(PlanError::Separated {
+            separated @ lattice::LatticeOutcome::Separated { .. } => Err(self.separated(separated)),
+            _ => Ok(None),
+        }
+    }
+
+    /// The planning error for a lattice outcome that proves separation.
+    fn separated(&self, outcome: lattice::LatticeOutcome) -> PlanError {
+        match outcome {
+            lattice::LatticeOutcome::Separated {
+                side,
+                size,
+                unit,
+                spacing,
+            } => PlanError::Separated {
                 radius: self.lattice.radius_min(),
                 side,
-                visited,
-                spacing: self.lattice.spacing(),
-            }),
-            _ => Ok(None),
+                size,
+                unit,
+                spacing,
+            },
+            other => unreachable!("not a separation: {other:?}"),
         }
     }
 
@@ -203,10 +217,10 @@ impl ArcPlanner {
     /// Refuses a query whose start configuration is not valid or whose goal cannot
     /// hold the head (at the smallest clearance).
     fn check_query(&self, query: &Query) -> Result<(), PlanError> {
+        let (start, goal) = query.ends();
         self.ctx_min
-            .check_config(query.start, &query.start_shape)
+            .check_config(start, &query.start_shape)
             .map_err(|c| PlanError::StartInvalid(c.to_string()))?;
-        let goal = query.goal;
         if !self.ctx_min.is_head_free(goal) {
             let why = if self.ctx.field().grid().in_bounds(goal) {
                 format!(
@@ -228,7 +242,7 @@ impl ArcPlanner {
         query: &Query,
         stop: Termination,
     ) -> Result<Solution<Stats>, PlanError> {
-        let (start, goal) = (query.start, query.goal);
+        let (start, goal) = query.ends();
         // The time limit covers the roadmap too (when it is built here) and growth.
         let began = Instant::now();
         let deadline = stop.deadline(began);
@@ -236,6 +250,12 @@ impl ArcPlanner {
         let query_began = Instant::now();
         let checks_before = self.check_count();
         self.check_query(query)?;
+        if self.settings.head_lattice {
+            // The labelled regions refuse a sealed-off goal at once, whatever the map.
+            if let Some(sep) = self.lattice.separation(self.ctx.field(), start, goal) {
+                return Err(self.separated(sep));
+            }
+        }
         // The head route over the lattice ([`lattice`]), searched when the uniform
         // roadmap fails (where it works, it is cheaper in rooms and mazes): the route
         // joins the roadmap, and a proof that none exists ends the query.
@@ -301,8 +321,8 @@ impl ArcPlanner {
         stats.lattice_expanded = lattice_expanded;
         stats.lattice_s = lattice_s;
         stats.route_points = route.as_ref().map_or(0, |r| r.points.len());
-        stats.roadmap_s = self.roadmap_s;
-        stats.planning_s = query_began.elapsed().as_secs_f64();
+        stats.timings.roadmap_s = self.roadmap_s;
+        stats.timings.planning_s = query_began.elapsed().as_secs_f64();
         (stats.roadmap_vertices, stats.roadmap_edges) = size;
         Ok(Solution { steps, stats })
     }
@@ -348,7 +368,10 @@ impl Planner for ArcPlanner {
             .as_ref()
             .map_or((0, 0), |r| (r.vertex_count(), r.edge_count()));
         Stats {
-            roadmap_s: self.roadmap_s,
+            timings: Timings {
+                roadmap_s: self.roadmap_s,
+                ..Default::default()
+            },
             roadmap_vertices,
             roadmap_edges,
             ..Default::default()
@@ -377,13 +400,12 @@ impl SolutionStats for Stats {
         ]
     }
 
-    fn timing(&self) -> Timing {
-        Timing {
-            roadmap_s: self.roadmap_s,
-            planning_s: self.planning_s,
-            collision_s: self.collision_s,
-            rest: "shape_search_s",
-        }
+    fn timings(&self) -> Timings {
+        self.timings
+    }
+
+    fn rest_name(&self) -> &'static str {
+        "shape_search_s"
     }
 
     /// Where each waypoint's shape came from, and the smallest clearance margin in

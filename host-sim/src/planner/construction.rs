@@ -64,7 +64,7 @@ impl<'p> Construction<'p> {
         stop: Termination,
         began: Instant,
     ) -> Self {
-        let (start, shape, goal) = (query.start, query.start_shape, query.goal);
+        let ((start, goal), shape) = (query.ends(), query.start_shape);
         let s = roadmap.add_query_vertex(start);
         let g = roadmap.add_query_vertex(goal);
         if let Some(inner) = route {
@@ -203,7 +203,7 @@ impl<'p> Construction<'p> {
                 self.stats.min_margin_at = Some(at);
             }
         }
-        self.stats.collision_s = self.checker.time.as_secs_f64();
+        self.stats.timings.collision_s = self.checker.time.as_secs_f64();
         Ok((self.steps, self.stats))
     }
 

@@ -50,15 +50,17 @@ pub enum PlanError {
     },
     /// The head's sphere cannot get from the start to the goal at all: the lattice
     /// search flooded one side's free region without meeting the other.
-    #[error("start and goal are in separate free regions for the head's sphere (radius {radius:.3} m, the smallest clearance included): the {side}'s region ({visited} lattice points at {spacing:.3} m) does not reach the other")]
+    #[error("start and goal are in separate free regions for the head's sphere (radius {radius:.3} m, the smallest clearance included): the {side}'s region ({size} {unit} at {spacing:.3} m) does not reach the other")]
     Separated {
         /// Sphere radius tested (m).
         radius: f64,
-        /// Which side's region was flooded ("start" or "goal").
+        /// Which side's region was measured whole ("start" or "goal").
         side: &'static str,
-        /// Lattice points in it.
-        visited: usize,
-        /// Lattice spacing (m).
+        /// Its size, in `unit`s.
+        size: u64,
+        /// What `size` counts ("lattice points" or "voxels").
+        unit: &'static str,
+        /// Spacing of what was counted (m).
         spacing: f64,
     },
     /// The termination condition stopped the query.

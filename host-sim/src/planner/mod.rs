@@ -36,6 +36,7 @@ pub(crate) mod srs_connect;
 use std::time::{Duration, Instant};
 
 use aerial_chain_core::Shape;
+use nalgebra::Point3;
 
 pub use arc::{ArcPlanner, Stats};
 pub use candidates::Source;
@@ -46,18 +47,18 @@ pub use refine::{Quality, Refinement};
 pub use settings::{Mode, Preference, Settings};
 
 use crate::collision::CollisionContext;
-use crate::plan::{Plan, Timing};
+use crate::plan_file::{Plan, Timings};
 
 /// What a planner is asked: from a start configuration of the chain to a goal region
 /// for the head.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Query {
     /// Head start position (m).
-    pub start: [f64; 3],
+    pub start: Point3<f64>,
     /// Start shape.
     pub start_shape: Shape,
     /// Head goal position (m).
-    pub goal: [f64; 3],
+    pub goal: Point3<f64>,
     /// Goal tolerance: the head ends within this distance of the goal (m).
     pub goal_tol: f64,
 }
@@ -67,13 +68,19 @@ impl Query {
     pub const DEFAULT_GOAL_TOL: f64 = 0.3;
 
     /// A query from `start` in `start_shape` to `goal`, at the default tolerance.
-    pub fn new(start: [f64; 3], start_shape: Shape, goal: [f64; 3]) -> Self {
+    pub fn new(start: Point3<f64>, start_shape: Shape, goal: Point3<f64>) -> Self {
         Self {
             start,
             start_shape,
             goal,
             goal_tol: Self::DEFAULT_GOAL_TOL,
         }
+    }
+
+    /// The head's start and goal as the arrays the collision checks and the roadmaps
+    /// take.
+    pub fn ends(&self) -> ([f64; 3], [f64; 3]) {
+        (self.start.into(), self.goal.into())
     }
 }
 
@@ -124,7 +131,9 @@ pub trait SolutionStats {
     /// The counters, in the order the plan file lists them.
     fn counts(&self) -> Vec<(&'static str, u64)>;
     /// Where the time went.
-    fn timing(&self) -> Timing;
+    fn timings(&self) -> Timings;
+    /// The name of the query's time outside collision checks in the plan file.
+    fn rest_name(&self) -> &'static str;
     /// Adds what else this planner records about the solution `steps` to `plan`.
     fn annotate(&self, steps: &[Step], plan: &mut Plan);
 }

@@ -11,7 +11,7 @@ use serde_json::Value;
 use super::candidates::Source;
 use super::refine::{Quality, Refinement};
 use super::{Solution, SolutionStats};
-use crate::plan::Plan;
+use crate::plan_file::Plan;
 
 /// A short label of where a waypoint's shape came from.
 pub fn source_label(s: &Source, shape_change: bool) -> String {
@@ -42,7 +42,7 @@ pub fn to_plan<S: SolutionStats>(
         (resolution, unknown_is_occupied),
         steps,
         &st.counts(),
-        &st.timing(),
+        (&st.timings(), st.rest_name()),
     );
     st.annotate(&solution.steps, &mut plan);
     plan

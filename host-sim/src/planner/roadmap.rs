@@ -324,7 +324,7 @@ mod tests {
         let ctx = CollisionContext::new(field, ChainParams::new(5), 0.05).expect("context");
         let mut rng = Pcg64::seed_from_u64(3);
         let map = Roadmap::build(&ctx, 3000, (1.5, 30), (2.0, 1.0), &mut rng, None);
-        (ctx, map, sc.start, sc.goal)
+        (ctx, map, sc.start.into(), sc.goal.into())
     }
 
     /// Adds `start` and `goal` as query vertices; returns them and the cost-to-go to the

@@ -5,6 +5,7 @@
 //! This layer sits above the map and collision layers (a scenario is a grid; a witness
 //! is checked by the exact verifier) and below planning.
 
+pub mod large;
 pub mod passages;
 pub mod scenarios;
 
@@ -15,7 +16,7 @@ use crate::collision::verify::PlanViolation;
 pub enum ProblemError {
     /// A name that is no built-in scenario.
     #[error(
-        "unknown scenario {0:?}; known: {known}, corridor:LENGTH, passage:KEY=VALUE,...",
+        "unknown scenario {0:?}; known: {known}, corridor:LENGTH, passage:KEY=VALUE,..., campus[:RES], hall[:RES]",
         known = scenarios::NAMES.join(", ")
     )]
     UnknownScenario(String),

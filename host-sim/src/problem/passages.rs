@@ -9,7 +9,7 @@
 //! | `w` | 0.5 | window width and height (m), 0.4 to 1.0, widened to whole voxels |
 //! | `angle` | 45 | approach angle off the wall's normal (degrees), -60 to 60 |
 //! | `offset` | 0 | window centre off the room's axis (m), -0.4 to 0.4 |
-//! | `wall` | 0.2 | wall thickness (m), 0.1 to 0.3 |
+//! | `wall` | 0.2 | wall thickness (m), 0.1 to 2.0: from 0.5 m on, the window is a square tunnel |
 //! | `door` | none | width (m) of a door in a second wall 2.5 m behind the first, 0.4 to 1.0 |
 //! | `door_offset` | 0 | door centre off the room's axis (m), -0.4 to 0.4 |
 //! | `res` | 0.05 | map resolution (m), 0.025 to 0.1 |
@@ -26,7 +26,7 @@ use aerial_chain_core::ChainParams;
 use super::ProblemError;
 use crate::collision::verify_plan;
 use crate::map::grid::{Cell, Grid};
-use crate::plan::Plan;
+use crate::plan_file::Plan;
 use crate::problem::scenarios::Scenario;
 
 /// Parameters of one instance.
@@ -122,7 +122,7 @@ impl PassageSpec {
         within("w", self.w, 0.4, 1.0)?;
         within("angle", self.angle_deg, -60.0, 60.0)?;
         within("offset", self.offset, -0.4, 0.4)?;
-        within("wall", self.wall, 0.1, 0.3)?;
+        within("wall", self.wall, 0.1, 2.0)?;
         within("res", self.res, 0.025, 0.1)?;
         if let Some((d, o)) = self.door {
             within("door", d, 0.4, 1.0)?;
@@ -150,18 +150,25 @@ impl PassageSpec {
     }
 
     /// A random instance of the family (widths 0.45-0.6 m, walls 0.1-0.3 m, angles
-    /// up to 60 degrees either way, offsets up to 0.3 m, a door half of the time),
-    /// rounded to the centimetre and degree so that names stay short.
+    /// up to 60 degrees either way, offsets up to 0.3 m, a door half of the time; one
+    /// in five a tunnel instead, 0.5-0.6 m square and 0.6-1.5 m long), rounded to the
+    /// centimetre and degree so that names stay short.
     pub fn random(rng: &mut impl rand::Rng) -> Self {
         let cm = |v: f64| (v * 100.0).round() / 100.0;
         let door = rng
             .gen_bool(0.5)
             .then(|| (cm(rng.gen_range(0.5..=0.8)), cm(rng.gen_range(-0.3..=0.3))));
+        let tunnel = rng.gen_bool(0.2);
+        let (w, wall) = if tunnel {
+            (rng.gen_range(0.5..=0.6), rng.gen_range(0.6..=1.5))
+        } else {
+            (rng.gen_range(0.45..=0.6), rng.gen_range(0.1..=0.3))
+        };
         Self {
-            w: cm(rng.gen_range(0.45..=0.6)),
+            w: cm(w),
             angle_deg: rng.gen_range(-60.0f64..=60.0).round(),
             offset: cm(rng.gen_range(-0.3..=0.3)),
-            wall: cm(rng.gen_range(0.1..=0.3)),
+            wall: cm(wall),
             door,
             res: 0.05,
             sealed: false,
@@ -185,14 +192,7 @@ impl PassageSpec {
         });
         let dims = [sx, ROOM_Y, ROOM_Z].map(|v| (v / r).round() as usize);
         let mut g = Grid::new(r, [0; 3], dims, Cell::Occupied, true)?;
-        let e = 1e-6;
-        let fill = |g: &mut Grid, lo: [f64; 3], hi: [f64; 3], c: Cell| {
-            g.fill_box(
-                [lo[0] + e, lo[1] + e, lo[2] + e],
-                [hi[0] - e, hi[1] - e, hi[2] - e],
-                c,
-            )
-        };
+        let fill = super::scenarios::fill;
         let size = [dims[0] as f64 * r, dims[1] as f64 * r, dims[2] as f64 * r];
         fill(
             &mut g,
@@ -246,18 +246,18 @@ impl PassageSpec {
         Ok(Scenario {
             name: self.name(),
             description: format!(
-                "A room at {r} m with a {t} m wall holding a {w} m x {w} m window {off:+} m off the \
+                "A room at {r} m with a {t} m wall holding a {w} m x {w} m window (a tunnel when the wall is thick) {off:+} m off the \
                  axis, approached at {ang} degrees off its normal{door_text}.",
                 w = self.w,
                 off = self.offset,
                 ang = self.angle_deg
             ),
             grid: g,
-            start,
+            start: start.into(),
             start_yaw: a,
-            goal,
+            goal: goal.into(),
             default_units: 5,
-            route,
+            route: super::scenarios::points(&route),
         })
     }
 }

@@ -27,11 +27,12 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use aerial_chain_core::{ChainParams, Shape};
+use nalgebra::Point3;
 
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
 use crate::map::octomap::{MapFileError, OcTree};
-use crate::plan::{ChainSection, MapSection, MapSource, Plan, Waypoint};
+use crate::plan_file::{ChainSection, MapSection, MapSource, Plan, Waypoint};
 
 /// Resolution of every built-in scenario (m).
 pub const RESOLUTION: f64 = 0.1;
@@ -55,17 +56,22 @@ pub struct Scenario {
     /// The map (unknown space counts as occupied; there is none inside the box).
     pub grid: Grid,
     /// Start position of the head (m).
-    pub start: [f64; 3],
+    pub start: Point3<f64>,
     /// Start yaw (rad): the chain starts as the straight line LI at this yaw, trailing
     /// behind the head along `-(cos yaw, sin yaw, 0)`.
     pub start_yaw: f64,
     /// Goal position of the head (m).
-    pub goal: [f64; 3],
+    pub goal: Point3<f64>,
     /// Number of units the scenario is made for.
     pub default_units: u8,
     /// A collision-free route for the head from `start` to `goal` (polyline), with room
     /// for the default chain to follow it; for tests and pictures, not for the planner.
-    pub route: Vec<[f64; 3]>,
+    pub route: Vec<Point3<f64>>,
+}
+
+/// `v` as points: the scenarios' data is written as arrays.
+pub(crate) fn points(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
+    v.iter().map(|&p| p.into()).collect()
 }
 
 /// A scenario by name: `window`, `maze`, `silos`, `corridor` (20 m) or `corridor:L`
@@ -77,7 +83,9 @@ pub fn build(name: &str) -> Result<Scenario, ProblemError> {
         "silos" => Ok(silos()),
         "corridor" => corridor(DEFAULT_CORRIDOR_LENGTH),
         _ => {
-            if let Some(spec) = name.strip_prefix("passage:") {
+            if let Some(large) = super::large::build(name) {
+                large
+            } else if let Some(spec) = name.strip_prefix("passage:") {
                 super::passages::PassageSpec::parse(spec)?.build()
             } else if let Some(len) = name.strip_prefix("corridor:") {
                 let l: f64 = len
@@ -93,41 +101,36 @@ pub fn build(name: &str) -> Result<Scenario, ProblemError> {
 
 /// A free box `0..size` (snapped to the lattice) with occupied outer shell of [`WALL`].
 fn closed_box(size: [f64; 3]) -> Grid {
-    let dims = size.map(|s| (s / RESOLUTION).round() as usize);
-    let mut g = Grid::new(RESOLUTION, [0; 3], dims, Cell::Occupied, true)
-        .expect("scenario sizes are small and positive");
+    shell_box(size, RESOLUTION, WALL)
+}
+
+/// A free box `0..size` at resolution `res` (snapped to the lattice) inside an occupied
+/// shell `shell` thick.
+pub(super) fn shell_box(size: [f64; 3], res: f64, shell: f64) -> Grid {
+    let dims = size.map(|s| (s / res).round() as usize);
+    let mut g = Grid::new(res, [0; 3], dims, Cell::Occupied, true)
+        .expect("scenario sizes are positive and within the grid's limits");
     let eps = 1e-6;
-    g.fill_box(
-        [WALL + eps; 3],
-        [
-            size[0] - WALL - eps,
-            size[1] - WALL - eps,
-            size[2] - WALL - eps,
-        ],
-        Cell::Free,
-    );
+    g.fill_box([shell + eps; 3], size.map(|s| s - shell - eps), Cell::Free);
     g
 }
 
-/// Occupies the voxels whose centres lie in the box `lo..hi` (shrunk by a hair so that
-/// a box given by its faces on the lattice takes exactly the voxels inside it).
-fn solid(g: &mut Grid, lo: [f64; 3], hi: [f64; 3]) {
+/// Sets the voxels whose centres lie in the box `lo..hi` to `cell` (the box shrunk by a
+/// hair so that a box given by its faces on the lattice takes exactly the voxels inside
+/// it).
+pub(super) fn fill(g: &mut Grid, lo: [f64; 3], hi: [f64; 3], cell: Cell) {
     let e = 1e-6;
-    g.fill_box(
-        [lo[0] + e, lo[1] + e, lo[2] + e],
-        [hi[0] - e, hi[1] - e, hi[2] - e],
-        Cell::Occupied,
-    );
+    g.fill_box(lo.map(|v| v + e), hi.map(|v| v - e), cell);
 }
 
-/// Frees the voxels whose centres lie in the box `lo..hi` (see [`solid`]).
+/// Occupies the voxels whose centres lie in the box `lo..hi` (see [`fill`]).
+fn solid(g: &mut Grid, lo: [f64; 3], hi: [f64; 3]) {
+    fill(g, lo, hi, Cell::Occupied);
+}
+
+/// Frees the voxels whose centres lie in the box `lo..hi` (see [`fill`]).
 fn open(g: &mut Grid, lo: [f64; 3], hi: [f64; 3]) {
-    let e = 1e-6;
-    g.fill_box(
-        [lo[0] + e, lo[1] + e, lo[2] + e],
-        [hi[0] - e, hi[1] - e, hi[2] - e],
-        Cell::Free,
-    );
+    fill(g, lo, hi, Cell::Free);
 }
 
 /// Env 1 of the paper: two rooms joined by a small window.
@@ -145,11 +148,11 @@ pub fn window() -> Scenario {
                       room, perpendicular to the window, and must turn to pass it end first."
             .into(),
         grid: g,
-        start: [2.0, 4.5, 1.5],
+        start: Point3::new(2.0, 4.5, 1.5),
         start_yaw: FRAC_PI_2,
-        goal: [6.6, 3.0, 1.5],
+        goal: Point3::new(6.6, 3.0, 1.5),
         default_units: 5,
-        route: vec![
+        route: points(&[
             [2.0, 4.5, 1.5],
             [2.0, 5.0, 1.5],
             [2.4, 5.3, 1.5],
@@ -159,7 +162,7 @@ pub fn window() -> Scenario {
             [3.55, 3.1, 1.5],
             [3.8, 3.0, 1.5],
             [6.6, 3.0, 1.5],
-        ],
+        ]),
     }
 }
 
@@ -180,11 +183,11 @@ pub fn maze() -> Scenario {
                       sideways: it must bend around every wall end."
             .into(),
         grid: g,
-        start: [1.45, 4.0, z],
+        start: Point3::new(1.45, 4.0, z),
         start_yaw: FRAC_PI_2,
-        goal: [9.05, 3.5, z],
+        goal: Point3::new(9.05, 3.5, z),
         default_units: 5,
-        route: vec![
+        route: points(&[
             [1.45, 4.0, z],
             [1.45, 5.0, z],
             [1.75, 5.45, z],
@@ -205,7 +208,7 @@ pub fn maze() -> Scenario {
             [8.85, 5.45, z],
             [9.05, 5.0, z],
             [9.05, 3.5, z],
-        ],
+        ]),
     }
 }
 
@@ -232,11 +235,11 @@ pub fn silos() -> Scenario {
                       from west to east is end first through the gap."
             .into(),
         grid: g,
-        start: [3.0, 5.2, 2.0],
+        start: Point3::new(3.0, 5.2, 2.0),
         start_yaw: FRAC_PI_2,
-        goal: [11.0, 5.2, 2.0],
+        goal: Point3::new(11.0, 5.2, 2.0),
         default_units: 5,
-        route: vec![
+        route: points(&[
             [3.0, 5.2, 2.0],
             [3.0, 6.0, 2.0],
             [3.4, 6.6, 2.0],
@@ -246,7 +249,7 @@ pub fn silos() -> Scenario {
             [4.8, 5.25, 2.0],
             [5.3, 5.2, 2.0],
             [11.0, 5.2, 2.0],
-        ],
+        ]),
     }
 }
 
@@ -305,11 +308,11 @@ pub fn corridor(length: f64) -> Result<Scenario, ProblemError> {
             doors.len()
         ),
         grid: g,
-        start,
+        start: start.into(),
         start_yaw: 0.0,
-        goal,
+        goal: goal.into(),
         default_units: 5,
-        route,
+        route: points(&route),
     })
 }
 
@@ -344,22 +347,23 @@ impl Scenario {
         let n = params.n();
         let l = params.link_length as f64;
         let (c, s) = (self.start_yaw.cos(), self.start_yaw.sin());
+        // The plan file's arrays (docs/model.md "Files").
+        let (start, goal): ([f64; 3], [f64; 3]) = (self.start.into(), self.goal.into());
+        let given: Vec<[f64; 3]> = self.route.iter().map(|&p| p.into()).collect();
         // The path: the start chain's line (extended by one more link), then the route.
         let mut path: Vec<[f64; 3]> = (1..=n)
             .rev()
             .map(|k| {
                 let d = k as f64 * l;
-                [self.start[0] - c * d, self.start[1] - s * d, self.start[2]]
+                [start[0] - c * d, start[1] - s * d, start[2]]
             })
             .collect();
-        for p in &self.route {
+        for p in &given {
             if dist(*p, path[path.len() - 1]) > 1e-12 {
                 path.push(*p);
             }
         }
-        if dist(self.route[0], self.start) > 1e-9
-            || dist(*self.route.last().unwrap_or(&self.start), self.goal) > 1e-9
-        {
+        if dist(given[0], start) > 1e-9 || dist(*given.last().unwrap_or(&start), goal) > 1e-9 {
             return Err(ProblemError::RouteEnds);
         }
         let route = Polyline::new(path);
@@ -367,19 +371,19 @@ impl Scenario {
         let s_end = route.length();
         let mut shape = self.start_shape(params.units)?;
         let mut plan = Plan {
-            format: crate::plan::FORMAT.into(),
+            format: crate::plan_file::FORMAT.into(),
             chain: ChainSection::from_params(&params),
             map: MapSection {
                 source: MapSource::scenario(&self.name),
                 ..MapSection::new(self.grid.resolution(), self.grid.unknown_is_occupied())
             },
-            waypoints: vec![Waypoint::new(self.start, &shape)],
+            waypoints: vec![Waypoint::new(start, &shape)],
             stats: Default::default(),
         };
         let mut at = s_start;
         loop {
             let head = if at == s_start {
-                self.start
+                start
             } else {
                 route.point(at)
             };
@@ -392,11 +396,7 @@ impl Scenario {
                 break;
             }
             at = (at + step).min(s_end);
-            let head = if at >= s_end {
-                self.goal
-            } else {
-                route.point(at)
-            };
+            let head = if at >= s_end { goal } else { route.point(at) };
             plan.waypoints.push(Waypoint::new(head, &shape));
         }
         Ok(plan)

@@ -393,13 +393,30 @@ pub fn simulate_with_progress(
     obstacles: Option<&dyn Obstacles>,
     progress: &Progress,
 ) -> Result<Flight, SimError> {
-    fly(
-        ChainModel::new(*params),
-        waypoints,
-        cfg,
-        obstacles,
-        progress,
-    )
+    let model = ChainModel::new(*params);
+    let reference = Reference::new(model.units(), model.link_length(), waypoints, &cfg.limits)?;
+    fly(model, reference, cfg, obstacles, progress)
+}
+
+/// Flies a timed `reference` (a trajectory, see `crate::trajectory`) as it is: its
+/// timing replaces the limits of `cfg`, except that `cfg.limits.start_hold` seconds at
+/// rest come first.
+pub fn simulate_reference(
+    params: &ChainParams,
+    reference: &Reference,
+    cfg: &SimConfig,
+    obstacles: Option<&dyn Obstacles>,
+    progress: &Progress,
+) -> Result<Flight, SimError> {
+    cfg.validate()?;
+    if reference.units() != params.n() {
+        return Err(SimError::Plan(ReferenceError::Waypoint {
+            index: 0,
+            dim: 2 * params.n() + 2,
+        }));
+    }
+    let timed = reference.with_start_hold(cfg.limits.start_hold);
+    fly(ChainModel::new(*params), timed, cfg, obstacles, progress)
 }
 
 /// [`simulate`] with explicit bodies.
@@ -409,13 +426,15 @@ pub fn simulate_model(
     cfg: &SimConfig,
     obstacles: Option<&dyn Obstacles>,
 ) -> Result<Flight, SimError> {
-    fly(model, waypoints, cfg, obstacles, &Progress::default())
+    cfg.validate()?;
+    let reference = Reference::new(model.units(), model.link_length(), waypoints, &cfg.limits)?;
+    fly(model, reference, cfg, obstacles, &Progress::default())
 }
 
 /// The simulation loop behind [`simulate_model`] and [`simulate_with_progress`].
 fn fly(
     model: ChainModel,
-    waypoints: &[Vec<f64>],
+    reference: Reference,
     cfg: &SimConfig,
     obstacles: Option<&dyn Obstacles>,
     progress: &Progress,
@@ -424,8 +443,7 @@ fn fly(
     model.validate()?;
     let params = model.params;
     let n = model.units();
-    let reference = Reference::new(n, model.link_length(), waypoints, &cfg.limits)?;
-    let start = &waypoints[0];
+    let start = &reference.zeta(0.0);
     let mut dynamics = ChainDynamics::new(
         model,
         V3::new(start[0], start[1], start[2]),

@@ -50,13 +50,13 @@ pub use flight::BodySample;
 pub use controller::{ChainController, ControllerConfig};
 pub use dynamics::{BodyState, ChainDynamics, Formulation, UnitCommand, V3};
 pub use flight::{
-    simulate, simulate_with_progress, Flight, FlightReport, Gust, Obstacles, Progress, Sample,
-    SimConfig, SimError,
+    simulate, simulate_reference, simulate_with_progress, Flight, FlightReport, Gust, Obstacles,
+    Progress, Sample, SimConfig, SimError,
 };
 pub use model::ChainModel;
 pub use mpc::{HeadMpc, MpcConfig, MpcRef};
 pub use plot::flight_svg;
-pub use reference::{Reference, ReferenceLimits};
+pub use reference::{Reference, ReferenceError, ReferenceLimits};
 
 #[cfg(test)]
 mod tests;

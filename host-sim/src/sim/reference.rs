@@ -109,6 +109,30 @@ impl ReferenceLimits {
     }
 }
 
+/// The largest rate of progress (1/s) along a segment of `kind` that changes `zeta` by
+/// `delta` within the speed and angular-rate `limits` (0 for a hold).
+pub(crate) fn max_rate(
+    kind: SegmentKind,
+    link_length: f64,
+    delta: &[f64],
+    limits: &ReferenceLimits,
+) -> f64 {
+    match kind {
+        SegmentKind::Hold => 0.0,
+        SegmentKind::Translation => limits.speed / V3::new(delta[0], delta[1], delta[2]).norm(),
+        SegmentKind::ShapeChange => {
+            let max_angle = delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()));
+            // Unit i moves at most at l * sum_{k<i} |d(dir_k)/ds| * ds/dt, and a link
+            // direction moves at most at sqrt(dtheta^2 + dpsi^2).
+            let sweep: f64 = (0..(delta.len() - 4) / 2)
+                .map(|k| (delta[4 + 2 * k].powi(2) + delta[5 + 2 * k].powi(2)).sqrt())
+                .sum::<f64>()
+                * link_length;
+            (limits.angular_rate / max_angle).min(limits.speed / sweep)
+        }
+    }
+}
+
 /// The kind of a timed segment.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SegmentKind {
@@ -141,13 +165,16 @@ pub struct Segment {
 }
 
 /// Progress `s` from 0 to 1 along a segment: a smoothstep speed ramp up to the cruise
-/// rate, the cruise, and the mirror ramp down.
+/// rate, the cruise, and a smoothstep ramp down (as long as the ramp up unless the
+/// segment is blended with the next, see `crate::trajectory`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Scaling {
     /// Cruise rate of `s` (1/s).
     pub rate: f64,
-    /// Duration of each ramp (s).
+    /// Duration of the ramp up (s).
     pub ramp: f64,
+    /// Duration of the ramp down (s).
+    pub ramp_down: f64,
     /// Duration of the whole segment (s).
     pub duration: f64,
 }
@@ -165,10 +192,17 @@ impl Scaling {
             (max_accel / RAMP_PEAK_ACCEL).sqrt()
         };
         let ramp = RAMP_PEAK_ACCEL * rate / max_accel;
+        Self::with_ramps(rate, ramp, ramp)
+    }
+
+    /// Cruise at `rate` with ramps of the given lengths (s); they must fit:
+    /// `rate * (up + down) / 2 <= 1`.
+    pub fn with_ramps(rate: f64, up: f64, down: f64) -> Self {
         Self {
             rate,
-            ramp,
-            duration: 1.0 / rate + ramp,
+            ramp: up,
+            ramp_down: down,
+            duration: 1.0 / rate + (up + down) / 2.0,
         }
     }
 
@@ -180,23 +214,24 @@ impl Scaling {
         if t <= 0.0 {
             return (0.0, 0.0, 0.0);
         }
-        if t > self.duration - self.ramp {
-            let (s, ds, dds) = self.ramp_up(self.duration - t);
+        if t > self.duration - self.ramp_down {
+            let (s, ds, dds) = self.ramp_up(self.ramp_down, self.duration - t);
             return (1.0 - s, ds, -dds);
         }
         if t < self.ramp {
-            return self.ramp_up(t);
+            return self.ramp_up(self.ramp, t);
         }
         let s = self.rate * self.ramp / 2.0 + self.rate * (t - self.ramp);
         (s, self.rate, 0.0)
     }
 
-    /// The ramp from rest: speed `rate * (3x^2 - 2x^3)` with `x = t / ramp`.
-    fn ramp_up(&self, t: f64) -> (f64, f64, f64) {
-        let x = t / self.ramp;
-        let s = self.rate * self.ramp * (x * x * x - 0.5 * x * x * x * x);
+    /// A ramp of length `ramp` from rest: speed `rate * (3x^2 - 2x^3)` with
+    /// `x = t / ramp`.
+    fn ramp_up(&self, ramp: f64, t: f64) -> (f64, f64, f64) {
+        let x = t / ramp;
+        let s = self.rate * ramp * (x * x * x - 0.5 * x * x * x * x);
         let ds = self.rate * x * x * (3.0 - 2.0 * x);
-        let dds = self.rate / self.ramp * 6.0 * x * (1.0 - x);
+        let dds = self.rate / ramp * 6.0 * x * (1.0 - x);
         (s, ds, dds)
     }
 }
@@ -283,11 +318,7 @@ impl Reference {
                 from: waypoints[0].clone(),
                 delta: vec![0.0; dim],
                 to_waypoint: 0,
-                scaling: Scaling {
-                    rate: 0.0,
-                    ramp: 0.0,
-                    duration: 0.0,
-                },
+                scaling: Scaling::default(),
             });
             t = limits.start_hold;
         }
@@ -311,22 +342,17 @@ impl Reference {
                     (SegmentKind::Hold, Scaling::default())
                 }
                 (true, false) => {
-                    let len = V3::new(delta[0], delta[1], delta[2]).norm();
-                    let scaling = Scaling::fastest(limits.speed / len, limits.accel / len);
                     delta[3..].iter_mut().for_each(|d| *d = 0.0);
+                    let len = V3::new(delta[0], delta[1], delta[2]).norm();
+                    let rate = max_rate(SegmentKind::Translation, link_length, &delta, limits);
+                    let scaling = Scaling::fastest(rate, limits.accel / len);
                     (SegmentKind::Translation, scaling)
                 }
                 (false, true) => {
-                    let max_angle = delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()));
-                    // Unit i moves at most at l * sum_{k<i} |d(dir_k)/ds| * ds/dt, and a
-                    // link direction moves at most at sqrt(dtheta^2 + dpsi^2).
-                    let sweep: f64 = (0..units - 1)
-                        .map(|k| (delta[4 + 2 * k].powi(2) + delta[5 + 2 * k].powi(2)).sqrt())
-                        .sum::<f64>()
-                        * link_length;
-                    let rate = (limits.angular_rate / max_angle).min(limits.speed / sweep);
-                    let scaling = Scaling::fastest(rate, limits.angular_accel / max_angle);
                     delta[..3].iter_mut().for_each(|d| *d = 0.0);
+                    let max_angle = delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()));
+                    let rate = max_rate(SegmentKind::ShapeChange, link_length, &delta, limits);
+                    let scaling = Scaling::fastest(rate, limits.angular_accel / max_angle);
                     (SegmentKind::ShapeChange, scaling)
                 }
             };
@@ -383,47 +409,145 @@ impl Reference {
 
     /// The configuration `zeta` at time `t` (the end after the last edge).
     pub fn zeta(&self, t: f64) -> Vec<f64> {
-        match self.segment_at(t) {
-            Some(seg) => {
-                let (s, _, _) = seg.progress(t - seg.t0);
-                seg.from
-                    .iter()
-                    .zip(&seg.delta)
-                    .map(|(a, d)| a + s * d)
-                    .collect()
+        self.state(t).0
+    }
+
+    /// The segments that shape the motion at time `t`, oldest first: the latest one
+    /// started and every earlier one still moving (two where a blend overlaps them).
+    /// Empty after the end.
+    fn active(&self, t: f64) -> &[Segment] {
+        if t >= self.duration {
+            return &[];
+        }
+        let last = self.segments.partition_point(|s| s.t0 <= t);
+        if last == 0 {
+            return &self.segments[..1.min(self.segments.len())];
+        }
+        let mut first = last - 1;
+        while first > 0 && t < self.segments[first - 1].t0 + self.segments[first - 1].duration {
+            first -= 1;
+        }
+        &self.segments[first..last]
+    }
+
+    /// `zeta` and its first and second time derivatives at `t`: the oldest active
+    /// segment's start plus the progress of every active one.
+    fn state(&self, t: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let active = self.active(t);
+        let n = self.end.len();
+        let Some(first) = active.first() else {
+            return (self.end.clone(), vec![0.0; n], vec![0.0; n]);
+        };
+        let (mut z, mut dz, mut ddz) = (first.from.clone(), vec![0.0; n], vec![0.0; n]);
+        for seg in active {
+            let (s, ds, dds) = seg.progress(t - seg.t0);
+            for (j, d) in seg.delta.iter().enumerate() {
+                z[j] += s * d;
+                dz[j] += ds * d;
+                ddz[j] += dds * d;
             }
-            None => self.end.clone(),
+        }
+        (z, dz, ddz)
+    }
+
+    /// A reference from timed segments that may overlap (a blend), each starting no
+    /// earlier than the one before it; every segment's start is re-based on the end of
+    /// the one before it, so that angles run on without jumps of a full turn.
+    pub(crate) fn from_segments(units: usize, start: &[f64], mut segments: Vec<Segment>) -> Self {
+        let mut at = start.to_vec();
+        let mut duration = 0.0f64;
+        for seg in &mut segments {
+            seg.from.clone_from(&at);
+            at.iter_mut().zip(&seg.delta).for_each(|(a, d)| *a += d);
+            duration = duration.max(seg.t0 + seg.duration);
+        }
+        Self {
+            units,
+            segments,
+            end: at,
+            duration,
         }
     }
 
-    fn segment_at(&self, t: f64) -> Option<&Segment> {
-        if t >= self.duration {
-            return None;
+    /// A reference that moves linearly in `zeta` between timed samples (a trajectory
+    /// file's, docs/model.md "Trajectories"; angles along their shortest signed
+    /// difference): the velocity is constant over each interval, the acceleration zero.
+    /// Times must increase; they are counted from the first sample.
+    pub fn from_samples(
+        units: usize,
+        times: &[f64],
+        zetas: &[Vec<f64>],
+    ) -> Result<Self, ReferenceError> {
+        let dim = 2 * units + 2;
+        let (Some(first), Some(&t0)) = (zetas.first(), times.first()) else {
+            return Err(ReferenceError::NoWaypoints);
+        };
+        for (i, z) in zetas.iter().enumerate() {
+            let later = i == 0
+                || times
+                    .get(i)
+                    .zip(times.get(i - 1))
+                    .is_some_and(|(a, b)| a > b);
+            if z.len() != dim || z.iter().any(|v| !v.is_finite()) || !later {
+                return Err(ReferenceError::Waypoint { index: i, dim });
+            }
         }
-        let i = self.segments.partition_point(|s| s.t0 <= t);
-        self.segments.get(i.saturating_sub(1))
+        let segments = zetas
+            .windows(2)
+            .zip(times.windows(2))
+            .enumerate()
+            .map(|(i, (z, t))| {
+                let delta: Vec<f64> = (0..dim)
+                    .map(|j| match j {
+                        0..3 => z[1][j] - z[0][j],
+                        _ => wrap(z[1][j] - z[0][j]),
+                    })
+                    .collect();
+                let h = t[1] - t[0];
+                Segment {
+                    kind: SegmentKind::Translation,
+                    t0: t[0] - t0,
+                    duration: h,
+                    from: z[0].clone(),
+                    delta,
+                    to_waypoint: i + 1,
+                    scaling: Scaling::with_ramps(1.0 / h, 0.0, 0.0),
+                }
+            })
+            .collect();
+        Ok(Self::from_segments(units, first, segments))
+    }
+
+    /// The same motion after `hold` seconds at rest at its start.
+    pub fn with_start_hold(&self, hold: f64) -> Self {
+        if hold <= 0.0 {
+            return self.clone();
+        }
+        let start = self.segments.first().map_or(&self.end, |s| &s.from);
+        let mut segments = vec![Segment {
+            kind: SegmentKind::Hold,
+            t0: 0.0,
+            duration: hold,
+            from: start.clone(),
+            delta: vec![0.0; self.end.len()],
+            to_waypoint: 0,
+            scaling: Scaling::default(),
+        }];
+        segments.extend(self.segments.iter().cloned().map(|mut s| {
+            s.t0 += hold;
+            s
+        }));
+        Self {
+            units: self.units,
+            segments,
+            end: self.end.clone(),
+            duration: self.duration + hold,
+        }
     }
 
     /// The reference at time `t` (clamped to `[0, duration]`: at rest before and after).
     pub fn sample(&self, t: f64) -> RefPoint {
-        let (z, dz, ddz) = match self.segment_at(t) {
-            Some(seg) => {
-                let (s, ds, dds) = seg.progress(t - seg.t0);
-                let z: Vec<f64> = seg
-                    .from
-                    .iter()
-                    .zip(&seg.delta)
-                    .map(|(a, d)| a + s * d)
-                    .collect();
-                let dz: Vec<f64> = seg.delta.iter().map(|d| d * ds).collect();
-                let ddz: Vec<f64> = seg.delta.iter().map(|d| d * dds).collect();
-                (z, dz, ddz)
-            }
-            None => {
-                let n = self.end.len();
-                (self.end.clone(), vec![0.0; n], vec![0.0; n])
-            }
-        };
+        let (z, dz, ddz) = self.state(t);
         let links = (0..self.units - 1)
             .map(|k| LinkRef {
                 pitch: z[4 + 2 * k],
@@ -544,6 +668,41 @@ mod tests {
             t += 0.001;
         }
         assert!((wrap(r.sample(r.duration()).links[0].yaw - (-3.0))).abs() < 1e-12);
+    }
+
+    #[test]
+    fn samples_are_flown_through_in_time() {
+        let lim = ReferenceLimits::default();
+        let w = [
+            zeta([0.0; 3], &[3.0, 0.0, 3.0, 0.0, 0.0]),
+            zeta([0.0; 3], &[-3.0, 0.2, -3.0, 0.0, 0.0]),
+            zeta([1.0, -1.0, 0.5], &[-3.0, 0.2, -3.0, 0.0, 0.0]),
+        ];
+        let r = Reference::new(3, 0.5, &w, &lim).unwrap();
+        let times: Vec<f64> = (0..=200)
+            .map(|j| 5.0 + j as f64 * r.duration() / 200.0)
+            .collect();
+        let zetas: Vec<Vec<f64>> = times.iter().map(|t| r.zeta(t - 5.0)).collect();
+        let s = Reference::from_samples(3, &times, &zetas).unwrap();
+        assert!((s.duration() - r.duration()).abs() < 1e-9);
+        for (t, z) in times.iter().zip(&zetas) {
+            let got = s.zeta(t - 5.0);
+            for (a, b) in got.iter().zip(z) {
+                assert!(wrap(a - b).abs() < 1e-9, "{t}: {a} vs {b}");
+            }
+        }
+        let mid = s.sample(0.5 * (times[100] + times[101]) - 5.0);
+        let dt = times[101] - times[100];
+        let (a, b) = (&zetas[100], &zetas[101]);
+        let chord = V3::new(b[0] - a[0], b[1] - a[1], b[2] - a[2]) / dt;
+        assert!(
+            (mid.v - chord).norm() < 1e-9,
+            "constant velocity between samples"
+        );
+        assert!(Reference::from_samples(3, &[], &[]).is_err());
+        let back = [times[1], times[0]];
+        assert!(Reference::from_samples(3, &back, &zetas[..2]).is_err());
+        assert!(Reference::from_samples(4, &times, &zetas).is_err());
     }
 
     #[test]

@@ -13,7 +13,28 @@ fn zeta(xi: [f64; 3], eta: &[f64]) -> Vec<f64> {
 }
 
 /// The default simulation, `min_time` seconds at least, with one `gust`.
-fn with_gust(gust: Gust, min_time: f64) -> SimConfig {
+/// The default settings, flying at least `min_time` s.
+fn flying_for(min_time: f64) -> SimConfig {
+    SimConfig {
+        min_time,
+        ..Default::default()
+    }
+}
+
+/// The default settings with one gust, flying at least `min_time` s: from `start`
+/// for `duration` s, `force` on `unit` (`None`: on every unit).
+fn with_gust(
+    (start, duration): (f64, f64),
+    unit: Option<usize>,
+    force: V3,
+    min_time: f64,
+) -> SimConfig {
+    let gust = Gust {
+        start,
+        duration,
+        unit,
+        force,
+    };
     SimConfig {
         min_time,
         gusts: vec![gust],
@@ -39,10 +60,7 @@ fn bent(n: usize) -> Vec<f64> {
 #[test]
 fn hover_equilibrium_holds() {
     let p = ChainParams::new(5);
-    let cfg = SimConfig {
-        min_time: 5.0,
-        ..Default::default()
-    };
+    let cfg = flying_for(5.0);
     let f = simulate(&p, &[zeta([1.0, 2.0, 3.0], &bent(5))], &cfg, None).unwrap();
     let r = &f.report;
     assert!(r.success(), "{r:?}");
@@ -117,13 +135,7 @@ fn a_gust_is_rejected() {
     // 2 N sideways and 1 N down on every unit for 0.5 s (about a fifth of each unit's
     // weight): the chain is pushed, then returns.
     let p = ChainParams::new(4);
-    let gust = Gust {
-        start: 2.0,
-        duration: 0.5,
-        unit: None,
-        force: V3::new(2.0, 1.0, -1.0),
-    };
-    let cfg = with_gust(gust, 8.0);
+    let cfg = with_gust((2.0, 0.5), None, V3::new(2.0, 1.0, -1.0), 8.0);
     let f = simulate(&p, &[zeta([0.0, 0.0, 2.0], &bent(4))], &cfg, None).unwrap();
     let r = &f.report;
     assert!(r.success(), "{r:?}");
@@ -152,13 +164,7 @@ fn a_steady_wind_is_rejected_without_offset() {
     // A constant 1.5 N push on the head from t = 1 s: the disturbance observer removes
     // the steady-state error the MPC alone would keep.
     let p = ChainParams::new(3);
-    let gust = Gust {
-        start: 1.0,
-        duration: 100.0,
-        unit: Some(0),
-        force: V3::new(1.5, 0.0, 0.0),
-    };
-    let cfg = with_gust(gust, 10.0);
+    let cfg = with_gust((1.0, 100.0), Some(0), V3::new(1.5, 0.0, 0.0), 10.0);
     let f = simulate(&p, &[zeta([0.0, 0.0, 2.0], &line(3))], &cfg, None).unwrap();
     let last = f.samples.last().unwrap();
     assert!(f.report.success(), "{:?}", f.report);
@@ -204,10 +210,7 @@ fn progress_counts_the_steps_flown() {
     use super::flight::{simulate_with_progress, Progress};
     use std::sync::atomic::Ordering;
     let p = ChainParams::new(3);
-    let cfg = SimConfig {
-        min_time: 1.0,
-        ..Default::default()
-    };
+    let cfg = flying_for(1.0);
     let progress = Progress::default();
     let f = simulate_with_progress(
         &p,
@@ -276,13 +279,7 @@ fn the_reported_clearance_is_the_every_step_minimum() {
     //    the chain 8 mm into the wall: a check scheduled by motion alone never fires.
     let mut turned = line(3);
     turned[0] = 1.0;
-    let gust = Gust {
-        start: 1.0,
-        duration: 5.0,
-        unit: None,
-        force: V3::new(0.0, -0.2, 0.0),
-    };
-    let cfg = with_gust(gust, 6.0);
+    let cfg = with_gust((1.0, 5.0), None, V3::new(0.0, -0.2, 0.0), 6.0);
     // 2. An ordinary flight along the wall, drifting towards it.
     let along = zeta([3.0, -0.004, 2.0], &line(3));
     let flights = [

@@ -202,7 +202,7 @@ pub fn plan_scenario(scenario: &str, units: u8, flags: &[&str], out: &Path) -> R
 /// that its head ends within 0.3 m of the goal; `label` names the case in failures.
 pub fn assert_verified_to_goal(
     sc: &aerial_chain::problem::scenarios::Scenario,
-    plan: &aerial_chain::plan::Plan,
+    plan: &aerial_chain::plan_file::Plan,
     label: &str,
 ) {
     let report = aerial_chain::collision::verify_plan(&sc.grid, plan);
@@ -219,13 +219,13 @@ pub fn plan_verified(
     units: u8,
     dir: &Path,
 ) -> (
-    aerial_chain::plan::Plan,
+    aerial_chain::plan_file::Plan,
     aerial_chain::problem::scenarios::Scenario,
 ) {
     let out = dir.join(format!("{scenario}-{units}.json"));
     plan_scenario(scenario, units, &[], &out)
         .unwrap_or_else(|e| panic!("{scenario} N={units}: no plan: {e}"));
-    let plan = aerial_chain::plan::Plan::read(&out).expect("plan file reads back");
+    let plan = aerial_chain::plan_file::Plan::read(&out).expect("plan file reads back");
     let sc = aerial_chain::problem::scenarios::build(scenario).expect("scenario");
     assert_verified_to_goal(&sc, &plan, &format!("{scenario} N={units}"));
     (plan, sc)

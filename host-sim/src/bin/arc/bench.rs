@@ -1,6 +1,6 @@
 //! `arc bench`: the paper's evaluation, the scaling study, and single full-state PRM plans.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use clap::{Args, Subcommand};
@@ -8,7 +8,9 @@ use clap::{Args, Subcommand};
 use super::checks;
 use super::common::{write_plan, ProblemArgs};
 use super::{CliError, CliResult};
-use crate::study::{self, paper, robust, scale};
+use crate::study::paper::PaperOptions;
+use crate::study::scale::ScaleOptions;
+use crate::study::{self, paper, robust, scale, Budgets, RunResult, RunSpec, Summary};
 use aerial_chain::baseline::{FullStatePrm, PrmError, PrmSettings};
 use aerial_chain::collision::{verify_plan, DEFAULT_CLEARANCE};
 use aerial_chain::planner::{to_plan, Planner, Termination};
@@ -27,6 +29,11 @@ pub enum BenchCommand {
     /// Robustness on the hard-case family (`passage:`): random instances with
     /// witnesses, N = 4..8, `arc plan`'s defaults; CSV, markdown and a plot.
     Robust(RobustArgs),
+    /// Flight time of the planner's plans (window, maze, silos, corridor; N = 4..6):
+    /// stopping at every waypoint against the blended trajectory, simulated; CSV,
+    /// markdown and a plot of flight time against head path / speed.
+    #[command(after_help = "Example:\n  arc bench flight --seeds 2 --out-dir out/flight")]
+    Flight(FlightArgs),
     /// One plan by the full-state lazy PRM baseline (arc-plan/1, verified exactly).
     #[command(
         after_help = "Example:\n  arc bench prm --scenario window --units 4 --vertices 15000 --out prm.json"
@@ -117,6 +124,27 @@ pub struct RobustArgs {
     threads: Option<usize>,
 }
 
+/// `arc bench flight`
+#[derive(Args, Debug)]
+pub struct FlightArgs {
+    /// Scenarios, comma-separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "window,maze,silos,corridor"
+    )]
+    scenarios: Vec<String>,
+    /// Chain sizes, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "4,5,6")]
+    units: Vec<u8>,
+    /// Seeds per scenario and size (1, 2, ...).
+    #[arg(long, default_value_t = 2)]
+    seeds: u64,
+    /// Where CSV, markdown and the plot go.
+    #[arg(long, default_value = "bench-out")]
+    out_dir: PathBuf,
+}
+
 /// `arc bench prm`
 #[derive(Args, Debug)]
 pub struct PrmArgs {
@@ -191,11 +219,27 @@ fn check_study(a: &StudyArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-fn time_limit(a: &StudyArgs, default: Option<f64>) -> Option<f64> {
-    match a.time_limit {
-        Some(0.0) => None,
-        Some(t) => Some(t),
-        None => default,
+/// A study's defaults: its smoke run's with `--quick`, else the full study's.
+fn defaults<O>(a: &StudyArgs, quick: fn() -> O, full: fn() -> O) -> O {
+    if a.quick {
+        quick()
+    } else {
+        full()
+    }
+}
+
+/// The study's budgets: `base`, with what the command line sets instead (a time limit
+/// of 0: none).
+fn budgets(a: &StudyArgs, base: Budgets) -> Budgets {
+    Budgets {
+        seeds: a.seeds.unwrap_or(base.seeds),
+        vertices: a.vertices.unwrap_or(base.vertices),
+        srs: a.srs.unwrap_or(base.srs),
+        time_limit: match a.time_limit {
+            Some(0.0) => None,
+            Some(t) => Some(t),
+            None => base.time_limit,
+        },
     }
 }
 
@@ -232,24 +276,46 @@ fn meta(a: &StudyArgs, runs: usize) -> String {
     )
 }
 
-fn write(dir: &std::path::Path, name: &str, text: &[u8]) -> Result<PathBuf, CliError> {
-    study::write_out(dir, name, text).map_err(CliError::input)
+/// Runs a study's `specs` (`what` names it in the progress display) and groups the
+/// results; also gives the report's header line, with the study's wall time.
+fn run_study(
+    a: &StudyArgs,
+    specs: &[RunSpec],
+    what: &str,
+) -> Result<(Vec<RunResult>, Vec<Summary>, String), CliError> {
+    let envs = study::Envs::for_specs(specs)?;
+    let t = Instant::now();
+    let results = study::run_all(&envs, specs, a.threads, what, true)?;
+    let sums = study::summarize(&results);
+    let header = format!(
+        "{} Wall time of the whole study: {:.0} s.",
+        meta(a, specs.len()),
+        t.elapsed().as_secs_f64()
+    );
+    Ok((results, sums, header))
+}
+
+/// Writes each `(name, bytes)` of `files` into `dir`, then prints the report `md` and
+/// where every file went.
+fn publish(dir: &Path, md: &str, files: &[(&str, &[u8])]) -> CliResult {
+    let mut written = Vec::new();
+    for (name, bytes) in files {
+        written.push(study::write_out(dir, name, bytes)?);
+    }
+    println!("{md}");
+    for f in written {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
 }
 
 fn run_paper(a: PaperArgs) -> CliResult {
     check_study(&a.study)?;
-    let base = if a.study.quick {
-        paper::PaperOptions::quick()
-    } else {
-        paper::PaperOptions::full()
-    };
-    let o = paper::PaperOptions {
-        seeds: a.study.seeds.unwrap_or(base.seeds),
-        vertices: a.study.vertices.unwrap_or(base.vertices),
-        srs: a.study.srs.unwrap_or(base.srs),
+    let base = defaults(&a.study, PaperOptions::quick, PaperOptions::full);
+    let o = PaperOptions {
+        budgets: budgets(&a.study, base.budgets),
         prm_vertices: a.prm_vertices.clone().unwrap_or(base.prm_vertices),
         prm_units: a.prm_units.clone().unwrap_or(base.prm_units),
-        time_limit: time_limit(&a.study, base.time_limit),
         tables: a.tables.clone().unwrap_or(base.tables),
         wide_windows: match &a.wide_window {
             Some(v) if v.as_slice() == [0.0] => Vec::new(),
@@ -284,48 +350,23 @@ fn run_paper(a: PaperArgs) -> CliResult {
         )));
     }
     let specs = paper::specs(&o);
-    let envs = study::Envs::for_specs(&specs).map_err(CliError::input)?;
-    let t = Instant::now();
-    let results = study::run_all(&envs, &specs, a.study.threads, "arc bench paper", true)
-        .map_err(CliError::input)?;
-    let sums = study::summarize(&results);
-    let md = paper::markdown(
-        &sums,
-        &o,
-        &format!(
-            "{} Wall time of the whole study: {:.0} s.",
-            meta(&a.study, specs.len()),
-            t.elapsed().as_secs_f64()
-        ),
-    );
-    let dir = &a.study.out_dir;
-    let files = [
-        write(dir, "paper_runs.csv", study::runs_csv(&results).as_bytes())?,
-        write(
-            dir,
-            "paper_summary.csv",
-            study::summary_csv(&sums).as_bytes(),
-        )?,
-        write(dir, "paper.md", md.as_bytes())?,
+    let (results, sums, header) = run_study(&a.study, &specs, "arc bench paper")?;
+    let md = paper::markdown(&sums, &o, &header);
+    let (runs, summary) = (study::runs_csv(&results), study::summary_csv(&sums));
+    let files: [(&str, &[u8]); 3] = [
+        ("paper_runs.csv", runs.as_bytes()),
+        ("paper_summary.csv", summary.as_bytes()),
+        ("paper.md", md.as_bytes()),
     ];
-    println!("{md}");
-    for f in files {
-        println!("wrote {}", f.display());
-    }
-    Ok(())
+    publish(&a.study.out_dir, &md, &files)
 }
 
 fn run_scale(a: ScaleArgs) -> CliResult {
     check_study(&a.study)?;
-    let base = if a.study.quick {
-        scale::ScaleOptions::quick()
-    } else {
-        scale::ScaleOptions::full()
-    };
-    let o = scale::ScaleOptions {
-        seeds: a.study.seeds.unwrap_or(base.seeds),
+    let base = defaults(&a.study, ScaleOptions::quick, ScaleOptions::full);
+    let o = ScaleOptions {
+        budgets: budgets(&a.study, base.budgets),
         units: a.units.clone().unwrap_or(base.units),
-        vertices: a.study.vertices.unwrap_or(base.vertices),
         lengths: a.lengths.clone().unwrap_or(base.lengths),
         corridor_units: base.corridor_units,
         corridor_vertices_per_m: match a.corridor_density {
@@ -333,8 +374,6 @@ fn run_scale(a: ScaleArgs) -> CliResult {
             Some(d) => Some(d),
             None => base.corridor_vertices_per_m,
         },
-        srs: a.study.srs.unwrap_or(base.srs),
-        time_limit: time_limit(&a.study, base.time_limit),
     };
     if let Some(n) = o.units.iter().find(|n| !(2..=16).contains(*n)) {
         return Err(CliError::input(format!(
@@ -354,42 +393,21 @@ fn run_scale(a: ScaleArgs) -> CliResult {
             ));
         }
     }
-    let (specs, starts) = scale::specs(&o).map_err(CliError::input)?;
-    let envs = study::Envs::for_specs(&specs).map_err(CliError::input)?;
-    let t = Instant::now();
-    let results = study::run_all(&envs, &specs, a.study.threads, "arc bench scale", true)
-        .map_err(CliError::input)?;
-    let sums = study::summarize(&results);
-    let md = scale::markdown(
-        &sums,
-        &o,
-        &starts,
-        &format!(
-            "{} Wall time of the whole study: {:.0} s.",
-            meta(&a.study, specs.len()),
-            t.elapsed().as_secs_f64()
-        ),
-    );
+    let (specs, starts) = scale::specs(&o)?;
+    let (results, sums, header) = run_study(&a.study, &specs, "arc bench scale")?;
+    let md = scale::markdown(&sums, &o, &starts, &header);
     let svg = scale::figure(&sums, o.corridor_units);
     let png =
         aerial_chain::picture::rasterise(&svg).map_err(|e| CliError::failed(e.to_string()))?;
-    let dir = &a.study.out_dir;
-    let files = [
-        write(dir, "scale_runs.csv", study::runs_csv(&results).as_bytes())?,
-        write(
-            dir,
-            "scale_summary.csv",
-            study::summary_csv(&sums).as_bytes(),
-        )?,
-        write(dir, "scale.md", md.as_bytes())?,
-        write(dir, "scale.svg", svg.as_bytes())?,
-        write(dir, "scale.png", &png)?,
+    let (runs, summary) = (study::runs_csv(&results), study::summary_csv(&sums));
+    let files: [(&str, &[u8]); 5] = [
+        ("scale_runs.csv", runs.as_bytes()),
+        ("scale_summary.csv", summary.as_bytes()),
+        ("scale.md", md.as_bytes()),
+        ("scale.svg", svg.as_bytes()),
+        ("scale.png", &png),
     ];
-    println!("{md}");
-    for f in files {
-        println!("wrote {}", f.display());
-    }
-    Ok(())
+    publish(&a.study.out_dir, &md, &files)
 }
 
 /// Checks every option of `arc bench prm` before any work (docs/promises.md).
@@ -441,7 +459,7 @@ fn run_robust(a: RobustArgs) -> CliResult {
         specs.len(),
         t.elapsed().as_secs_f64()
     );
-    let results = robust::run(&specs, a.threads, 10).map_err(CliError::input)?;
+    let results = robust::run(&specs, a.threads, 10)?;
     let md = robust::markdown(
         &results,
         redrawn,
@@ -453,11 +471,64 @@ fn run_robust(a: RobustArgs) -> CliResult {
         ),
     );
     let svg = robust::figure(&results);
-    let dir = &a.out_dir;
+    let runs = study::runs_csv(&results);
+    let files: [(&str, &[u8]); 3] = [
+        ("robust_runs.csv", runs.as_bytes()),
+        ("robust.md", md.as_bytes()),
+        ("robust.svg", svg.as_bytes()),
+    ];
+    publish(&a.out_dir, &md, &files)
+}
+
+fn run_flight(a: FlightArgs) -> CliResult {
+    checks::count("--seeds", a.seeds as usize, 1, 1000, "seeds")?;
+    for n in &a.units {
+        checks::count("--units", *n as usize, 2, 16, "units")?;
+    }
+    for s in &a.scenarios {
+        aerial_chain::problem::scenarios::build(s).map_err(|e| CliError::input(e.to_string()))?;
+    }
+    let speed = aerial_chain::trajectory::Limits::default().speed;
+    let t = Instant::now();
+    let mut runs = Vec::new();
+    for sc in &a.scenarios {
+        for &n in &a.units {
+            for seed in 1..=a.seeds {
+                let r = study::flight::run_one(sc, n, seed);
+                eprintln!(
+                    "{sc} N = {n} seed {seed}: path {:.1} m, stop-go {:.1} s, trajectory {:.1} s ({} of {} corners blended, {} merged, made in {:.0} ms){}",
+                    r.head_path_m,
+                    r.before.map_or(f64::NAN, |f| f.time_s),
+                    r.after.map_or(f64::NAN, |f| f.time_s),
+                    r.blended,
+                    r.corners,
+                    r.merged,
+                    r.trajectory_s * 1e3,
+                    if r.error.is_empty() { String::new() } else { format!(": {}", r.error) }
+                );
+                runs.push(r);
+            }
+        }
+    }
+    let md = format!(
+        "{}\nMedians over seeds 1..={}; flight time from the start of the flight (1 s hold included) to arrival; {} build; whole study {:.0} s.\n",
+        study::flight::markdown(&runs, speed),
+        a.seeds,
+        if cfg!(debug_assertions) { "debug" } else { "release" },
+        t.elapsed().as_secs_f64()
+    );
     let files = [
-        write(dir, "robust_runs.csv", study::runs_csv(&results).as_bytes())?,
-        write(dir, "robust.md", md.as_bytes())?,
-        write(dir, "robust.svg", svg.as_bytes())?,
+        study::write_out(
+            &a.out_dir,
+            "flight_runs.csv",
+            study::flight::csv(&runs, speed).as_bytes(),
+        )?,
+        study::write_out(&a.out_dir, "flight.md", md.as_bytes())?,
+        study::write_out(
+            &a.out_dir,
+            "flight.svg",
+            study::flight::figure(&runs, speed).as_bytes(),
+        )?,
     ];
     println!("{md}");
     for f in files {
@@ -468,10 +539,7 @@ fn run_robust(a: RobustArgs) -> CliResult {
 
 fn run_prm(a: PrmArgs) -> CliResult {
     let time_limit = check_prm(&a)?;
-    let (loaded, params, query) = a.problem.load()?;
-    let grid = loaded.grid.clone();
-    let source = loaded.source.clone();
-    let ctx = loaded.into_context(params, a.clearance)?;
+    let (ctx, params, query, source) = a.problem.context(a.clearance)?;
     let settings = PrmSettings {
         vertices: a.vertices,
         k: a.k,
@@ -490,7 +558,7 @@ fn run_prm(a: PrmArgs) -> CliResult {
                 "no plan: {e} (roadmap {} vertices, {} edges, built in {:.1} ms{})",
                 r.vertices,
                 r.graph_edges,
-                r.roadmap_s * 1e3,
+                r.timings.roadmap_s * 1e3,
                 if r.build_capped {
                     ", cut by the time limit"
                 } else {
@@ -499,9 +567,10 @@ fn run_prm(a: PrmArgs) -> CliResult {
             ))
         }
     })?;
+    let grid = prm.context().field().grid();
     let mut plan = to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
     plan.map.source = source;
-    let report = verify_plan(&grid, &plan);
+    let report = verify_plan(grid, &plan);
     let s = &sol.stats;
     let lines = write_plan(
         &plan,
@@ -515,15 +584,15 @@ fn run_prm(a: PrmArgs) -> CliResult {
     )?;
     lines.line(format_args!(
         "  roadmap {:.1} ms ({} vertices, k = {}, {} edges), planning {:.1} ms ({} lazy searches, {} edges checked, {} blocked; {:.1} ms in checks)",
-        s.roadmap_s * 1e3,
+        s.timings.roadmap_s * 1e3,
         s.vertices,
         s.k,
         s.graph_edges,
-        s.planning_s * 1e3,
+        s.timings.planning_s * 1e3,
         s.iterations,
         s.edges_checked,
         s.edges_blocked,
-        s.collision_s * 1e3
+        s.timings.collision_s * 1e3
     ));
     if report.ok {
         lines.line(format_args!("  exact verification: ok"));
@@ -545,6 +614,7 @@ pub fn run(c: BenchCommand) -> CliResult {
         BenchCommand::Paper(a) => run_paper(a),
         BenchCommand::Scale(a) => run_scale(a),
         BenchCommand::Robust(a) => run_robust(a),
+        BenchCommand::Flight(a) => run_flight(a),
         BenchCommand::Prm(a) => run_prm(*a),
     }
 }

@@ -13,7 +13,7 @@ use aerial_chain::collision::CollisionContext;
 use aerial_chain::map::DistanceField;
 use aerial_chain::map::Grid;
 use aerial_chain::map::OcTree;
-use aerial_chain::plan::{MapSource, Plan};
+use aerial_chain::plan_file::{MapSource, Plan};
 use aerial_chain::planner::Query;
 use aerial_chain::problem::scenarios::{self, Scenario};
 
@@ -110,7 +110,8 @@ pub struct MapArgs {
         required_unless_present = "scenario"
     )]
     pub map: Option<PathBuf>,
-    /// Built-in scenario: window, maze, silos, corridor or corridor:LENGTH.
+    /// Built-in scenario: window, maze, silos, corridor, corridor:LENGTH, passage:KEY=VALUE,...
+    /// or the large generated maps campus, campus:RES, hall and hall:RES.
     #[arg(long)]
     pub scenario: Option<String>,
     /// Treat unknown space as free (the default treats it as occupied).
@@ -121,7 +122,7 @@ pub struct MapArgs {
 /// Why a plan cannot be trusted under the user's assumptions: it was made with
 /// unknown space free, and the user did not say `--unknown-free`. The checker's
 /// assumptions come from the person running it, never from the file under test.
-pub fn looser_assumption(plan: &aerial_chain::plan::Plan, map: &MapArgs) -> Option<String> {
+pub fn looser_assumption(plan: &aerial_chain::plan_file::Plan, map: &MapArgs) -> Option<String> {
     (!plan.map.unknown_is_occupied && !map.unknown_free).then(|| {
         "the plan was made with unknown space free (map.unknown_is_occupied: false), \
          but it is checked with unknown space occupied; give --unknown-free to check it \
@@ -245,6 +246,19 @@ impl ProblemArgs {
                 .resolve(&self.chain, loaded.scenario.as_ref(), self.goal_tol)?;
         Ok((loaded, params, query))
     }
+
+    /// Loads the problem ([`Self::load`]) for a planner: the collision context at
+    /// `clearance` (the map inside it), the chain, the query, and the map as plans
+    /// record it.
+    pub fn context(
+        &self,
+        clearance: f64,
+    ) -> Result<(CollisionContext, ChainParams, Query, MapSource), CliError> {
+        let (loaded, params, query) = self.load()?;
+        let source = loaded.source.clone();
+        let ctx = loaded.into_context(params, clearance)?;
+        Ok((ctx, params, query, source))
+    }
 }
 
 /// Writes `plan` to `out` and opens the report that follows it with a line naming the
@@ -304,11 +318,11 @@ impl QueryArgs {
         let params = chain.params(units)?;
         let start = self
             .start
-            .or(sc.map(|s| s.start))
+            .or(sc.map(|s| s.start.into()))
             .ok_or_else(|| CliError::input("--start is required with --map"))?;
         let goal = self
             .goal
-            .or(sc.map(|s| s.goal))
+            .or(sc.map(|s| s.goal.into()))
             .ok_or_else(|| CliError::input("--goal is required with --map"))?;
         if let Some(d) = self.start_yaw_deg {
             // The shape holds angles as f32.
@@ -327,9 +341,9 @@ impl QueryArgs {
             .unwrap_or(0.0);
         let shape = start_shape(&params, &self.start_shape, yaw as f32)?;
         let query = Query {
-            start,
+            start: start.into(),
             start_shape: shape,
-            goal,
+            goal: goal.into(),
             goal_tol,
         };
         Ok((params, query))
@@ -358,8 +372,9 @@ pub fn start_shape(params: &ChainParams, name: &str, yaw: f32) -> Result<Shape, 
 /// messages, and its chain's parameters.
 pub fn read_plan(
     path: &std::path::Path,
-) -> Result<(aerial_chain::plan::Plan, String, ChainParams), CliError> {
-    let plan = aerial_chain::plan::Plan::read(path).map_err(|e| CliError::input(e.to_string()))?;
+) -> Result<(aerial_chain::plan_file::Plan, String, ChainParams), CliError> {
+    let plan =
+        aerial_chain::plan_file::Plan::read(path).map_err(|e| CliError::input(e.to_string()))?;
     let name = crate::fsutil::input_name(path);
     let params = plan
         .check()

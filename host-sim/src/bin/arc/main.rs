@@ -18,6 +18,7 @@ mod plan;
 mod sim;
 mod study;
 mod tables;
+mod trajectory;
 mod verify;
 mod view;
 
@@ -95,9 +96,17 @@ enum Command {
         after_help = "Example:\n  arc plan --scenario window --units 5 --out window.json --picture window.svg"
     )]
     Plan(Box<plan::PlanArgs>),
-    /// Check a plan exactly against a map (docs/model.md), independent of the planner.
-    #[command(after_help = "Example:\n  arc verify --scenario window --plan window.json")]
+    /// Check a plan or a trajectory exactly against a map (docs/model.md), independent
+    /// of the planner.
+    #[command(
+        after_help = "Examples:\n  arc verify --scenario window --plan window.json\n  arc verify --scenario window --trajectory window-t.json"
+    )]
     Verify(verify::VerifyArgs),
+    /// Time a plan into a trajectory that blends through its corners (CSV or JSON).
+    #[command(
+        after_help = "Example:\n  arc trajectory --scenario window --plan window.json --out window-t.json"
+    )]
+    Trajectory(trajectory::TrajectoryArgs),
     /// Maps: export built-in scenarios as OctoMap files, inspect and draw maps.
     #[command(subcommand, after_help = "Example:\n  arc map info maps/geb079.bt")]
     Map(map::MapCommand),
@@ -179,6 +188,7 @@ where
         Command::Shapes(a) => tables::run_shapes(a),
         Command::Plan(a) => plan::run(*a),
         Command::Verify(a) => verify::run(a),
+        Command::Trajectory(a) => trajectory::run(a),
         Command::Map(c) => map::run(c),
         Command::Bench(c) => bench::run(c),
         Command::Sim(a) => sim::run(a),

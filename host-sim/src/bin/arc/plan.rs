@@ -9,6 +9,7 @@ use clap::Args;
 
 use super::checks;
 use super::common::{write_plan, ProblemArgs, Report};
+use super::trajectory::TimingArgs;
 use super::{CliError, CliResult};
 use aerial_chain::collision::DEFAULT_CLEARANCE;
 use aerial_chain::planner::{
@@ -93,6 +94,12 @@ pub struct PlanArgs {
     /// Picture of the plan (.svg or .png).
     #[arg(long)]
     picture: Option<PathBuf>,
+    /// Also write the plan's timed trajectory (CSV when the name ends in .csv, else
+    /// JSON, arc-trajectory/1), checked exactly on the map.
+    #[arg(long)]
+    trajectory: Option<PathBuf>,
+    #[command(flatten)]
+    timing: TimingArgs,
 }
 
 /// Smallest follow-the-leader step (m) other than 0 (off).
@@ -149,6 +156,13 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
     checks::length("--clearance-min", a.clearance_min, false)?;
     checks::time_limit(a.time_limit)?;
     checks::srs(a.srs)?;
+    a.timing.settings()?;
+    let stdout = |p: &std::path::Path| crate::fsutil::is_stdio(p);
+    if stdout(&a.out) && a.trajectory.as_deref().is_some_and(stdout) {
+        return Err(CliError::input(
+            "--out - and --trajectory - would both write to standard output: name a file for one",
+        ));
+    }
     checks::optional_picture("--picture", a.picture.as_ref())
 }
 
@@ -192,11 +206,10 @@ pub fn run(a: PlanArgs) -> CliResult {
     // Setup (map, distance field, shape tables) is timed apart: the time limit
     // covers what follows it (docs/promises.md).
     let setup = Instant::now();
-    let (loaded, params, query) = a.problem.load()?;
+    let (ctx, params, query, source) = a.problem.context(a.clearance)?;
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
-    let (resolution, unknown_occ) = (loaded.grid.resolution(), loaded.grid.unknown_is_occupied());
-    let source = loaded.source.clone();
-    let ctx = loaded.into_context(params, a.clearance)?;
+    let grid = ctx.field().grid();
+    let (resolution, unknown_occ) = (grid.resolution(), grid.unknown_is_occupied());
     let settings = Settings {
         vertices: a.vertices,
         r_t: a.r_t,
@@ -261,10 +274,10 @@ pub fn run(a: PlanArgs) -> CliResult {
     report.line(format_args!(
         "  setup {:.1} ms, roadmap {:.1} ms ({} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
         setup_s * 1e3,
-        s.roadmap_s * 1e3,
+        s.timings.roadmap_s * 1e3,
         s.roadmap_vertices,
-        s.planning_s * 1e3,
-        s.collision_s * 1e3,
+        s.timings.planning_s * 1e3,
+        s.timings.collision_s * 1e3,
         s.collision_checks
     ));
     print_quality(&report, &quality, refinement.as_ref());
@@ -283,13 +296,23 @@ pub fn run(a: PlanArgs) -> CliResult {
             s.lattice_s * 1e3
         ));
     }
+    if let Some(path) = &a.trajectory {
+        let grid = planner.context().field().grid();
+        let began = Instant::now();
+        let tr = super::trajectory::make(&plan, "the plan", grid, &a.timing.settings()?)?;
+        super::trajectory::write(&tr, &plan, path, &report)?;
+        report.line(format_args!(
+            "  trajectory made and checked in {:.1} ms",
+            began.elapsed().as_secs_f64() * 1e3
+        ));
+    }
     if let Some(pic) = &a.picture {
         let grid = planner.context().field().grid();
         aerial_chain::plan_picture::draw(
             grid,
             &plan,
             &format!("ARCplanner on {}", a.problem.map.name()),
-            Some(query.goal),
+            Some(query.goal.into()),
         )
         .save(pic)
         .map_err(|e| CliError::input(e.to_string()))?;

@@ -10,11 +10,18 @@ use serde::Serialize;
 
 use super::checks;
 use super::common::{looser_assumption, read_plan, MapArgs, Report};
+use super::trajectory::{read_trajectory, TimingArgs};
 use super::{CliError, CliResult};
+use aerial_chain::map::Grid;
+use aerial_chain::plan_file::Plan;
 use aerial_chain::sim::flight_svg;
+use aerial_chain::sim::Reference;
 use aerial_chain::sim::V3;
 use aerial_chain::sim::{footprint, MapClearance};
-use aerial_chain::sim::{simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig};
+use aerial_chain::sim::{
+    simulate_reference, simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig,
+};
+use aerial_chain::trajectory::{self, Trajectory, TrajectoryError};
 
 /// `arc sim`
 #[derive(Args, Debug)]
@@ -22,8 +29,16 @@ pub struct SimArgs {
     #[command(flatten)]
     map: MapArgs,
     /// The plan to fly (JSON, arc-plan/1); `-` reads it from standard input.
+    #[arg(
+        long,
+        required_unless_present = "trajectory",
+        conflicts_with = "trajectory"
+    )]
+    plan: Option<PathBuf>,
+    /// A trajectory to fly as it is (JSON, arc-trajectory/1), instead of a plan;
+    /// the chain moves linearly between its samples.
     #[arg(long)]
-    plan: PathBuf,
+    trajectory: Option<PathBuf>,
     /// Write the flight (report and recorded states) as JSON; `-` writes it to
     /// standard output.
     #[arg(long)]
@@ -34,15 +49,11 @@ pub struct SimArgs {
     /// Physics and control rate (Hz, at least 500).
     #[arg(long, default_value_t = 500.0)]
     rate: f64,
-    /// Largest speed of any unit on the plan's edges (m/s).
-    #[arg(long, default_value_t = 0.5)]
-    speed: f64,
-    /// Largest head acceleration on translations (m/s^2).
-    #[arg(long, default_value_t = 0.5)]
-    accel: f64,
-    /// Largest rate of any shape angle (degrees/s).
-    #[arg(long, default_value_t = 0.4f64.to_degrees())]
-    angular_rate_deg: f64,
+    /// How the plan is timed: by default a trajectory that blends through corners
+    /// where that is admissible (as `arc trajectory`); `--no-blend` stops at every
+    /// waypoint.
+    #[command(flatten)]
+    timing: TimingArgs,
     /// Distance of the head from the plan's last waypoint that counts as arrived (m).
     #[arg(long, default_value_t = 0.1)]
     goal_tol: f64,
@@ -130,9 +141,7 @@ fn check(a: &SimArgs) -> Result<(), CliError> {
     if !(a.rate.is_finite() && (500.0..=20_000.0).contains(&a.rate)) {
         return Err(checks::bad("--rate", a.rate, "between 500 and 20000 Hz"));
     }
-    checks::positive("--speed", a.speed)?;
-    checks::positive("--accel", a.accel)?;
-    checks::positive("--angular-rate-deg", a.angular_rate_deg)?;
+    a.timing.settings()?;
     checks::positive("--goal-tol", a.goal_tol)?;
     checks::positive("--settle-time", a.settle_time)?;
     if a.record_every == 0 {
@@ -145,23 +154,57 @@ fn check(a: &SimArgs) -> Result<(), CliError> {
 /// the map or itself.
 pub fn run(a: SimArgs) -> CliResult {
     check(&a)?;
-    let (plan, plan_name, params) = read_plan(&a.plan)?;
-    // The flight is judged under the user's assumption about unknown space, never the
-    // plan's: a plan made with looser assumptions fails (docs/model.md).
-    let looser = looser_assumption(&plan, &a.map);
-    let loaded = a.map.load()?;
     let cfg = sim_config(&a)?;
-    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
-    let obstacles = MapClearance::new(&loaded.grid, &params);
-    let flight = with_progress(|progress| {
-        simulate_with_progress(&params, &waypoints, &cfg, Some(&obstacles), progress)
-    })
-    .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
-    let r = &flight.report;
     // With `--out -` the flight is standard output; the report goes to standard error.
     let report = Report::new(a.out.as_deref().unwrap_or(Path::new("")));
     let say = |args: std::fmt::Arguments<'_>| report.line(args);
-    say_report(&say, &plan_name, plan.waypoints.len(), r);
+    let (plan_name, waypoints, params, looser, loaded, motion) = match (&a.plan, &a.trajectory) {
+        (Some(path), None) => {
+            let (plan, name, params) = read_plan(path)?;
+            // The flight is judged under the user's assumption about unknown space,
+            // never the plan's: a plan made with looser assumptions fails (docs/model.md).
+            let looser = looser_assumption(&plan, &a.map);
+            let loaded = a.map.load()?;
+            let motion = match timed(&a, &plan, &name, &loaded.grid, &say)? {
+                Some(tr) => Motion::Timed(tr.reference().clone()),
+                None => Motion::Waypoints(plan.waypoints.iter().map(|w| w.zeta.clone()).collect()),
+            };
+            (name, plan.waypoints.len(), params, looser, loaded, motion)
+        }
+        (None, Some(path)) => {
+            let (file, name, params) = read_trajectory(path)?;
+            let looser = (!file.map.unknown_is_occupied && !a.map.unknown_free).then(|| {
+                "the trajectory was made with unknown space free; fly it with --unknown-free"
+                    .to_string()
+            });
+            let loaded = a.map.load()?;
+            let r = Reference::from_samples(params.n(), &file.times(), &file.zetas())
+                .map_err(|e| CliError::input(format!("{name}: {e}")))?;
+            say(format_args!(
+                "  timing: the trajectory's own, {:.2} s",
+                r.duration()
+            ));
+            (
+                name,
+                file.samples.len(),
+                params,
+                looser,
+                loaded,
+                Motion::Timed(r),
+            )
+        }
+        _ => return Err(CliError::input("give --plan or --trajectory")),
+    };
+    let obstacles = MapClearance::new(&loaded.grid, &params);
+    let flight = with_progress(|progress| match &motion {
+        Motion::Timed(r) => simulate_reference(&params, r, &cfg, Some(&obstacles), progress),
+        Motion::Waypoints(w) => {
+            simulate_with_progress(&params, w, &cfg, Some(&obstacles), progress)
+        }
+    })
+    .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
+    let r = &flight.report;
+    say_report(&say, &plan_name, waypoints, r);
     if let Some(path) = &a.out {
         write_flight(path, &a, &plan_name, &flight)?;
         if !crate::fsutil::is_stdio(path) {
@@ -190,6 +233,50 @@ pub fn run(a: SimArgs) -> CliResult {
     )))
 }
 
+/// What is flown: a timed reference, or a plan's waypoints stopping at each.
+enum Motion {
+    Timed(Reference),
+    Waypoints(Vec<Vec<f64>>),
+}
+
+/// The trajectory to fly: made from the plan and checked exactly on the map, unless
+/// `--no-blend` asks for the stop at every waypoint; a plan that is not admissible as
+/// a trajectory is flown stopping at every waypoint, and the report says why.
+fn timed(
+    a: &SimArgs,
+    plan: &Plan,
+    plan_name: &str,
+    grid: &Grid,
+    say: &dyn Fn(std::fmt::Arguments<'_>),
+) -> Result<Option<Trajectory>, CliError> {
+    if a.timing.no_blend {
+        say(format_args!(
+            "  timing: stopping at every waypoint (--no-blend)"
+        ));
+        return Ok(None);
+    }
+    match trajectory::build(plan, grid, &a.timing.settings()?) {
+        Ok(tr) => {
+            say(format_args!(
+                "  timing: trajectory of {:.2} s ({:.2} s stopping at every waypoint), {} of {} corners blended, {} translations and shape changes merged",
+                tr.duration(),
+                tr.stop_go_duration(),
+                tr.blended(),
+                tr.corners(),
+                tr.merged()
+            ));
+            Ok(Some(tr))
+        }
+        Err(TrajectoryError::Inadmissible(v)) => {
+            say(format_args!(
+                "  timing: stopping at every waypoint: the plan is not admissible as a trajectory ({v})"
+            ));
+            Ok(None)
+        }
+        Err(e) => Err(super::trajectory::refused(e, plan_name)),
+    }
+}
+
 /// The simulation settings from the command line, checked.
 fn sim_config(a: &SimArgs) -> Result<SimConfig, CliError> {
     let gusts = a
@@ -204,9 +291,11 @@ fn sim_config(a: &SimArgs) -> Result<SimConfig, CliError> {
         gusts,
         ..Default::default()
     };
-    cfg.limits.speed = a.speed;
-    cfg.limits.accel = a.accel;
-    cfg.limits.angular_rate = a.angular_rate_deg.to_radians();
+    let limits = a.timing.limits.limits()?;
+    cfg.limits.speed = limits.speed;
+    cfg.limits.accel = limits.accel;
+    cfg.limits.angular_rate = limits.angular_rate;
+    cfg.limits.angular_accel = limits.angular_accel;
     cfg.validate()
         .map_err(|e| CliError::input(format!("simulation settings: {e}")))?;
     Ok(cfg)

@@ -1,14 +1,16 @@
 //! `arc verify`: the exact check of docs/model.md, independent of the planner.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
 
 use super::checks;
 use super::common::{looser_assumption, parse_point, MapArgs};
+use super::trajectory::{read_trajectory, LimitArgs};
 use super::{CliError, CliResult};
-use aerial_chain::collision::verify_plan;
-use aerial_chain::plan::Plan;
+use aerial_chain::collision::{verify_plan, VerifyOptions};
+use aerial_chain::plan_file::Plan;
+use aerial_chain::trajectory::check_samples;
 
 /// `arc verify`
 #[derive(Args, Debug)]
@@ -16,8 +18,18 @@ pub struct VerifyArgs {
     #[command(flatten)]
     map: MapArgs,
     /// The plan (JSON, arc-plan/1); `-` reads it from standard input.
+    #[arg(
+        long,
+        required_unless_present = "trajectory",
+        conflicts_with = "trajectory"
+    )]
+    plan: Option<PathBuf>,
+    /// A trajectory instead of a plan (JSON, arc-trajectory/1); `-` reads it from
+    /// standard input. Checked against the limits below, not the ones it records.
     #[arg(long)]
-    plan: PathBuf,
+    trajectory: Option<PathBuf>,
+    #[command(flatten)]
+    limits: LimitArgs,
     /// Where the plan must start (head x,y,z); a scenario has its own.
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     start: Option<[f64; 3]>,
@@ -42,18 +54,23 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// every edge is valid, and the plan starts and ends where asked.
 pub fn run(a: VerifyArgs) -> CliResult {
     checks::length("--goal-tol", a.goal_tol, false)?;
-    let plan = Plan::read(&a.plan).map_err(|e| CliError::input(e.to_string()))?;
+    let path = match (&a.plan, &a.trajectory) {
+        (Some(p), None) => p,
+        (None, Some(t)) => return run_trajectory(&a, t),
+        _ => return Err(CliError::input("give --plan or --trajectory")),
+    };
+    let plan = Plan::read(path).map_err(|e| CliError::input(e.to_string()))?;
     // What unknown space is comes from the command line only, never from the plan
     // under test (docs/model.md, Interpretations).
     let looser = looser_assumption(&plan, &a.map);
     let loaded = a.map.load()?;
     let sc = loaded.scenario.as_ref();
-    let start = a.start.or(sc.map(|s| s.start));
-    let goal = a.goal.or(sc.map(|s| s.goal));
+    let start = a.start.or(sc.map(|s| s.start.into()));
+    let goal = a.goal.or(sc.map(|s| s.goal.into()));
     let report = verify_plan(&loaded.grid, &plan);
     println!(
         "{}: {} waypoints, {} edges ({} translations, {} shape changes), {} configurations checked exactly (unknown space {})",
-        crate::fsutil::input_name(&a.plan),
+        crate::fsutil::input_name(path),
         plan.waypoints.len(),
         report.edges.len(),
         report.edges.iter().filter(|e| **e == aerial_chain::collision::EdgeKind::Translation).count(),
@@ -83,32 +100,114 @@ pub fn run(a: VerifyArgs) -> CliResult {
     if let Some(why) = looser {
         return Err(CliError::failed(format!("INVALID: {why}")));
     }
-    let first = plan.waypoints[0].xi();
+    let last = plan.waypoints[plan.waypoints.len() - 1].xi();
+    ends_where_asked(
+        plan.waypoints[0].xi(),
+        last,
+        start,
+        goal,
+        a.goal_tol,
+        "waypoint 0",
+    )?;
+    if !report.ok {
+        return Err(CliError::failed("INVALID"));
+    }
+    println!("  VALID");
+    Ok(())
+}
+
+/// Checks that the head starts at `start` (within 1e-6 m) and ends within `tol` of
+/// `goal`, where given; `what` names the first configuration.
+fn ends_where_asked(
+    first: [f64; 3],
+    last: [f64; 3],
+    start: Option<[f64; 3]>,
+    goal: Option<[f64; 3]>,
+    tol: f64,
+    what: &str,
+) -> CliResult {
     if let Some(s) = start {
         if dist(first, s) > 1e-6 {
             return Err(CliError::failed(format!(
-                "INVALID: waypoint 0 head {} is not the start {}",
+                "INVALID: {what} head {} is not the start {}",
                 point(first),
                 point(s)
             )));
         }
     }
-    let last = plan.waypoints[plan.waypoints.len() - 1].xi();
     if let Some(g) = goal {
         let d = dist(last, g);
         // A NaN distance fails too.
-        if d.is_nan() || d > a.goal_tol {
+        if d.is_nan() || d > tol {
             return Err(CliError::failed(format!(
                 "INVALID: last head {} is {d:.3} m from the goal {} (tolerance {} m)",
                 point(last),
                 point(g),
-                a.goal_tol
+                tol
             )));
         }
     }
-    if !report.ok {
-        return Err(CliError::failed("INVALID"));
+    Ok(())
+}
+
+/// `arc verify --trajectory`: every limit at every sample and every configuration
+/// between samples exactly (docs/model.md, "Trajectories").
+fn run_trajectory(a: &VerifyArgs, path: &Path) -> CliResult {
+    let limits = a.limits.limits()?;
+    let (file, name, params) = read_trajectory(path)?;
+    let looser = (!file.map.unknown_is_occupied && !a.map.unknown_free).then(|| {
+        "the trajectory was made with unknown space free; check it with --unknown-free".to_string()
+    });
+    let loaded = a.map.load()?;
+    let sc = loaded.scenario.as_ref();
+    let (times, zetas) = (file.times(), file.zetas());
+    let rep = check_samples(
+        &loaded.grid,
+        &params,
+        &limits,
+        &times,
+        &zetas,
+        VerifyOptions::default().horizon,
+    );
+    println!(
+        "{name}: {} samples over {:.2} s, {} configurations checked exactly (unknown space {})",
+        times.len(),
+        times.last().copied().unwrap_or(0.0),
+        rep.configurations,
+        if loaded.grid.unknown_is_occupied() {
+            "occupied"
+        } else {
+            "free"
+        }
+    );
+    if file.map.source.differs_from(&loaded.source) {
+        println!(
+            "  note: the trajectory was made for {}; checked here against {}",
+            file.map.source, loaded.source
+        );
     }
+    let p = &rep.peaks;
+    println!(
+        "  peaks: speed {:.4} m/s, head acceleration {:.4} m/s^2, angle rate {:.4} rad/s, angular acceleration {:.4} rad/s^2",
+        p.speed, p.accel, p.angular_rate, p.angular_accel
+    );
+    if let Some((t, body)) = rep.min_clearance_at {
+        println!(
+            "  minimum clearance {:.4} m ({body} at t = {t:.3} s)",
+            rep.min_clearance
+        );
+    }
+    if let Some(v) = &rep.violation {
+        return Err(CliError::failed(format!("INVALID: {v}")));
+    }
+    if let Some(why) = looser {
+        return Err(CliError::failed(format!("INVALID: {why}")));
+    }
+    let head = |z: &[f64]| [z[0], z[1], z[2]];
+    let last = head(&zetas[zetas.len() - 1]);
+    let start = a.start.or(sc.map(|s| s.start.into()));
+    let goal = a.goal.or(sc.map(|s| s.goal.into()));
+    ends_where_asked(head(&zetas[0]), last, start, goal, a.goal_tol, "sample 0")?;
     println!("  VALID");
     Ok(())
 }

@@ -14,6 +14,13 @@
 //! `R`, and only where it does not are the obstacle cubes near the point measured one
 //! by one ([`exact_clearance`]). Points are 26-connected.
 //!
+//! Once per map, setup labels the free regions of a relaxed voxel set
+//! ([`Regions`]): a query whose start and goal lie in different regions is refused at
+//! once (no lattice route can exist), whatever the map's size. The same sweep builds a
+//! coarse graph of free-space pieces per block, and a Dijkstra over it from the goal
+//! ([`guide`]) gives the A* a heuristic that knows the way through doors, where the
+//! straight line would flood every room that faces the goal across a wall.
+//!
 //! A query is an A* from the lattice points next to the start to those next to the
 //! goal. Each step costs its length times `1 + w max(0, 1 - (c - r_u) / c_ref)`, `c`
 //! the clearance of the point it enters, plus a surcharge where `c` is below the
@@ -39,15 +46,19 @@
 
 mod clearance;
 mod flood;
+mod guide;
 mod nodes;
 mod pull;
+mod regions;
 mod search;
 #[cfg(test)]
 mod tests;
 
-pub use clearance::exact_clearance;
+pub use crate::collision::exact::exact_clearance;
+pub use regions::Regions;
 
 use crate::collision::{CollisionContext, FK_TOLERANCE};
+use crate::map::distance::DistanceField;
 use nodes::{KeyMap, Nodes};
 use search::{Limit, Search};
 
@@ -76,10 +87,15 @@ pub enum LatticeOutcome {
     /// Start and goal are in separate free regions of the lattice: no route exists for
     /// the head's sphere at the smallest clearance.
     Separated {
-        /// Which side's region was flooded completely ("start" or "goal").
+        /// Which side's region was measured whole ("start" or "goal").
         side: &'static str,
-        /// Lattice points visited.
-        visited: usize,
+        /// Its size, in `unit`s.
+        size: u64,
+        /// What `size` counts: "lattice points" (a flood) or "voxels" (the labelled
+        /// regions, [`Regions`]).
+        unit: &'static str,
+        /// Spacing of what was counted (m).
+        spacing: f64,
     },
     /// No free lattice point next to the start (or the goal): the lattice cannot say.
     NoAnchor {
@@ -124,6 +140,8 @@ pub struct HeadLattice {
     pub budget: usize,
     /// Expansions of the last strided search.
     searched: std::cell::Cell<Option<usize>>,
+    /// The map's free regions for the sphere of radius `r_min`, labelled on first use.
+    regions: std::sync::OnceLock<Regions>,
 }
 
 impl HeadLattice {
@@ -147,7 +165,60 @@ impl HeadLattice {
             weight,
             budget: 60_000_000,
             searched: std::cell::Cell::new(None),
+            regions: std::sync::OnceLock::new(),
         }
+    }
+
+    /// The map's free regions for the head's sphere ([`Regions`]), labelled on the
+    /// first call (part of the planner's setup: its cost follows the map's size).
+    pub fn regions(&self, field: &DistanceField) -> &Regions {
+        self.regions
+            .get_or_init(|| Regions::label(field, self.r_min))
+    }
+
+    /// [`LatticeOutcome::Separated`] when the labelled regions prove that no lattice
+    /// route joins `start` and `goal`; `None` when they cannot tell.
+    pub fn separation(
+        &self,
+        field: &DistanceField,
+        start: [f64; 3],
+        goal: [f64; 3],
+    ) -> Option<LatticeOutcome> {
+        let regions = self.regions(field);
+        let mut nodes = Nodes {
+            lat: self,
+            field,
+            map: KeyMap::default(),
+        };
+        let mut sides = [("start", start), ("goal", goal)].map(|(side, p)| {
+            let mut found: Vec<u32> = self
+                .anchors(&mut nodes, p, 1)
+                .into_iter()
+                .filter_map(|k| regions.region_of(self.voxel_of(k)))
+                .collect();
+            found.sort_unstable();
+            found.dedup();
+            (side, found)
+        });
+        if sides.iter().any(|(_, f)| f.is_empty())
+            || sides[0].1.iter().any(|r| sides[1].1.contains(r))
+        {
+            return None;
+        }
+        let total = |f: &[u32]| f.iter().map(|&r| regions.size(r)).sum::<u64>();
+        sides.sort_by_key(|(_, f)| total(f));
+        Some(LatticeOutcome::Separated {
+            side: sides[0].0,
+            size: total(&sides[0].1),
+            unit: "voxels",
+            spacing: 2.0 * self.h,
+        })
+    }
+
+    /// The voxel (local indices) whose closed cube holds lattice point `k`.
+    pub(super) fn voxel_of(&self, k: u64) -> [usize; 3] {
+        let i = Self::unpack(k);
+        [0, 1, 2].map(|a| ((i[a] / 2).min(self.n[a] / 2 - 1)).max(0) as usize)
     }
 
     /// Radius (m) of the sphere that must be free at lattice points: `r_u` plus the
@@ -230,7 +301,11 @@ impl HeadLattice {
             map: KeyMap::default(),
         };
         let mut expanded = 0;
-        match self.search(&mut nodes, start, goal, 2, &limit) {
+        let regions = self.regions(field);
+        let starts = self.anchors(&mut nodes, start, 1);
+        let goals = self.anchors(&mut nodes, goal, 1);
+        let guide = guide::Guide::new(self, regions, &starts, &goals, goal);
+        match self.search(&mut nodes, start, goal, 2, &limit, &guide) {
             Search::Found(keys, n) => {
                 return self.finish(ctx_min, &mut nodes, start, goal, keys, n)
             }
@@ -244,11 +319,16 @@ impl HeadLattice {
         for n in nodes.map.values_mut() {
             (n.g, n.parent, n.closed, n.flooded) = (f64::INFINITY, u64::MAX, false, false);
         }
-        match self.search(&mut nodes, start, goal, 1, &limit) {
+        match self.search(&mut nodes, start, goal, 1, &limit, &guide) {
             Search::Found(keys, n) => {
                 self.finish(ctx_min, &mut nodes, start, goal, keys, n + expanded)
             }
-            Search::Separated { side, visited } => LatticeOutcome::Separated { side, visited },
+            Search::Separated { side, visited } => LatticeOutcome::Separated {
+                side,
+                size: visited as u64,
+                unit: "lattice points",
+                spacing: self.h,
+            },
             Search::NoAnchor(side) => LatticeOutcome::NoAnchor { side },
             Search::Exhausted | Search::Budget => LatticeOutcome::Budget,
         }

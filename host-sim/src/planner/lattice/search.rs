@@ -5,6 +5,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use super::flood::Flood;
+use super::guide::Guide;
 use super::nodes::{KeySet, Nodes};
 use super::{dist, HeadLattice, HEURISTIC_WEIGHT, MAX_JUMP};
 
@@ -37,11 +38,11 @@ impl Limit {
     }
 }
 
-/// Open-list entry, lowest `f` first.
+/// Open-list entry, lowest `f` first (ties: the lower key).
 #[derive(PartialEq)]
-struct Open {
-    f: f64,
-    k: u64,
+pub(super) struct Open {
+    pub(super) f: f64,
+    pub(super) k: u64,
 }
 impl Eq for Open {}
 impl Ord for Open {
@@ -141,6 +142,7 @@ impl HeadLattice {
         goal: [f64; 3],
         stride: i64,
         limit: &Limit,
+        guide: &Guide<'_>,
     ) -> Search {
         let starts = self.anchors(nodes, start, stride);
         if starts.is_empty() {
@@ -160,7 +162,7 @@ impl HeadLattice {
             if c < n.g {
                 n.g = c;
                 open.push(Open {
-                    f: c + HEURISTIC_WEIGHT * dist(self.point(s), goal),
+                    f: c + HEURISTIC_WEIGHT * guide.estimate(s, self.point(s)),
                     k: s,
                 });
             }
@@ -224,7 +226,7 @@ impl HeadLattice {
                     nn.g = ng;
                     nn.parent = k;
                     open.push(Open {
-                        f: ng + HEURISTIC_WEIGHT * dist(pn, goal),
+                        f: ng + HEURISTIC_WEIGHT * guide.estimate(n, pn),
                         k: n,
                     });
                 }

@@ -39,15 +39,29 @@ fn wall_with_hole(g: &mut Grid, wx: i32, ys: std::ops::Range<i32>, zs: std::ops:
     }
 }
 
+/// A box of `dims` voxels at `res` with a wall at column `wx` holding the hole `ys`,
+/// `zs` (empty ranges: sealed), its context at clearance 0 and its lattice.
+fn walled(
+    res: f64,
+    dims: [usize; 3],
+    wx: std::ops::Range<i32>,
+    hole: [std::ops::Range<i32>; 2],
+) -> (CollisionContext, HeadLattice) {
+    let mut g = boxed(res, dims);
+    for x in wx {
+        wall_with_hole(&mut g, x, hole[0].clone(), hole[1].clone());
+    }
+    let c = ctx(g, 0.0);
+    let lat = HeadLattice::new(&c, 0.0, 2.0);
+    (c, lat)
+}
+
 #[test]
 fn a_passage_one_voxel_wide_is_found_where_uniform_samples_miss_it() {
     // 0.35 m voxels: a one-voxel hole leaves the head's centre (r 0.15 m, no
     // clearance) a 0.05 m x 0.05 m x 0.35 m tube in a 7 x 7 x 3.5 m box.
     let res = 0.35;
-    let mut g = boxed(res, [20, 20, 10]);
-    wall_with_hole(&mut g, 10, 10..11, 5..6);
-    let c = ctx(g, 0.0);
-    let lat = HeadLattice::new(&c, 0.0, 2.0);
+    let (c, lat) = walled(res, [20, 20, 10], 10..11, [10..11, 5..6]);
     let (a, b) = ([1.5, 1.5, 1.5], [5.5, 5.5, 1.5]);
     let LatticeOutcome::Found(r) = lat.route(&c, a, b) else {
         panic!("no route");
@@ -81,10 +95,7 @@ fn a_gap_two_voxels_wide_is_found_on_its_face_centred_line() {
     // 0.2 m voxels, a 2 x 2 voxel hole (0.4 m): the head (0.15 m) fits only
     // near the hole's centre, which is on voxel faces, not on voxel centres.
     let res = 0.2;
-    let mut g = boxed(res, [30, 20, 15]);
-    wall_with_hole(&mut g, 15, 9..11, 7..9);
-    let c = ctx(g, 0.0);
-    let lat = HeadLattice::new(&c, 0.0, 2.0);
+    let (c, lat) = walled(res, [30, 20, 15], 15..16, [9..11, 7..9]);
     let (a, b) = ([1.0, 2.0, 1.5], [5.0, 2.0, 1.5]);
     let centre = [2.0, 2.0, 1.6];
     // No voxel centre in the hole is free.
@@ -115,6 +126,54 @@ fn a_wall_without_an_opening_separates_the_regions() {
         LatticeOutcome::Separated { .. } => {}
         other => panic!("{other:?}"),
     }
+}
+
+#[test]
+fn labelled_regions_refuse_a_sealed_wall_and_keep_a_one_voxel_hole() {
+    let res = 0.35;
+    let (a, b) = ([1.5, 1.5, 1.5], [5.5, 5.5, 1.5]);
+    let (c, lat) = walled(res, [20, 20, 10], 10..11, [0..0, 0..0]);
+    match lat.separation(c.field(), a, b) {
+        Some(LatticeOutcome::Separated {
+            side, size, unit, ..
+        }) => {
+            assert_eq!(unit, "voxels");
+            // The smaller side: 8 x 18 x 8 free voxels behind the wall.
+            assert_eq!((side, size), ("goal", 8 * 18 * 8));
+        }
+        other => panic!("not separated: {other:?}"),
+    }
+    let (c, lat) = walled(res, [20, 20, 10], 10..11, [10..11, 5..6]);
+    assert_eq!(lat.separation(c.field(), a, b), None);
+}
+
+#[test]
+fn the_coarse_guide_leads_through_the_door_not_the_wall() {
+    // A 0.2 m wall across x at 2.0-2.2 m with a 0.6 m door at y 3.0-3.6 m; start and
+    // goal 2 m apart on either side of the wall, 2.5 m from the door.
+    let (c, lat) = walled(0.1, [40, 40, 20], 20..22, [30..36, 1..15]);
+    let (a, b) = ([1.0, 1.0, 1.0], [3.2, 1.0, 1.0]);
+    let mut nodes = Nodes {
+        lat: &lat,
+        field: c.field(),
+        map: KeyMap::default(),
+    };
+    let starts = lat.anchors(&mut nodes, a, 1);
+    let goals = lat.anchors(&mut nodes, b, 1);
+    let guide = super::guide::Guide::new(&lat, lat.regions(c.field()), &starts, &goals, b);
+    let door = [2.1, 3.3, 1.0];
+    let around = dist(a, door) + dist(door, b);
+    let h = guide.estimate(starts[0], lat.point(starts[0]));
+    // The way round (5.1 m), give or take a block, not the straight line (2.2 m).
+    assert!((h - around).abs() < 0.8, "estimate {h}, way round {around}");
+    // And the route takes the door.
+    let LatticeOutcome::Found(r) = lat.route(&c, a, b) else {
+        panic!("no route");
+    };
+    assert!(r
+        .points
+        .iter()
+        .any(|p| p[1] > 2.9 && (2.0..2.2).contains(&p[0])));
 }
 
 /// Reference: a breadth-first flood over the whole lattice with the same exact
@@ -184,6 +243,10 @@ proptest! {
         };
         let (a, b) = (pick(&mut rng), pick(&mut rng));
         let reference = flood_connects(&lat, &c, a, b);
+        // The labelled regions only ever prove what the flood confirms.
+        if let Some(sep) = lat.separation(c.field(), a, b) {
+            prop_assert_eq!(reference, Some(false), "regions said {:?}", sep);
+        }
         let got = lat.route(&c, a, b);
         match (reference, &got) {
             (None, LatticeOutcome::NoAnchor { .. }) => {}

@@ -80,8 +80,13 @@ fn start_and_goal_are_free() {
         let f = Arc::new(DistanceField::new(s.grid.clone()));
         let ctx = CollisionContext::new(f, p, DEFAULT_CLEARANCE).unwrap();
         let shape = s.start_shape(s.default_units).unwrap();
-        assert_eq!(ctx.check_config(s.start, &shape), Ok(()), "{}", s.name);
-        assert!(ctx.is_head_free(s.goal), "{}", s.name);
+        assert_eq!(
+            ctx.check_config(s.start.into(), &shape),
+            Ok(()),
+            "{}",
+            s.name
+        );
+        assert!(ctx.is_head_free(s.goal.into()), "{}", s.name);
     }
 }
 
@@ -128,7 +133,7 @@ fn scenarios_can_be_flown() {
             );
         }
         let last = plan.waypoints.last().unwrap().xi();
-        assert!(super::dist(last, s.goal) < 1e-9);
+        assert!(super::dist(last, s.goal.into()) < 1e-9);
     }
 }
 

@@ -16,14 +16,19 @@
 //! include some contention; both planners of a study run in the same batch, so their
 //! ratio is fair.
 
+mod error;
+pub mod flight;
 pub mod paper;
 pub mod plot;
 mod report;
 pub mod robust;
 pub mod scale;
+mod spec;
 mod statistics;
 
+pub use error::StudyError;
 pub use report::{fmt_ms, ms, runs_csv, summary_csv, write_out};
+pub use spec::{ArcMode, Budgets, Method, RunKey, RunSpec};
 pub use statistics::{summarize, Spread, Summary};
 
 use std::collections::BTreeMap;
@@ -40,100 +45,13 @@ use aerial_chain::baseline::{FullStatePrm, PrmError, PrmSettings};
 use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use aerial_chain::map::DistanceField;
 use aerial_chain::planner::{
-    to_plan, ArcPlanner, Failure, Mode, Planner, Settings, Solution, SolutionStats, Termination,
+    to_plan, ArcPlanner, Failure, Planner, Settings, Solution, SolutionStats, Termination,
 };
 use aerial_chain::problem::scenarios::{self, Scenario};
 use aerial_chain::tables::{ShapeTables, TableSettings};
 
-/// Which planner a run uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Method {
-    /// The ARCplanner with these shape sources.
-    Arc(ArcMode),
-    /// The full-state lazy PRM.
-    FullPrm,
-}
-
-/// The ARCplanner's shape sources (the paper's ablation), orderable for grouping.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum ArcMode {
-    /// Library shapes only ("LSC").
-    Lsc,
-    /// Random shapes only ("SRS").
-    Srs,
-    /// Both ("Both", the paper's full ARCplanner: rigid shapes only).
-    Both,
-    /// Both plus follow-the-leader steps ("Both+follow", `arc plan`'s default).
-    Follow,
-}
-
-impl ArcMode {
-    /// The planner's mode.
-    pub fn mode(self) -> Mode {
-        match self {
-            ArcMode::Lsc => Mode::Lsc,
-            ArcMode::Srs => Mode::Srs,
-            ArcMode::Both | ArcMode::Follow => Mode::Both,
-        }
-    }
-
-    /// The planner's follow-the-leader step (0: off, the paper's planner).
-    pub fn follow_step(self) -> f64 {
-        match self {
-            ArcMode::Follow => Settings::default().follow_step,
-            _ => 0.0,
-        }
-    }
-
-    /// Row label in the tables.
-    pub fn name(self) -> &'static str {
-        match self {
-            ArcMode::Lsc => "LSC",
-            ArcMode::Srs => "SRS",
-            ArcMode::Both => "Both",
-            ArcMode::Follow => "Both+follow",
-        }
-    }
-}
-
-impl Method {
-    /// Short label: `ARC-lsc`, `ARC-srs`, `ARC-both`, `ARC-follow`, `PRM`.
-    pub fn label(self) -> &'static str {
-        match self {
-            Method::Arc(ArcMode::Lsc) => "ARC-lsc",
-            Method::Arc(ArcMode::Srs) => "ARC-srs",
-            Method::Arc(ArcMode::Both) => "ARC-both",
-            Method::Arc(ArcMode::Follow) => "ARC-follow",
-            Method::FullPrm => "PRM",
-        }
-    }
-}
-
 /// Start and goal of a query (at the default goal tolerance).
 pub use aerial_chain::planner::Query;
-
-/// One benchmark run.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RunSpec {
-    /// Which study it belongs to (`table1`, `scale-units`, ...).
-    pub study: String,
-    /// Built-in scenario name.
-    pub scenario: String,
-    /// Chain size N.
-    pub units: u8,
-    /// Planner.
-    pub method: Method,
-    /// Roadmap vertices: `M_VT` for the ARCplanner, `M_F` for the PRM.
-    pub vertices: usize,
-    /// Random shapes `N_SRS` (ARCplanner; 0 for LSC only).
-    pub srs: usize,
-    /// Seed of the roadmap (and of the SRS).
-    pub seed: u64,
-    /// Time limit of the query, and of the PRM's roadmap build (s).
-    pub time_limit: Option<f64>,
-    /// Start and goal; `None`: the scenario's own (LI at its start yaw).
-    pub query: Option<Query>,
-}
 
 /// What a run gave.
 #[derive(Clone, Debug, PartialEq)]
@@ -287,15 +205,19 @@ pub const WIDE_WINDOW: &str = "window-wide:";
 /// A built-in scenario ([`scenarios::build`]), or the bench-only variant
 /// `window-wide:W`: `window` with its opening widened to `W` x `W` metres (`0.8..=2.4`,
 /// same centre), where a full-state PRM has a chance (see [`paper`]).
-pub fn build_scenario(name: &str) -> Result<Scenario, String> {
+pub fn build_scenario(name: &str) -> Result<Scenario, StudyError> {
     let Some(w) = name.strip_prefix(WIDE_WINDOW) else {
-        return scenarios::build(name).map_err(|e| e.to_string());
+        return Ok(scenarios::build(name)?);
+    };
+    let wide = |why: String| StudyError::WideWindow {
+        name: name.into(),
+        why,
     };
     let w: f64 = w
         .parse()
-        .map_err(|_| format!("{name}: the opening {w:?} is not a number"))?;
+        .map_err(|_| wide(format!("the opening {w:?} is not a number")))?;
     if !(0.8..=2.4).contains(&w) {
-        return Err(format!("{name}: the opening must be 0.8 to 2.4 m"));
+        return Err(wide("the opening must be 0.8 to 2.4 m".into()));
     }
     let mut sc = scenarios::window();
     let (h, e) = (0.5 * w, 1e-6);
@@ -316,13 +238,14 @@ pub struct Envs(BTreeMap<String, Env>);
 
 impl Envs {
     /// Builds every scenario the specs name.
-    pub fn for_specs(specs: &[RunSpec]) -> Result<Self, String> {
+    pub fn for_specs(specs: &[RunSpec]) -> Result<Self, StudyError> {
         let mut m = BTreeMap::new();
         for s in specs {
-            if !m.contains_key(&s.scenario) {
-                let scenario = build_scenario(&s.scenario)?;
+            let name = &s.key.scenario;
+            if !m.contains_key(name) {
+                let scenario = build_scenario(name)?;
                 let field = Arc::new(DistanceField::new(scenario.grid.clone()));
-                m.insert(s.scenario.clone(), Env { scenario, field });
+                m.insert(name.clone(), Env { scenario, field });
             }
         }
         Ok(Self(m))
@@ -335,20 +258,20 @@ impl Envs {
 }
 
 /// A collision context of its own (fresh counters) for a run.
-pub fn context(env: &Env, units: u8) -> Result<CollisionContext, String> {
+pub fn context(env: &Env, units: u8) -> Result<CollisionContext, StudyError> {
     let params = ChainParams::new(units)
         .validate()
-        .map_err(|e| format!("N = {units}: {e}"))?;
-    CollisionContext::new(env.field.clone(), params, DEFAULT_CLEARANCE).map_err(|e| e.to_string())
+        .map_err(|why| StudyError::Chain { units, why })?;
+    Ok(CollisionContext::new(
+        env.field.clone(),
+        params,
+        DEFAULT_CLEARANCE,
+    )?)
 }
 
 /// The scenario's own query for `units`: its start, LI at its start yaw, its goal.
-pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, String> {
-    Ok(Query::new(
-        sc.start,
-        sc.start_shape(units).map_err(|e| e.to_string())?,
-        sc.goal,
-    ))
+pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, StudyError> {
+    Ok(Query::new(sc.start, sc.start_shape(units)?, sc.goal))
 }
 
 /// A query for a chain that may not fit at the scenario's start as a straight line
@@ -359,10 +282,11 @@ pub fn default_query(sc: &Scenario, units: u8) -> Result<Query, String> {
 /// is valid. The goal is the scenario's. PN comes second because its body bends
 /// evenly, so the chain can slide along it (follow-the-leader); the serpentines are
 /// zig-zags at the bend limit, along which no unit can slide.
-pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, String> {
+pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, StudyError> {
     let params = *ctx.params();
     let lib = library(&params);
-    let mut positions = vec![sc.start];
+    let start: [f64; 3] = sc.start.into();
+    let mut positions = vec![start];
     let mut ring = Vec::new();
     for i in -15i32..=15 {
         for j in -15i32..=15 {
@@ -375,9 +299,9 @@ pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, Str
     ring.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
     positions.extend(ring.iter().map(|&(_, i, j)| {
         [
-            sc.start[0] + 0.1 * i as f64,
-            sc.start[1] + 0.1 * j as f64,
-            sc.start[2],
+            start[0] + 0.1 * i as f64,
+            start[1] + 0.1 * j as f64,
+            start[2],
         ]
     }));
     let yaw0 = sc.start_yaw as f32;
@@ -396,35 +320,33 @@ pub fn fitting_query(sc: &Scenario, ctx: &CollisionContext) -> Result<Query, Str
                     .shape
                     .rotated(aerial_chain_core::angle::diff(e.shape.head_yaw(), yaw));
                 if ctx.check_config(p, &shape).is_ok() {
-                    return Ok(Query::new(p, shape, sc.goal));
+                    return Ok(Query::new(p.into(), shape, sc.goal));
                 }
             }
         }
     }
-    Err(format!(
-        "no library shape of N = {} fits within 1.5 m of {}'s start",
-        params.units, sc.name
-    ))
+    Err(StudyError::NoFittingStart {
+        units: params.units,
+        scenario: sc.name.clone(),
+    })
 }
 
 /// Runs one spec.
 pub fn run_one(envs: &Envs, spec: &RunSpec) -> RunResult {
-    let Some(env) = envs.get(&spec.scenario) else {
-        return RunResult::failed(
-            spec,
-            "error",
-            format!("scenario {} not built", spec.scenario),
-        );
+    let key = &spec.key;
+    let Some(env) = envs.get(&key.scenario) else {
+        let e = StudyError::NotBuilt(key.scenario.clone());
+        return RunResult::failed(spec, "error", e.to_string());
     };
-    let ctx = match context(env, spec.units) {
+    let ctx = match context(env, key.units) {
         Ok(c) => c,
-        Err(e) => return RunResult::failed(spec, "error", e),
+        Err(e) => return RunResult::failed(spec, "error", e.to_string()),
     };
     let query = match spec.query {
         Some(q) => q,
-        None => match default_query(&env.scenario, spec.units) {
+        None => match default_query(&env.scenario, key.units) {
             Ok(q) => q,
-            Err(e) => return RunResult::failed(spec, "error", e),
+            Err(e) => return RunResult::failed(spec, "error", e.to_string()),
         },
     };
     let stop = Termination {
@@ -433,7 +355,7 @@ pub fn run_one(envs: &Envs, spec: &RunSpec) -> RunResult {
             .time_limit
             .and_then(|t| Duration::try_from_secs_f64(t).ok()),
     };
-    match spec.method {
+    match key.method {
         Method::Arc(mode) => run_arc(env, ctx, spec, mode, query, stop),
         Method::FullPrm => run_prm(env, ctx, spec, query, stop),
     }
@@ -463,10 +385,10 @@ fn run_planner<P: Planner>(
             r.message = e.to_string();
         }
         Ok(sol) => {
-            let t = sol.stats.timing();
+            let t = sol.stats.timings();
             r.success = true;
             r.collision_s = Some(t.collision_s);
-            r.search_s = Some((t.planning_s - t.collision_s).max(0.0));
+            r.search_s = Some(t.rest_s());
             let g = &env.scenario.grid;
             let plan = to_plan(sol, &params, g.resolution(), g.unknown_is_occupied());
             r.waypoints = Some(plan.waypoints.len());
@@ -489,7 +411,7 @@ fn run_arc(
     let tables = ShapeTables::build(
         params,
         &TableSettings {
-            srs: spec.srs,
+            srs: spec.key.srs,
             seed: spec.seed,
             ..Default::default()
         },
@@ -501,7 +423,7 @@ fn run_arc(
         Err(e) => return RunResult::failed(spec, "error", e.to_string()),
     };
     let settings = Settings {
-        vertices: spec.vertices,
+        vertices: spec.key.vertices,
         mode: mode.mode(),
         follow_step: mode.follow_step(),
         seed: spec.seed,
@@ -516,7 +438,7 @@ fn run_arc(
     let stops = (Termination::default(), stop);
     let (mut r, res) = run_planner(env, spec, &mut planner, &q, stops);
     r.tables_s = tables_s;
-    r.roadmap_vertices = spec.vertices;
+    r.roadmap_vertices = spec.key.vertices;
     if let Ok(sol) = res {
         let s = &sol.stats;
         r.roadmap_vertices = s.roadmap_vertices;
@@ -537,7 +459,7 @@ fn run_prm(
     stop: Termination,
 ) -> RunResult {
     let settings = PrmSettings {
-        vertices: spec.vertices,
+        vertices: spec.key.vertices,
         seed: spec.seed,
         ..Default::default()
     };
@@ -574,19 +496,17 @@ pub fn run_all(
     threads: Option<usize>,
     what: &str,
     log: bool,
-) -> Result<Vec<RunResult>, String> {
+) -> Result<Vec<RunResult>, StudyError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| format!("thread pool: {e}"))?;
+        .build()?;
     let total = specs.len();
     let bar = if log && std::io::stderr().is_terminal() {
         let b = indicatif::ProgressBar::new(total as u64);
         b.set_style(
             indicatif::ProgressStyle::with_template(
                 "{msg} [{bar:40}] {pos}/{len} runs ({elapsed}, eta {eta})",
-            )
-            .map_err(|e| e.to_string())?
+            )?
             .progress_chars("=> "),
         );
         b.set_message(what.to_string());
@@ -676,7 +596,7 @@ mod tests {
         for n in [3u8, 12, 16] {
             let ctx = context(&env, n).unwrap();
             let q = fitting_query(&env.scenario, &ctx).unwrap();
-            assert!(ctx.check_config(q.start, &q.start_shape).is_ok());
+            assert!(ctx.check_config(q.start.into(), &q.start_shape).is_ok());
         }
         // A short chain keeps the scenario's own start.
         let ctx = context(&env, 4).unwrap();
@@ -686,17 +606,7 @@ mod tests {
 
     #[test]
     fn unknown_scenario_is_an_error() {
-        let spec = RunSpec {
-            study: "t".into(),
-            scenario: "nowhere".into(),
-            units: 4,
-            method: Method::FullPrm,
-            vertices: 10,
-            srs: 0,
-            seed: 1,
-            time_limit: None,
-            query: None,
-        };
+        let spec = RunKey::new("t", "nowhere", 4, Method::FullPrm, (10, 0)).run(1, None);
         assert!(Envs::for_specs(std::slice::from_ref(&spec)).is_err());
         let envs = Envs(BTreeMap::new());
         let r = run_one(&envs, &spec);

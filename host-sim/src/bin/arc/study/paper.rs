@@ -10,23 +10,17 @@
 
 use std::fmt::Write as _;
 
-use super::{fmt_ms, ms, ArcMode, Method, RunSpec, Summary};
+use super::{fmt_ms, ms, ArcMode, Budgets, Method, RunKey, RunSpec, Summary};
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PaperOptions {
-    /// Seeds per configuration.
-    pub seeds: u64,
-    /// Head roadmap vertices `M_VT`.
-    pub vertices: usize,
-    /// Random shapes `N_SRS`.
-    pub srs: usize,
+    /// Seeds, `M_VT`, `N_SRS` and the time limit of every run.
+    pub budgets: Budgets,
     /// Vertex budgets `M_F` of the full-state PRM.
     pub prm_vertices: Vec<usize>,
     /// Chain sizes of Table 3 (window).
     pub prm_units: Vec<u8>,
-    /// Time limit per run (s).
-    pub time_limit: Option<f64>,
     /// Which tables to run (1, 2, 3).
     pub tables: Vec<u8>,
     /// Also run Table 3 on `window-wide:W` for each of these `W` (the window widened to
@@ -40,12 +34,9 @@ impl PaperOptions {
     /// per run.
     pub fn full() -> Self {
         Self {
-            seeds: 20,
-            vertices: 1500,
-            srs: 500,
+            budgets: Budgets::full(),
             prm_vertices: vec![1500, 15000],
             prm_units: vec![5],
-            time_limit: Some(60.0),
             tables: vec![1, 2, 3],
             wide_windows: vec![1.0, 1.2, 1.4, 1.6],
         }
@@ -54,12 +45,9 @@ impl PaperOptions {
     /// A smoke run: 2 seeds, small budgets, 2 s per run.
     pub fn quick() -> Self {
         Self {
-            seeds: 2,
-            vertices: 300,
-            srs: 100,
+            budgets: Budgets::quick(2),
             prm_vertices: vec![100, 300],
             prm_units: vec![4],
-            time_limit: Some(2.0),
             tables: vec![1, 2, 3],
             wide_windows: vec![1.6],
         }
@@ -92,19 +80,10 @@ pub fn specs(o: &PaperOptions) -> Vec<RunSpec> {
             continue;
         }
         for mode in MODES {
-            for seed in 1..=o.seeds {
-                v.push(RunSpec {
-                    study: study.into(),
-                    scenario: scenario.into(),
-                    units,
-                    method: Method::Arc(mode),
-                    vertices: o.vertices,
-                    srs: if mode == ArcMode::Lsc { 0 } else { o.srs },
-                    seed,
-                    time_limit: o.time_limit,
-                    query: None,
-                });
-            }
+            let b = &o.budgets;
+            let srs = if mode == ArcMode::Lsc { 0 } else { b.srs };
+            let key = RunKey::new(study, scenario, units, Method::Arc(mode), (b.vertices, srs));
+            v.extend(b.runs(&key));
         }
     }
     if !o.tables.contains(&3) {
@@ -118,34 +97,13 @@ pub fn specs(o: &PaperOptions) -> Vec<RunSpec> {
                 && o.tables.contains(&1)
                 && ABLATION.contains(&("table1", "window", units));
             for mode in TABLE3_ARC.into_iter().filter(|_| !in_table1) {
-                for seed in 1..=o.seeds {
-                    v.push(RunSpec {
-                        study: study.into(),
-                        scenario: scenario.clone(),
-                        units,
-                        method: Method::Arc(mode),
-                        vertices: o.vertices,
-                        srs: o.srs,
-                        seed,
-                        time_limit: o.time_limit,
-                        query: None,
-                    });
-                }
+                let budgets = (o.budgets.vertices, o.budgets.srs);
+                let key = RunKey::new(study, &scenario, units, Method::Arc(mode), budgets);
+                v.extend(o.budgets.runs(&key));
             }
             for &m in &o.prm_vertices {
-                for seed in 1..=o.seeds {
-                    v.push(RunSpec {
-                        study: study.into(),
-                        scenario: scenario.clone(),
-                        units,
-                        method: Method::FullPrm,
-                        vertices: m,
-                        srs: 0,
-                        seed,
-                        time_limit: o.time_limit,
-                        query: None,
-                    });
-                }
+                let key = RunKey::new(study, &scenario, units, Method::FullPrm, (m, 0));
+                v.extend(o.budgets.runs(&key));
             }
         }
     }
@@ -161,20 +119,13 @@ pub fn table3_scenarios(o: &PaperOptions) -> Vec<(&'static str, String)> {
     v
 }
 
-/// The paper's planning times `t_P` (s) for Tables 1 and 2: (scenario, N, mode, t_P).
-pub const PAPER_TP: [(&str, u8, ArcMode, f64); 12] = [
-    ("window", 4, ArcMode::Lsc, 11.3),
-    ("window", 4, ArcMode::Srs, 23.0),
-    ("window", 4, ArcMode::Both, 4.4),
-    ("window", 5, ArcMode::Lsc, 46.1),
-    ("window", 5, ArcMode::Srs, 54.4),
-    ("window", 5, ArcMode::Both, 4.4),
-    ("maze", 5, ArcMode::Lsc, 1.5),
-    ("maze", 5, ArcMode::Srs, 9.5),
-    ("maze", 5, ArcMode::Both, 1.27),
-    ("maze", 6, ArcMode::Lsc, 32.7),
-    ("maze", 6, ArcMode::Srs, 14.2),
-    ("maze", 6, ArcMode::Both, 7.9),
+/// The paper's planning times `t_P` (s) for Tables 1 and 2: (scenario, N, `t_P` of
+/// LSC, SRS and Both).
+pub const PAPER_TP: [(&str, u8, [f64; 3]); 4] = [
+    ("window", 4, [11.3, 23.0, 4.4]),
+    ("window", 5, [46.1, 54.4, 4.4]),
+    ("maze", 5, [1.5, 9.5, 1.27]),
+    ("maze", 6, [32.7, 14.2, 7.9]),
 ];
 
 /// The paper's head roadmap build times `t_GT` (s): Env 1 and Env 2.
@@ -188,10 +139,16 @@ pub const PAPER_TABLE3: [(&str, usize, f64, f64, f64); 3] = [
 ];
 
 fn paper_tp(scenario: &str, units: u8, mode: ArcMode) -> Option<f64> {
+    let column = match mode {
+        ArcMode::Lsc => 0,
+        ArcMode::Srs => 1,
+        ArcMode::Both => 2,
+        ArcMode::Follow => return None,
+    };
     PAPER_TP
         .iter()
-        .find(|r| r.0 == scenario && r.1 == units && r.2 == mode)
-        .map(|r| r.3)
+        .find(|r| r.0 == scenario && r.1 == units)
+        .map(|r| r.2[column])
 }
 
 fn find<'a>(
@@ -202,10 +159,11 @@ fn find<'a>(
     vertices: Option<usize>,
 ) -> Option<&'a Summary> {
     sums.iter().find(|s| {
-        s.scenario == scenario
-            && s.units == units
-            && s.method == method
-            && vertices.is_none_or(|v| s.vertices == v)
+        let k = &s.key;
+        k.scenario == scenario
+            && k.units == units
+            && k.method == method
+            && vertices.is_none_or(|v| k.vertices == v)
     })
 }
 
@@ -252,11 +210,14 @@ pub fn speedups(sums: &[Summary], o: &PaperOptions) -> Vec<Speedup> {
         let arc = find(sums, scenario, units, Method::Arc(mode), None);
         let prm = sums
             .iter()
-            .filter(|s| &s.scenario == scenario && s.units == units && s.method == Method::FullPrm)
+            .filter(|s| {
+                let k = &s.key;
+                &k.scenario == scenario && k.units == units && k.method == Method::FullPrm
+            })
             .max_by(|a, b| {
                 a.success_rate()
                     .total_cmp(&b.success_rate())
-                    .then(b.vertices.cmp(&a.vertices))
+                    .then(b.key.vertices.cmp(&a.key.vertices))
             });
         if let (Some(a), Some(p)) = (arc, prm) {
             let ok_total = (p.successes > 0).then_some(p.total_ok.median);
@@ -264,7 +225,7 @@ pub fn speedups(sums: &[Summary], o: &PaperOptions) -> Vec<Speedup> {
                 scenario: scenario.clone(),
                 arc: mode,
                 units,
-                prm_vertices: p.vertices,
+                prm_vertices: p.key.vertices,
                 prm_success: p.success_rate(),
                 arc_success: a.success_rate(),
                 prm_total_s: p.total_all.median,
@@ -321,10 +282,10 @@ fn ablation_tables(s: &mut String, sums: &[Summary], o: &PaperOptions) {
             s,
             "## {title}\n\nM_VT = {}, N_SRS = {} (0 for LSC only), {} seeds, time limit {} s per run. \
              Paper: t_GT = {} s.\n",
-            o.vertices,
-            o.srs,
-            o.seeds,
-            o.time_limit.map_or("none".into(), |t| t.to_string()),
+            o.budgets.vertices,
+            o.budgets.srs,
+            o.budgets.seeds,
+            o.budgets.time_limit_text(),
             PAPER_TGT
                 .iter()
                 .find(|r| r.0 == scenario)
@@ -371,7 +332,7 @@ fn table3(s: &mut String, sums: &[Summary], o: &PaperOptions) {
          as a failure and its time as spent). `window` is Table 1's room (0.8 m x 0.8 m window); \
          `{}W` is the same room with the window widened to W x W m (bench-only variant), \
          where the full-state PRM can pass.\n",
-        o.time_limit.map_or("none".into(), |t| t.to_string()),
+        o.budgets.time_limit_text(),
         super::WIDE_WINDOW
     );
     let _ = writeln!(
@@ -416,27 +377,24 @@ fn table3(s: &mut String, sums: &[Summary], o: &PaperOptions) {
                 }
             }
             for (g, p) in rows {
-                let (name, budget) = match g.method {
-                    Method::FullPrm => ("full-state PRM", format!("M_F = {}", g.vertices)),
+                let (name, budget) = match g.key.method {
+                    Method::FullPrm => ("full-state PRM", format!("M_F = {}", g.key.vertices)),
                     Method::Arc(ArcMode::Follow) => (
                         "ARCplanner + follow",
-                        format!("M_VT = {}, N_SRS = {}", g.vertices, g.srs),
+                        format!("M_VT = {}, N_SRS = {}", g.key.vertices, g.key.srs),
                     ),
                     Method::Arc(_) => (
                         "ARCplanner",
-                        format!("M_VT = {}, N_SRS = {}", g.vertices, g.srs),
+                        format!("M_VT = {}, N_SRS = {}", g.key.vertices, g.key.srs),
                     ),
                 };
                 let _ = writeln!(
                     s,
-                    "| {scenario} | {units} | {name} | {budget} | {} | {} | {} | {}/{} | {}/{} | {} | {} | {} | {} | {} |",
+                    "| {scenario} | {units} | {name} | {budget} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                     num(p.0),
                     num(p.1),
                     if p.2.is_nan() { "-".into() } else { pct(p.2) },
-                    g.successes,
-                    g.runs,
-                    g.verified,
-                    g.successes,
+                    g.success_cells(),
                     ms(&g.roadmap),
                     ms(&g.planning),
                     ms(&g.planning_all),
@@ -502,14 +460,17 @@ fn profile_table(s: &mut String, sums: &[Summary]) {
         "| scenario | N | shapes | t_G (ms) | t_P (ms) | collision (ms) | search (ms) | collision share |"
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
-    for g in sums.iter().filter(|g| matches!(g.method, Method::Arc(_))) {
+    for g in sums
+        .iter()
+        .filter(|g| matches!(g.key.method, Method::Arc(_)))
+    {
         let share = g.collision.median / (g.collision.median + g.search.median);
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} | {} |",
-            g.scenario,
-            g.units,
-            g.method.label(),
+            g.key.scenario,
+            g.key.units,
+            g.key.method.label(),
             fmt_ms(g.roadmap.median),
             if g.planning.n > 0 {
                 fmt_ms(g.planning.median)

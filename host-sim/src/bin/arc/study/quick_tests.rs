@@ -4,10 +4,10 @@
 
 use std::path::PathBuf;
 
-use crate::study::{self as bench, ArcMode, Method, RunSpec};
+use crate::study::{self as bench, ArcMode, Method, RunKey};
 use crate::CliError;
 use aerial_chain::collision::verify_plan;
-use aerial_chain::plan::Plan;
+use aerial_chain::plan_file::Plan;
 use aerial_chain::problem::scenarios;
 
 /// Runs the command line in-process with `args` (the program name is added).
@@ -106,17 +106,8 @@ fn results_do_not_depend_on_the_thread_count() {
             (Method::Arc(ArcMode::Lsc), 300, 0),
             (Method::FullPrm, 200, 0),
         ] {
-            specs.push(RunSpec {
-                study: "determinism".into(),
-                scenario: "window".into(),
-                units: 4,
-                method,
-                vertices,
-                srs,
-                seed,
-                time_limit: None,
-                query: None,
-            });
+            let key = RunKey::new("determinism", "window", 4, method, (vertices, srs));
+            specs.push(key.run(seed, None));
         }
     }
     let envs = bench::Envs::for_specs(&specs).unwrap();

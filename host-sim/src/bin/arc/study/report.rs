@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::{RunResult, Spread, Summary};
+use super::{RunKey, RunResult, Spread, StudyError, Summary};
 
 pub(super) fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {
@@ -15,6 +15,16 @@ pub(super) fn csv_field(s: &str) -> String {
 
 fn opt<T: ToString>(v: Option<T>) -> String {
     v.map(|x| x.to_string()).unwrap_or_default()
+}
+
+/// The columns `study,scenario,units,method,vertices,srs` of both CSV files.
+fn key_cells(k: &RunKey) -> String {
+    let (study, scenario) = (csv_field(&k.study), csv_field(&k.scenario));
+    let (units, method) = (k.units, k.method.label());
+    format!(
+        "{study},{scenario},{units},{method},{},{}",
+        k.vertices, k.srs
+    )
 }
 
 /// One line per run.
@@ -29,13 +39,8 @@ pub fn runs_csv(results: &[RunResult]) -> String {
         let start = p.query.map(|q| q.start);
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            csv_field(&p.study),
-            csv_field(&p.scenario),
-            p.units,
-            p.method.label(),
-            p.vertices,
-            p.srs,
+            "{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            key_cells(&p.key),
             p.seed,
             opt(p.time_limit),
             opt(start.map(|s| s[0])),
@@ -73,53 +78,43 @@ fn spread_cols(s: &Spread) -> String {
     )
 }
 
+/// The spreads of the summary CSV, in column order: the name and where it is.
+type SpreadColumn = (&'static str, fn(&Summary) -> &Spread);
+
+const SPREAD_COLUMNS: [SpreadColumn; 10] = [
+    ("roadmap_s", |g| &g.roadmap),
+    ("planning_s", |g| &g.planning),
+    ("planning_all_s", |g| &g.planning_all),
+    ("total_all_s", |g| &g.total_all),
+    ("roadmap_cpu_s", |g| &g.roadmap_cpu),
+    ("planning_cpu_s", |g| &g.planning_cpu),
+    ("total_cpu_all_s", |g| &g.total_cpu_all),
+    ("collision_s", |g| &g.collision),
+    ("search_s", |g| &g.search),
+    ("shape_changes", |g| &g.shape_changes),
+];
+
 /// One line per group.
 pub fn summary_csv(sums: &[Summary]) -> String {
     let mut s = String::from("study,scenario,units,method,vertices,srs,time_limit_s,runs,successes,success_rate,verified,time_limited");
-    for name in [
-        "roadmap_s",
-        "planning_s",
-        "planning_all_s",
-        "total_all_s",
-        "roadmap_cpu_s",
-        "planning_cpu_s",
-        "total_cpu_all_s",
-        "collision_s",
-        "search_s",
-        "shape_changes",
-    ] {
+    for (name, _) in SPREAD_COLUMNS {
         for q in ["median", "q1", "q3", "min", "max"] {
             let _ = write!(s, ",{name}_{q}");
         }
     }
     s.push('\n');
     for g in sums {
-        let _ = writeln!(
+        let (key, limit) = (key_cells(&g.key), opt(g.time_limit));
+        let (runs, ok, rate) = (g.runs, g.successes, g.success_rate());
+        let _ = write!(
             s,
-            "{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{},{},{}",
-            csv_field(&g.study),
-            csv_field(&g.scenario),
-            g.units,
-            g.method.label(),
-            g.vertices,
-            g.srs,
-            opt(g.time_limit),
-            g.runs,
-            g.successes,
-            g.success_rate(),
-            g.verified,
-            g.time_limited,
-            spread_cols(&g.roadmap),
-            spread_cols(&g.planning),
-            spread_cols(&g.planning_all),
-            spread_cols(&g.total_all),
-            spread_cols(&g.roadmap_cpu),
-            spread_cols(&g.planning_cpu),
-            spread_cols(&g.total_cpu_all),
-            spread_cols(&g.collision),
-            spread_cols(&g.search),
-            spread_cols(&g.shape_changes)
+            "{key},{limit},{runs},{ok},{rate:.3},{},{}",
+            g.verified, g.time_limited
         );
+        for (_, spread) in SPREAD_COLUMNS {
+            let _ = write!(s, ",{}", spread_cols(spread(g)));
+        }
+        s.push('\n');
     }
     s
 }
@@ -159,9 +154,13 @@ pub fn write_out(
     dir: &std::path::Path,
     name: &str,
     bytes: &[u8],
-) -> Result<std::path::PathBuf, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+) -> Result<std::path::PathBuf, StudyError> {
+    let failed = |path: &std::path::Path| {
+        let path = path.to_path_buf();
+        move |source| StudyError::Write { path, source }
+    };
+    std::fs::create_dir_all(dir).map_err(failed(dir))?;
     let p = dir.join(name);
-    crate::fsutil::write_atomic(&p, bytes).map_err(|e| format!("{}: {e}", p.display()))?;
+    crate::fsutil::write_atomic(&p, bytes).map_err(failed(&p))?;
     Ok(p)
 }

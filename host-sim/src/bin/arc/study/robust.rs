@@ -9,7 +9,7 @@
 
 use rand::{Rng, SeedableRng};
 
-use super::{plot, run_all, ArcMode, Envs, Method, RunResult, RunSpec, Spread};
+use super::{plot, run_all, ArcMode, Envs, Method, RunKey, RunResult, RunSpec, Spread, StudyError};
 use aerial_chain::problem::passages::{witness, PassageSpec};
 
 /// Options of the study.
@@ -57,17 +57,9 @@ pub fn draw(o: &RobustOptions) -> (Vec<RunSpec>, usize) {
             redrawn += 1;
             continue;
         }
-        specs.push(RunSpec {
-            study: "robust".into(),
-            scenario: p.name(),
-            units,
-            method: Method::Arc(ArcMode::Follow),
-            vertices: o.vertices,
-            srs: o.srs,
-            seed: specs.len() as u64 + 1,
-            time_limit: o.time_limit,
-            query: None,
-        });
+        let method = Method::Arc(ArcMode::Follow);
+        let key = RunKey::new("robust", &p.name(), units, method, (o.vertices, o.srs));
+        specs.push(key.run(specs.len() as u64 + 1, o.time_limit));
     }
     (specs, redrawn)
 }
@@ -77,7 +69,7 @@ pub fn run(
     specs: &[RunSpec],
     threads: Option<usize>,
     chunk: usize,
-) -> Result<Vec<RunResult>, String> {
+) -> Result<Vec<RunResult>, StudyError> {
     let mut out = Vec::with_capacity(specs.len());
     let bar = indicatif::ProgressBar::new(specs.len() as u64);
     if let Ok(style) = indicatif::ProgressStyle::with_template(
@@ -117,7 +109,7 @@ pub fn markdown(results: &[RunResult], redrawn: usize, meta: &str) -> String {
     let mut s = String::new();
     s += "# Robustness: the hard-case family (`arc bench robust`)\n\n";
     s += &format!(
-        "{n} random instances of `passage:` (windows 0.45-0.6 m, walls 0.1-0.3 m, approach 0-60 degrees either way, \
+        "{n} random instances of `passage:` (windows 0.45-0.6 m in walls of 0.1-0.3 m, or one in five a tunnel 0.5-0.6 m square and 0.6-1.5 m long; approach 0-60 degrees either way, \
          offsets up to 0.3 m, a second wall with a door in half), N = 4..8, `arc plan`'s defaults. \
          Every instance has a witness checked by the exact verifier; {redrawn} draws without one were redrawn.\n\n"
     );
@@ -135,7 +127,7 @@ pub fn markdown(results: &[RunResult], redrawn: usize, meta: &str) -> String {
     );
     s += "| N | instances | solved | planning median (ms) |\n|---|---|---|---|\n";
     for u in 4..=8u8 {
-        let all: Vec<&RunResult> = results.iter().filter(|r| r.spec.units == u).collect();
+        let all: Vec<&RunResult> = results.iter().filter(|r| r.spec.key.units == u).collect();
         let ok: Vec<f64> = all
             .iter()
             .filter(|r| r.success)
@@ -154,7 +146,7 @@ pub fn markdown(results: &[RunResult], redrawn: usize, meta: &str) -> String {
         for r in failed {
             s += &format!(
                 "- `{}` N = {}: {} ({})\n",
-                r.spec.scenario, r.spec.units, r.outcome, r.message
+                r.spec.key.scenario, r.spec.key.units, r.outcome, r.message
             );
         }
     }

@@ -17,27 +17,23 @@ use aerial_chain::picture::{palette, Colour};
 use aerial_chain_core::lsc::library;
 
 use super::plot::{self, Chart, Curve};
-use super::{fitting_query, ArcMode, Envs, Method, Query, RunSpec, Summary};
+use super::{
+    fitting_query, ArcMode, Budgets, Envs, Method, Query, RunKey, RunSpec, StudyError, Summary,
+};
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScaleOptions {
-    /// Seeds per configuration.
-    pub seeds: u64,
+    /// Seeds, `M_VT` (for `window`), `N_SRS` and the time limit of every run.
+    pub budgets: Budgets,
     /// Chain sizes for `window`.
     pub units: Vec<u8>,
-    /// Head roadmap vertices for `window`.
-    pub vertices: usize,
     /// Corridor lengths (m).
     pub lengths: Vec<f64>,
     /// Chain size in the corridors.
     pub corridor_units: u8,
     /// Head roadmap vertices per metre of corridor (`None`: `vertices` for every length).
     pub corridor_vertices_per_m: Option<f64>,
-    /// Random shapes `N_SRS`.
-    pub srs: usize,
-    /// Time limit per run (s).
-    pub time_limit: Option<f64>,
 }
 
 impl ScaleOptions {
@@ -46,35 +42,29 @@ impl ScaleOptions {
     /// default 20 m corridor), `N_SRS = 500`, 60 s per run.
     pub fn full() -> Self {
         Self {
-            seeds: 20,
+            budgets: Budgets::full(),
             units: (3..=16).collect(),
-            vertices: 1500,
             lengths: (1..=10).map(|k| 10.0 * k as f64).collect(),
             corridor_units: 5,
             corridor_vertices_per_m: Some(100.0),
-            srs: 500,
-            time_limit: Some(60.0),
         }
     }
 
     /// A smoke run: two sizes, two corridors, one seed, small budgets.
     pub fn quick() -> Self {
         Self {
-            seeds: 1,
+            budgets: Budgets::quick(1),
             units: vec![3, 4],
-            vertices: 300,
             lengths: vec![10.0, 20.0],
             corridor_units: 4,
             corridor_vertices_per_m: Some(30.0),
-            srs: 100,
-            time_limit: Some(2.0),
         }
     }
 
     fn corridor_vertices(&self, l: f64) -> usize {
         match self.corridor_vertices_per_m {
             Some(d) => (d * l).round().max(1.0) as usize,
-            None => self.vertices,
+            None => self.budgets.vertices,
         }
     }
 }
@@ -88,20 +78,14 @@ pub fn corridor_name(l: f64) -> String {
 pub type StartChoice = (u8, Query, String);
 
 /// Every run of the study (N first, then the corridors), and the start chosen per N.
-pub fn specs(o: &ScaleOptions) -> Result<(Vec<RunSpec>, Vec<StartChoice>), String> {
-    let window: Vec<RunSpec> = vec![RunSpec {
-        study: "scale-units".into(),
-        scenario: "window".into(),
-        units: 3,
-        method: Method::Arc(ArcMode::Follow),
-        vertices: o.vertices,
-        srs: o.srs,
-        seed: 1,
-        time_limit: o.time_limit,
-        query: None,
-    }];
+pub fn specs(o: &ScaleOptions) -> Result<(Vec<RunSpec>, Vec<StartChoice>), StudyError> {
+    let (follow, b) = (Method::Arc(ArcMode::Follow), &o.budgets);
+    let by_units = |n| RunKey::new("scale-units", "window", n, follow, (b.vertices, b.srs));
+    let window = vec![by_units(3).run(1, b.time_limit)];
     let envs = Envs::for_specs(&window)?;
-    let env = envs.get("window").ok_or("window not built")?;
+    let env = envs
+        .get("window")
+        .ok_or_else(|| StudyError::NotBuilt("window".into()))?;
     let mut v = Vec::new();
     let mut starts = Vec::new();
     for &n in &o.units {
@@ -118,40 +102,23 @@ pub fn specs(o: &ScaleOptions) -> Result<(Vec<RunSpec>, Vec<StartChoice>), Strin
             })
             .map_or("?", |e| e.kind.name());
         starts.push((n, q, name.to_string()));
-        for seed in 1..=o.seeds {
-            v.push(RunSpec {
-                study: "scale-units".into(),
-                scenario: "window".into(),
-                units: n,
-                method: Method::Arc(ArcMode::Follow),
-                vertices: o.vertices,
-                srs: o.srs,
-                seed,
-                time_limit: o.time_limit,
-                query: Some(q),
-            });
-        }
+        let key = by_units(n);
+        v.extend(b.runs(&key).map(|r| RunSpec {
+            query: Some(q),
+            ..r
+        }));
     }
     for &l in &o.lengths {
-        for seed in 1..=o.seeds {
-            v.push(RunSpec {
-                study: "scale-map".into(),
-                scenario: corridor_name(l),
-                units: o.corridor_units,
-                method: Method::Arc(ArcMode::Follow),
-                vertices: o.corridor_vertices(l),
-                srs: o.srs,
-                seed,
-                time_limit: o.time_limit,
-                query: None,
-            });
-        }
+        let (name, budgets) = (corridor_name(l), (o.corridor_vertices(l), b.srs));
+        let key = RunKey::new("scale-map", &name, o.corridor_units, follow, budgets);
+        v.extend(b.runs(&key));
     }
     Ok((v, starts))
 }
 
 fn corridor_length(s: &Summary) -> f64 {
-    s.scenario
+    s.key
+        .scenario
         .strip_prefix("corridor:")
         .and_then(|l| l.parse().ok())
         .unwrap_or(f64::NAN)
@@ -165,9 +132,9 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
         s,
         "The full ARCplanner (LSC and SRS), N_SRS = {}, {} seeds per row, time limit {} s per run. \
          Times in ms, median [first-third quartile]; `t_P` over successful runs.\n",
-        o.srs,
-        o.seeds,
-        o.time_limit.map_or("none".into(), |t| t.to_string())
+        o.budgets.srs,
+        o.budgets.seeds,
+        o.budgets.time_limit_text()
     );
     let _ = writeln!(
         s,
@@ -175,19 +142,19 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
          Start: the scenario's (2.0, 4.5, 1.5) with LI at 90 deg where that fits; otherwise the first \
          library shape, heading (90 deg + k 45 deg) and head position (0.1 m lattice, nearest first) \
          that is valid. Goal: (6.6, 3.0, 1.5), tolerance 0.3 m.\n",
-        o.vertices
+        o.budgets.vertices
     );
     let _ = writeln!(
         s,
         "| N | start (m) | start shape, yaw (deg) | success | verified | t_G (ms) | t_P (ms) | t_P CPU (ms) | shape changes | replans | time-limited |"
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
-    for g in sums.iter().filter(|g| g.study == "scale-units") {
-        let st = starts.iter().find(|x| x.0 == g.units);
+    for g in sums.iter().filter(|g| g.key.study == "scale-units") {
+        let st = starts.iter().find(|x| x.0 == g.key.units);
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} |",
-            g.units,
+            g.key.units,
             st.map_or("-".into(), |x| format!(
                 "({:.1}, {:.1}, {:.1})",
                 x.1.start[0], x.1.start[1], x.1.start[2]
@@ -207,7 +174,7 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
         o.corridor_units,
         match o.corridor_vertices_per_m {
             Some(d) => format!("{d} per metre of corridor"),
-            None => o.vertices.to_string(),
+            None => o.budgets.vertices.to_string(),
         }
     );
     let _ = writeln!(
@@ -215,12 +182,12 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
         "| L (m) | M_VT | success | verified | t_G (ms) | t_P (ms) | t_P CPU (ms) | shape changes | replans | time-limited |"
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
-    for g in sums.iter().filter(|g| g.study == "scale-map") {
+    for g in sums.iter().filter(|g| g.key.study == "scale-map") {
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} |",
             corridor_length(g),
-            g.vertices,
+            g.key.vertices,
             g.outcome_cells(),
             g.time_limited
         );
@@ -234,9 +201,12 @@ const GREEN: Colour = palette::LSC;
 
 /// The figure: time and success against N (left) and against corridor length (right).
 pub fn figure(sums: &[Summary], corridor_units: u8) -> String {
-    let by_n: Vec<&Summary> = sums.iter().filter(|g| g.study == "scale-units").collect();
-    let by_l: Vec<&Summary> = sums.iter().filter(|g| g.study == "scale-map").collect();
-    let n = |g: &Summary| g.units as f64;
+    let by_n: Vec<&Summary> = sums
+        .iter()
+        .filter(|g| g.key.study == "scale-units")
+        .collect();
+    let by_l: Vec<&Summary> = sums.iter().filter(|g| g.key.study == "scale-map").collect();
+    let n = |g: &Summary| g.key.units as f64;
     let times = |v: &[&Summary]| {
         v.iter()
             .flat_map(|g| [g.planning.q3, g.roadmap.q3, g.planning.q1, g.roadmap.q1])

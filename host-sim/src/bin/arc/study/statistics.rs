@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 
 use super::report::{count, ms};
-use super::{Method, RunResult};
+use super::{RunKey, RunResult};
 
 /// Order statistics of a sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -52,18 +52,8 @@ impl Spread {
 /// The aggregate of the runs of one group (same study, scenario, N, planner, budgets).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Summary {
-    /// Study.
-    pub study: String,
-    /// Scenario.
-    pub scenario: String,
-    /// N.
-    pub units: u8,
-    /// Planner.
-    pub method: Method,
-    /// Roadmap vertices asked.
-    pub vertices: usize,
-    /// `N_SRS`.
-    pub srs: usize,
+    /// The group.
+    pub key: RunKey,
     /// Time limit (s).
     pub time_limit: Option<f64>,
     /// Runs.
@@ -107,17 +97,20 @@ impl Summary {
     /// t_P, t_P CPU, shape changes, replans.
     pub fn outcome_cells(&self) -> String {
         format!(
-            "{}/{} | {}/{} | {} | {} | {} | {} | {}",
-            self.successes,
-            self.runs,
-            self.verified,
-            self.successes,
+            "{} | {} | {} | {} | {} | {}",
+            self.success_cells(),
             ms(&self.roadmap),
             ms(&self.planning),
             ms(&self.planning_cpu),
             count(&self.shape_changes),
             count(&self.replans)
         )
+    }
+
+    /// The success and verified cells: `successes/runs | verified/successes`.
+    pub fn success_cells(&self) -> String {
+        let (ok, runs, verified) = (self.successes, self.runs, self.verified);
+        format!("{ok}/{runs} | {verified}/{ok}")
     }
 
     /// Success rate (0..=1).
@@ -130,23 +123,12 @@ impl Summary {
     }
 }
 
-/// What runs of one group share: study, scenario, N, planner, vertices, `N_SRS`.
-type GroupKey = (String, String, u8, Method, usize, usize);
-
 /// Groups results by (study, scenario, N, planner, budgets), in first-seen order.
 pub fn summarize(results: &[RunResult]) -> Vec<Summary> {
-    let mut order: Vec<GroupKey> = Vec::new();
-    let mut groups: BTreeMap<GroupKey, Vec<&RunResult>> = BTreeMap::new();
+    let mut order: Vec<RunKey> = Vec::new();
+    let mut groups: BTreeMap<RunKey, Vec<&RunResult>> = BTreeMap::new();
     for r in results {
-        let s = &r.spec;
-        let key = (
-            s.study.clone(),
-            s.scenario.clone(),
-            s.units,
-            s.method,
-            s.vertices,
-            s.srs,
-        );
+        let key = r.spec.key.clone();
         if !groups.contains_key(&key) {
             order.push(key.clone());
         }
@@ -158,12 +140,7 @@ pub fn summarize(results: &[RunResult]) -> Vec<Summary> {
             let rs = &groups[&key];
             let ok: Vec<&&RunResult> = rs.iter().filter(|r| r.success).collect();
             Summary {
-                study: key.0.clone(),
-                scenario: key.1.clone(),
-                units: key.2,
-                method: key.3,
-                vertices: key.4,
-                srs: key.5,
+                key,
                 time_limit: rs[0].spec.time_limit,
                 runs: rs.len(),
                 successes: ok.len(),

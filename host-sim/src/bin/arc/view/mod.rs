@@ -95,7 +95,7 @@ pub fn run(a: ViewArgs) -> CliResult {
     let last = plan.waypoints[plan.waypoints.len() - 1].xi();
     let goal = a
         .goal
-        .or(loaded.scenario.as_ref().map(|s| s.goal))
+        .or(loaded.scenario.as_ref().map(|s| s.goal.into()))
         .unwrap_or(last);
     let mut path = scene::along(&waypoints.units, units, a.near / 2.0);
     if let Some(f) = &flight {

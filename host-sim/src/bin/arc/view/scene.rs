@@ -5,7 +5,7 @@
 use std::collections::{BTreeMap, HashSet};
 
 use aerial_chain::map::{Cell, Grid};
-use aerial_chain::plan::Plan;
+use aerial_chain::plan_file::Plan;
 use aerial_chain::sim::{Reference, ReferenceLimits};
 use aerial_chain_core::kinematics::positions_into;
 use nalgebra::Vector3;

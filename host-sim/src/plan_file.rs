@@ -132,28 +132,32 @@ pub struct Waypoint {
     pub zeta: Vec<f64>,
 }
 
-/// Where a planner's time went (seconds); the only part of a plan that differs
-/// between two runs with the same seed.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Timing {
+/// Where a planner's time went (seconds): the part of a planner's statistics, and of a
+/// plan, that differs between two runs with the same seed. Both planners' statistics
+/// hold one.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
     /// Roadmap build.
     pub roadmap_s: f64,
     /// The query.
     pub planning_s: f64,
     /// Of the query, full-chain collision checks.
     pub collision_s: f64,
-    /// Name of the rest of the query in the file (`shape_search_s`, `search_s`).
-    pub rest: &'static str,
 }
 
-impl Timing {
-    fn to_json(self) -> serde_json::Value {
+impl Timings {
+    /// The rest of the query: its time outside collision checks.
+    pub fn rest_s(&self) -> f64 {
+        (self.planning_s - self.collision_s).max(0.0)
+    }
+
+    /// The file's `stats.timing`, the rest of the query under the name `rest`.
+    fn to_json(self, rest: &str) -> serde_json::Value {
         let mut m = serde_json::Map::new();
         m.insert("roadmap_build_s".into(), self.roadmap_s.into());
         m.insert("planning_s".into(), self.planning_s.into());
         m.insert("collision_checks_s".into(), self.collision_s.into());
-        let rest = (self.planning_s - self.collision_s).max(0.0);
-        m.insert(self.rest.into(), rest.into());
+        m.insert(rest.into(), self.rest_s().into());
         serde_json::Value::Object(m)
     }
 }
@@ -296,20 +300,20 @@ impl Waypoint {
 
 impl Plan {
     /// A plan through `steps` (head position and shape, the start first) for chain
-    /// `params` on a map of `resolution` m, with `counts` and `timing` as its
-    /// statistics.
+    /// `params` on a map of `resolution` m, with `counts` and `timings` as its
+    /// statistics (the rest of the query named `rest`: `shape_search_s`, `search_s`).
     pub fn from_steps<'a>(
         params: &ChainParams,
         (resolution, unknown_is_occupied): (f64, bool),
         steps: impl IntoIterator<Item = ([f64; 3], &'a Shape)>,
         counts: &[(&str, u64)],
-        timing: &Timing,
+        (timings, rest): (&Timings, &str),
     ) -> Self {
         let mut stats: serde_json::Map<_, _> = counts
             .iter()
             .map(|&(k, v)| (k.to_string(), serde_json::Value::from(v)))
             .collect();
-        stats.insert("timing".into(), timing.to_json());
+        stats.insert("timing".into(), timings.to_json(rest));
         Plan {
             format: FORMAT.into(),
             chain: ChainSection::from_params(params),

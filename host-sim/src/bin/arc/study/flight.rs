@@ -1,0 +1,368 @@
+//! `arc bench flight`: how long the planner's plans take to fly, stopping at every
+//! waypoint (as `arc sim --no-blend`) and along the blended trajectory (`arc sim`'s
+//! default), against the head's path length over the speed limit.
+//!
+//! Every run plans with `arc plan`'s defaults (refinement on), checks the plan and the
+//! trajectory exactly, and flies both with `arc sim`'s defaults on the scenario's map.
+//! Runs are sequential: each is deterministic in its spec, timings aside.
+
+use std::fmt::Write as _;
+use std::sync::atomic::AtomicUsize;
+use std::sync::Arc;
+use std::time::Instant;
+
+use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
+use aerial_chain::map::DistanceField;
+use aerial_chain::picture::{palette, stroke, Axis, Figure, Panel};
+use aerial_chain::planner::{to_plan, ArcPlanner, Planner, Query, Settings, Termination};
+use aerial_chain::problem::scenarios;
+use aerial_chain::sim::{
+    simulate_reference, simulate_with_progress, FlightReport, MapClearance, Progress, SimConfig,
+};
+use aerial_chain::tables::{ShapeTables, TableSettings};
+use aerial_chain::trajectory;
+use aerial_chain_core::ChainParams;
+
+/// One run: a plan, flown both ways.
+#[derive(Clone, Debug)]
+pub struct FlightRun {
+    /// Scenario.
+    pub scenario: String,
+    /// Units.
+    pub units: u8,
+    /// Planner and SRS seed.
+    pub seed: u64,
+    /// What went wrong, if anything (empty: both flights ran).
+    pub error: String,
+    /// Head path length of the plan (m).
+    pub head_path_m: f64,
+    /// Shape changes in the plan.
+    pub shape_changes: usize,
+    /// Corners of the plan, and how many the trajectory blends.
+    pub corners: usize,
+    /// Corners blended.
+    pub blended: usize,
+    /// Translations and shape changes merged.
+    pub merged: usize,
+    /// Time to make and check the trajectory (s).
+    pub trajectory_s: f64,
+    /// Trajectory duration (s).
+    pub trajectory_duration_s: f64,
+    /// Stop-at-every-waypoint flight.
+    pub before: Option<Flown>,
+    /// Trajectory flight.
+    pub after: Option<Flown>,
+}
+
+/// What one flight measured.
+#[derive(Clone, Copy, Debug)]
+pub struct Flown {
+    /// Time to reach the goal, from the start of the flight (s; the 1 s hold included).
+    pub time_s: f64,
+    /// Largest head tracking error (m).
+    pub head_max_m: f64,
+    /// Smallest clearance to the map (m).
+    pub min_clearance_m: f64,
+    /// Whether it arrived without contact.
+    pub success: bool,
+}
+
+impl Flown {
+    fn of(r: &FlightReport) -> Self {
+        Self {
+            time_s: r.time_to_complete.unwrap_or(f64::NAN),
+            head_max_m: r.head_max,
+            min_clearance_m: r.min_clearance.unwrap_or(f64::NAN),
+            success: r.success(),
+        }
+    }
+}
+
+impl FlightRun {
+    /// Flight time over head path / speed for one of the flights.
+    pub fn ratio(&self, f: Option<Flown>, speed: f64) -> f64 {
+        f.map_or(f64::NAN, |f| f.time_s / (self.head_path_m / speed))
+    }
+}
+
+/// Plans `scenario` for `units` with `seed` and flies it both ways.
+pub fn run_one(scenario: &str, units: u8, seed: u64) -> FlightRun {
+    let mut run = FlightRun {
+        scenario: scenario.into(),
+        units,
+        seed,
+        error: String::new(),
+        head_path_m: f64::NAN,
+        shape_changes: 0,
+        corners: 0,
+        blended: 0,
+        merged: 0,
+        trajectory_s: f64::NAN,
+        trajectory_duration_s: f64::NAN,
+        before: None,
+        after: None,
+    };
+    if let Err(e) = fly_both(&mut run) {
+        run.error = e;
+    }
+    run
+}
+
+fn fly_both(run: &mut FlightRun) -> Result<(), String> {
+    let sc = scenarios::build(&run.scenario).map_err(|e| e.to_string())?;
+    let params = ChainParams::new(run.units)
+        .validate()
+        .map_err(|e| e.to_string())?;
+    let field = Arc::new(DistanceField::new(sc.grid.clone()));
+    let ctx = CollisionContext::new(field, params, DEFAULT_CLEARANCE).map_err(|e| e.to_string())?;
+    let ts = TableSettings {
+        seed: run.seed,
+        ..Default::default()
+    };
+    let tables =
+        ShapeTables::build(params, &ts, &AtomicUsize::new(0)).map_err(|e| e.to_string())?;
+    let settings = Settings {
+        seed: run.seed,
+        ..Default::default()
+    };
+    let mut planner = ArcPlanner::new(ctx, tables, settings).map_err(|e| e.to_string())?;
+    let query = Query::new(
+        sc.start,
+        sc.start_shape(run.units).map_err(|e| e.to_string())?,
+        sc.goal,
+    );
+    let solution = planner
+        .solve(&query, Termination::default())
+        .map_err(|e| format!("no plan: {e}"))?;
+    let (solution, _) = planner.refine(&solution, None);
+    let grid = &sc.grid;
+    let plan = to_plan(
+        &solution,
+        &params,
+        grid.resolution(),
+        grid.unknown_is_occupied(),
+    );
+    let check = verify_plan(grid, &plan);
+    if !check.ok {
+        return Err(format!("plan invalid: {:?}", check.violation));
+    }
+    run.shape_changes = check
+        .edges
+        .iter()
+        .filter(|e| **e == aerial_chain::collision::EdgeKind::ShapeChange)
+        .count();
+    let began = Instant::now();
+    let tr = trajectory::build(&plan, grid, &trajectory::Settings::default())
+        .map_err(|e| e.to_string())?;
+    run.trajectory_s = began.elapsed().as_secs_f64();
+    run.head_path_m = tr.head_path_m();
+    run.corners = tr.corners();
+    run.blended = tr.blended();
+    run.merged = tr.merged();
+    run.trajectory_duration_s = tr.duration();
+    let cfg = SimConfig::default();
+    let obstacles = MapClearance::new(grid, &params);
+    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
+    let before = simulate_with_progress(
+        &params,
+        &waypoints,
+        &cfg,
+        Some(&obstacles),
+        &Progress::default(),
+    )
+    .map_err(|e| e.to_string())?;
+    run.before = Some(Flown::of(&before.report));
+    let after = simulate_reference(
+        &params,
+        tr.reference(),
+        &cfg,
+        Some(&obstacles),
+        &Progress::default(),
+    )
+    .map_err(|e| e.to_string())?;
+    run.after = Some(Flown::of(&after.report));
+    Ok(())
+}
+
+/// The runs as CSV, one row each.
+pub fn csv(runs: &[FlightRun], speed: f64) -> String {
+    let mut s = String::from(
+        "scenario,units,seed,head_path_m,path_over_speed_s,shape_changes,corners,blended,merged,trajectory_ms,trajectory_s,\
+         before_s,before_ratio,before_ok,before_head_max_m,before_min_clearance_m,\
+         after_s,after_ratio,after_ok,after_head_max_m,after_min_clearance_m,error\n",
+    );
+    for r in runs {
+        let f = |x: Option<Flown>| match x {
+            Some(f) => format!(
+                "{:.2},{:.3},{},{:.4},{:.4}",
+                f.time_s,
+                r.ratio(x, speed),
+                f.success,
+                f.head_max_m,
+                f.min_clearance_m
+            ),
+            None => ",,,,".into(),
+        };
+        let _ = writeln!(
+            s,
+            "{},{},{},{:.3},{:.2},{},{},{},{},{:.1},{:.2},{},{},{:?}",
+            r.scenario,
+            r.units,
+            r.seed,
+            r.head_path_m,
+            r.head_path_m / speed,
+            r.shape_changes,
+            r.corners,
+            r.blended,
+            r.merged,
+            r.trajectory_s * 1e3,
+            r.trajectory_duration_s,
+            f(r.before),
+            f(r.after),
+            r.error
+        );
+    }
+    s
+}
+
+/// A markdown table: per scenario and N, the median over seeds of both ratios.
+pub fn markdown(runs: &[FlightRun], speed: f64) -> String {
+    let mut s = String::from(
+        "| scenario | N | runs | head path (m) | path / speed (s) | stop at every waypoint (s) | ratio | trajectory (s) | ratio | all flights without contact |\n|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut keys: Vec<(String, u8)> = runs.iter().map(|r| (r.scenario.clone(), r.units)).collect();
+    keys.dedup();
+    for (sc, n) in keys {
+        let group: Vec<&FlightRun> = runs
+            .iter()
+            .filter(|r| r.scenario == sc && r.units == n && r.error.is_empty())
+            .collect();
+        let med = |f: &dyn Fn(&FlightRun) -> f64| median(group.iter().map(|r| f(r)).collect());
+        let ok = group
+            .iter()
+            .all(|r| r.before.is_some_and(|f| f.success) && r.after.is_some_and(|f| f.success));
+        let _ = writeln!(
+            s,
+            "| {sc} | {n} | {} | {:.1} | {:.1} | {:.1} | {:.2} | {:.1} | {:.2} | {} |",
+            group.len(),
+            med(&|r| r.head_path_m),
+            med(&|r| r.head_path_m / speed),
+            med(&|r| r.before.map_or(f64::NAN, |f| f.time_s)),
+            med(&|r| r.ratio(r.before, speed)),
+            med(&|r| r.after.map_or(f64::NAN, |f| f.time_s)),
+            med(&|r| r.ratio(r.after, speed)),
+            if ok { "yes" } else { "no" }
+        );
+    }
+    s
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.retain(|x| x.is_finite());
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let m = v.len() / 2;
+    if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    }
+}
+
+/// Flight time against head path / speed, both flights of every run, with the lines
+/// `time = path / speed` and the target `time = 2 path / speed`.
+pub fn figure(runs: &[FlightRun], speed: f64) -> String {
+    let points = |pick: &dyn Fn(&FlightRun) -> Option<Flown>| -> Vec<(f64, f64)> {
+        runs.iter()
+            .filter_map(|r| pick(r).map(|f| (r.head_path_m / speed, f.time_s)))
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect()
+    };
+    let (before, after) = (points(&|r| r.before), points(&|r| r.after));
+    let xmax = before.iter().chain(&after).map(|p| p.0).fold(1.0, f64::max) * 1.05;
+    let ymax = before.iter().chain(&after).map(|p| p.1).fold(1.0, f64::max) * 1.05;
+    let mut fig = Figure::new(900.0, 600.0, "");
+    let cell = fig.cells(1, 1, 0.0, 600.0)[0];
+    let x = Axis::linear("head path / speed (s)", (0.0, xmax));
+    let y = Axis::linear("simulated flight time (s)", (0.0, ymax));
+    let mut p = Panel::chart(
+        cell,
+        x,
+        y,
+        "arc bench flight: flight time against path length",
+    );
+    p.polyline(
+        &[(0.0, 0.0), (xmax, xmax)],
+        palette::INK,
+        stroke::HAIR,
+        true,
+    );
+    p.key(palette::INK, "path / speed");
+    p.polyline(
+        &[(0.0, 0.0), (xmax, 2.0 * xmax)],
+        palette::GOAL,
+        stroke::DATA,
+        true,
+    );
+    p.key(palette::GOAL, "target: 2 x path / speed");
+    for (pts, colour, label) in [
+        (&before, palette::series(1), "stop at every waypoint"),
+        (&after, palette::series(0), "blended trajectory"),
+    ] {
+        for &q in pts {
+            p.marker(q, 3.0, colour);
+        }
+        p.key(colour, label);
+    }
+    fig.add(p);
+    fig.to_svg()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(scenario: &str, seed: u64, before: f64, after: f64) -> FlightRun {
+        let flown = |t: f64| Flown {
+            time_s: t,
+            head_max_m: 0.01,
+            min_clearance_m: 0.1,
+            success: true,
+        };
+        FlightRun {
+            scenario: scenario.into(),
+            units: 5,
+            seed,
+            error: String::new(),
+            head_path_m: 10.0,
+            shape_changes: 3,
+            corners: 6,
+            blended: 4,
+            merged: 2,
+            trajectory_s: 0.01,
+            trajectory_duration_s: after - 1.0,
+            before: Some(flown(before)),
+            after: Some(flown(after)),
+        }
+    }
+
+    #[test]
+    fn table_csv_and_plot_of_the_runs() {
+        let runs = vec![run("maze", 1, 60.0, 30.0), run("maze", 2, 80.0, 50.0)];
+        let md = markdown(&runs, 0.5);
+        // Medians over the two seeds: 70 s and 40 s against 20 s of path.
+        assert!(
+            md.contains("| maze | 5 | 2 | 10.0 | 20.0 | 70.0 | 3.50 | 40.0 | 2.00 | yes |"),
+            "{md}"
+        );
+        let csv = csv(&runs, 0.5);
+        assert_eq!(csv.lines().count(), 3);
+        let cols = csv.lines().next().unwrap().split(',').count();
+        assert!(csv.lines().all(|l| l.split(',').count() == cols), "{csv}");
+        let svg = figure(&runs, 0.5);
+        assert!(svg.starts_with("<svg") && svg.contains("target: 2 x path / speed"));
+        assert!(median(vec![f64::NAN]).is_nan());
+    }
+}

@@ -1,0 +1,394 @@
+//! The free regions of the map for the head's sphere, labelled once per map: a proof
+//! in microseconds that start and goal are separated, whatever the map's size.
+//!
+//! Flooding the half-cell lattice to prove "no route" costs time in the size of the
+//! region flooded (seconds for a sealed room at 0.05 m). Instead, setup labels the
+//! connected regions of a coarser, RELAXED voxel set once, and a query compares labels.
+//!
+//! # Why a separation of voxels proves a separation of lattice points
+//! Give each half-cell lattice point (index `i` per axis) to the voxel `floor(i / 2)`:
+//! the voxel whose closed cube holds it, `|p - c| <= r sqrt(3) / 2` from its centre
+//! `c`. A lattice point `p` free for the sphere (distance `d(p) > R` to every obstacle
+//! cube) therefore lies in a voxel that
+//! - is not itself an obstacle (else `d(p) = 0`), and
+//! - has `d(c) > R - r sqrt(3) / 2` (the distance is 1-Lipschitz).
+//!
+//! The labelling only ever needs MORE free voxels than that (more voxels can only
+//! join regions), so it needs no exact measure: a voxel counts as relaxed-free when it
+//! is not an obstacle and the distance field's bound at its centre, plus the most the
+//! bound can lose there (`r (sqrt(3) - 1) / 2`: the nearest obstacle centre's cube is
+//! within `sqrt(n) - 1/2` voxels), exceeds `R - r sqrt(3) / 2`.
+//!
+//! Call such voxels RELAXED-FREE. Lattice neighbours differ by at most one index per
+//! axis, so their voxels are equal or 26-neighbours. Hence a lattice route maps to a
+//! 26-connected walk through relaxed-free voxels, and when the start's lattice
+//! anchors and the goal's lie in different 26-connected regions of relaxed-free
+//! voxels, no lattice route joins them. The converse does not hold (the relaxation can
+//! join what the lattice keeps apart); then the lattice search decides as before.
+//!
+//! # How it is labelled
+//! Relaxed-free voxels form runs along x in each (y, z) row, cut where they cross a
+//! block boundary (see below) into SEGMENTS. A segment touches a segment of a
+//! neighbouring row (`dy, dz` in -1..=1) when their x-ranges overlap or meet
+//! diagonally; a union-find over the segments joins them, row after row, looking back
+//! at the four neighbouring rows already seen. The work and memory follow the
+//! segments, not the voxels: a large open map is a few per row and block.
+//!
+//! # The coarse graph
+//! The same sweep builds a coarse graph for the A*'s heuristic ([`super::guide`]):
+//! the box is cut into blocks of `b >= 0.4 m` (at most about 100 000 of them), and a
+//! second union-find joins touching segments only within a block. Each of its sets is
+//! a NODE, a connected piece of free space in one block; two nodes are joined where
+//! their segments touch across a block boundary. Unlike a grid of block centres, this
+//! graph sees every opening the voxels see (a door in a thin wall included) and never
+//! steps through a wall: its edges are voxel adjacencies.
+
+use rayon::prelude::*;
+
+use crate::map::distance::DistanceField;
+
+/// Allowance for rounding in the relaxed test (m): relaxing further is always safe.
+const ROUND_EPS: f64 = 1e-6;
+
+/// Smallest block edge of the coarse graph (m).
+const MIN_BLOCK: f64 = 0.4;
+/// Most blocks over the map's box (the block edge grows to stay below).
+const MAX_BLOCKS: f64 = 100_000.0;
+
+/// Connected regions of relaxed-free voxels, and the coarse graph over them.
+#[derive(Clone, Debug)]
+pub struct Regions {
+    dims: [usize; 3],
+    /// Block edge of the coarse graph, in voxels.
+    block: u32,
+    /// Per row (`y + dims[1] z`), the index of its first segment; one entry more.
+    row_start: Vec<u32>,
+    /// Segments: runs of relaxed-free voxels along x, cut where they cross a block
+    /// boundary; `[x0, x1]` inclusive, local indices.
+    segs: Vec<[u32; 2]>,
+    /// Region of each coarse node (the smallest node index in it).
+    region: Vec<u32>,
+    /// Voxels per region, indexed by the region's node index.
+    size: Vec<u64>,
+    /// Coarse node of each segment: the segments of one block that are connected
+    /// within it.
+    node: Vec<u32>,
+    /// The coarse graph (see [`CoarseGraph`]).
+    coarse: CoarseGraph,
+}
+
+/// The coarse graph: one node per connected piece of relaxed-free voxels in a block,
+/// an edge where two pieces of neighbouring blocks touch.
+#[derive(Clone, Debug, Default)]
+pub struct CoarseGraph {
+    /// Mean position of each node's voxel centres (m).
+    pub centre: Vec<[f64; 3]>,
+    /// Per node, the index of its first edge in `edges`; one entry more.
+    pub edge_start: Vec<u32>,
+    /// Edges: the neighbour and the distance between the two centres (m).
+    pub edges: Vec<(u32, f32)>,
+    /// Block edge (m): how far a voxel can be from its node's centre, per axis.
+    pub block_m: f64,
+}
+
+impl Regions {
+    /// Labels the regions of `field`'s grid for a sphere of radius `radius` (m).
+    pub fn label(field: &DistanceField, radius: f64) -> Self {
+        let g = field.grid();
+        let dims = g.dims();
+        let r = g.resolution();
+        let threshold = radius - r * 3f64.sqrt() / 2.0 - ROUND_EPS;
+        let volume: f64 = dims.iter().map(|&d| d as f64 * r).product();
+        let block_m = MIN_BLOCK.max((volume / MAX_BLOCKS).cbrt());
+        let block = ((block_m / r).round() as u32).max(1);
+        // Segments of every row, rows in parallel by z-slab.
+        let slabs: Vec<Vec<Vec<[u32; 2]>>> = (0..dims[2])
+            .into_par_iter()
+            .map(|z| {
+                (0..dims[1])
+                    .map(|y| cut(row_runs(field, [y, z], threshold), block))
+                    .collect()
+            })
+            .collect();
+        let mut row_start = Vec::with_capacity(dims[1] * dims[2] + 1);
+        let mut segs = Vec::new();
+        for row in slabs.into_iter().flatten() {
+            row_start.push(segs.len() as u32);
+            segs.extend(row);
+        }
+        row_start.push(segs.len() as u32);
+        let mut regions = Self {
+            dims,
+            block,
+            row_start,
+            segs,
+            region: Vec::new(),
+            size: Vec::new(),
+            node: Vec::new(),
+            coarse: CoarseGraph::default(),
+        };
+        let across = regions.join_rows();
+        let voxels = regions.build_coarse(field, &across);
+        regions.label_regions(&voxels);
+        regions
+    }
+
+    /// The segments of row `(y, z)`.
+    fn row(&self, y: usize, z: usize) -> std::ops::Range<usize> {
+        let k = y + self.dims[1] * z;
+        self.row_start[k] as usize..self.row_start[k + 1] as usize
+    }
+
+    /// The block of segment `i` in row `(y, z)`.
+    fn block_of(&self, i: usize, y: usize, z: usize) -> [u32; 3] {
+        let b = self.block;
+        [self.segs[i][0] / b, y as u32 / b, z as u32 / b]
+    }
+
+    /// Calls `f(i, j)` for every pair of touching segments, `i` in row `(y, z)` and `j`
+    /// in the same row (the pieces of one run cut at a block boundary) or in one of the
+    /// four neighbouring rows seen before it, with whether the two share a block.
+    fn each_touching(&self, mut f: impl FnMut(usize, usize, bool)) {
+        let [_, ny, nz] = self.dims;
+        for z in 0..nz {
+            for y in 0..ny {
+                let here = self.row(y, z);
+                for i in here.start + 1..here.end {
+                    if self.segs[i - 1][1] + 1 == self.segs[i][0] {
+                        f(i - 1, i, false);
+                    }
+                }
+                for (dy, dz) in [(-1, 0), (-1, -1), (0, -1), (1, -1)] {
+                    let (yy, zz) = (y as i64 + dy, z as i64 + dz);
+                    if yy < 0 || zz < 0 || yy >= ny as i64 {
+                        continue;
+                    }
+                    let (yy, zz) = (yy as usize, zz as usize);
+                    let there = self.row(yy, zz);
+                    let (mut i, mut j) = (here.start, there.start);
+                    while i < here.end && j < there.end {
+                        let (ra, rb) = (self.segs[i], self.segs[j]);
+                        if ra[0] <= rb[1] + 1 && rb[0] <= ra[1] + 1 {
+                            f(i, j, self.block_of(i, y, z) == self.block_of(j, yy, zz));
+                        }
+                        // Advance the segment that ends first: it touches nothing further.
+                        if ra[1] < rb[1] {
+                            i += 1;
+                        } else {
+                            j += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Union-find over the segments: a touching pair within one block joins a coarse
+    /// node. Sets every segment's node; returns the touching pairs across blocks.
+    fn join_rows(&mut self) -> Vec<(u32, u32)> {
+        let n = self.segs.len();
+        let mut local: Vec<u32> = (0..n as u32).collect();
+        let mut across = Vec::new();
+        self.each_touching(|i, j, same_block| {
+            if same_block {
+                union(&mut local, i as u32, j as u32);
+            } else {
+                across.push((i as u32, j as u32));
+            }
+        });
+        // Coarse nodes: the local roots, numbered in order.
+        let mut number = vec![u32::MAX; n];
+        let mut count = 0u32;
+        self.node = (0..n)
+            .map(|i| {
+                let root = find(&mut local, i as u32) as usize;
+                if number[root] == u32::MAX {
+                    number[root] = count;
+                    count += 1;
+                }
+                number[root]
+            })
+            .collect();
+        across
+    }
+
+    /// The regions: the connected components of the coarse graph (its nodes are
+    /// connected pieces, its edges every adjacency between them), with their sizes.
+    fn label_regions(&mut self, voxels: &[f64]) {
+        let nodes = voxels.len();
+        let mut parent: Vec<u32> = (0..nodes as u32).collect();
+        for a in 0..nodes {
+            let edges = self.coarse.edge_start[a] as usize..self.coarse.edge_start[a + 1] as usize;
+            for &(b, _) in &self.coarse.edges[edges] {
+                union(&mut parent, a as u32, b);
+            }
+        }
+        let mut size = vec![0u64; nodes];
+        self.region = (0..nodes)
+            .map(|a| {
+                let root = find(&mut parent, a as u32);
+                size[root as usize] += voxels[a] as u64;
+                root
+            })
+            .collect();
+        self.size = size;
+    }
+
+    /// The coarse graph: node centres from the segments, edges where segments of two
+    /// nodes touch across a block boundary.
+    /// Returns the voxels of each node.
+    fn build_coarse(&mut self, field: &DistanceField, across: &[(u32, u32)]) -> Vec<f64> {
+        let nodes = self.node.iter().map(|&k| k as usize + 1).max().unwrap_or(0);
+        let mut sum = vec![[0f64; 3]; nodes];
+        let mut count = vec![0f64; nodes];
+        let [_, ny, nz] = self.dims;
+        for z in 0..nz {
+            for y in 0..ny {
+                for i in self.row(y, z) {
+                    let [x0, x1] = self.segs[i];
+                    let len = (x1 - x0 + 1) as f64;
+                    let k = self.node[i] as usize;
+                    let mid = (x0 + x1) as f64 / 2.0;
+                    for (a, v) in [mid, y as f64, z as f64].into_iter().enumerate() {
+                        sum[k][a] += v * len;
+                    }
+                    count[k] += len;
+                }
+            }
+        }
+        let g = field.grid();
+        let (lo, _) = g.bounds();
+        let r = g.resolution();
+        let centre: Vec<[f64; 3]> = (0..nodes)
+            .map(|k| [0, 1, 2].map(|a| lo[a] + (sum[k][a] / count[k] + 0.5) * r))
+            .collect();
+        // Neighbour lists; a node has a few dozen neighbours at most, and the same
+        // pair comes up row after row, so a linear check dedups cheaply.
+        let mut adjacent: Vec<Vec<u32>> = vec![Vec::new(); nodes];
+        for &(i, j) in across {
+            let (a, b) = (self.node[i as usize], self.node[j as usize]);
+            if a == b {
+                continue;
+            }
+            for (from, to) in [(a, b), (b, a)] {
+                let list = &mut adjacent[from as usize];
+                if list.last() != Some(&to) && !list.contains(&to) {
+                    list.push(to);
+                }
+            }
+        }
+        let mut edge_start = Vec::with_capacity(nodes + 1);
+        let mut edges = Vec::new();
+        for (a, list) in adjacent.iter_mut().enumerate() {
+            edge_start.push(edges.len() as u32);
+            list.sort_unstable();
+            for &b in list.iter() {
+                let d = super::dist(centre[a], centre[b as usize]);
+                edges.push((b, d as f32));
+            }
+        }
+        edge_start.push(edges.len() as u32);
+        self.coarse = CoarseGraph {
+            centre,
+            edge_start,
+            edges,
+            block_m: self.block as f64 * r,
+        };
+        count
+    }
+
+    /// The segment holding voxel `v` (local indices), when it is relaxed-free.
+    fn segment_of(&self, v: [usize; 3]) -> Option<usize> {
+        if (0..3).any(|a| v[a] >= self.dims[a]) {
+            return None;
+        }
+        let row = self.row(v[1], v[2]);
+        let segs = &self.segs[row.clone()];
+        let x = v[0] as u32;
+        let k = segs.partition_point(|r| r[1] < x);
+        (k < segs.len() && segs[k][0] <= x).then_some(row.start + k)
+    }
+
+    /// The region holding voxel `v` (local indices), `None` when it is not
+    /// relaxed-free.
+    pub fn region_of(&self, v: [usize; 3]) -> Option<u32> {
+        self.segment_of(v)
+            .map(|i| self.region[self.node[i] as usize])
+    }
+
+    /// The coarse node holding voxel `v` (local indices), `None` when it is not
+    /// relaxed-free.
+    pub fn node_of(&self, v: [usize; 3]) -> Option<u32> {
+        self.segment_of(v).map(|i| self.node[i])
+    }
+
+    /// The coarse graph.
+    pub fn coarse(&self) -> &CoarseGraph {
+        &self.coarse
+    }
+
+    /// Voxels in region `region`.
+    pub fn size(&self, region: u32) -> u64 {
+        self.size[region as usize]
+    }
+}
+
+/// `runs` cut where they cross a multiple of `block` (a block boundary along x).
+fn cut(runs: Vec<[u32; 2]>, block: u32) -> Vec<[u32; 2]> {
+    let mut out = Vec::with_capacity(runs.len());
+    for [mut x0, x1] in runs {
+        while x0 / block != x1 / block {
+            let end = (x0 / block + 1) * block - 1;
+            out.push([x0, end]);
+            x0 = end + 1;
+        }
+        out.push([x0, x1]);
+    }
+    out
+}
+
+/// The relaxed-free runs of row `(y, z)` (see the module docs).
+fn row_runs(field: &DistanceField, [y, z]: [usize; 2], threshold: f64) -> Vec<[u32; 2]> {
+    let g = field.grid();
+    let r = g.resolution();
+    // The field's bound is at most r (sqrt(3) - 1) / 2 below the true distance of a
+    // centre (see the module docs): a voxel it cannot rule out counts as free.
+    let bar = (threshold - r * (3f64.sqrt() - 1.0) / 2.0 - ROUND_EPS) as f32;
+    let mut runs = Vec::new();
+    let mut open: Option<u32> = None;
+    let row = g.obstacle_row(y, z).zip(field.row_bounds(y, z));
+    for (x, (obstacle, &lb)) in row.enumerate() {
+        let free = !obstacle && lb > bar;
+        match (free, open) {
+            (true, None) => open = Some(x as u32),
+            (false, Some(x0)) => {
+                runs.push([x0, x as u32 - 1]);
+                open = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some(x0) = open {
+        runs.push([x0, g.dims()[0] as u32 - 1]);
+    }
+    runs
+}
+
+/// The root of `i`, halving the path on the way.
+fn find(parent: &mut [u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        let p = parent[i as usize];
+        parent[i as usize] = parent[p as usize];
+        i = p;
+    }
+    i
+}
+
+/// Joins the sets of `a` and `b`; the smaller root wins, so labels are deterministic.
+fn union(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    if ra != rb {
+        let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+        parent[hi as usize] = lo;
+    }
+}

@@ -1,0 +1,349 @@
+//! The generator: a plan's edges timed with smooth ramps, consecutive edges blended
+//! where the blend is admissible.
+//!
+//! Edge `k` advances its progress `s` from 0 to 1: a smoothstep ramp up of length
+//! `U_k`, a cruise at rate `r_k`, a smoothstep ramp down of length `W_k`; it lasts
+//! `D_k = 1/r_k + (U_k + W_k)/2`. At a corner that is not blended, edge `k` ramps down
+//! to rest, and edge `k + 1` starts from rest after it on the next sample time. At a
+//! blended corner the two ramps have one length `R` and overlap exactly: edge `k + 1`
+//! starts `R` before edge `k` ends, so the chain moves by the sum of both and the
+//! velocity passes from one edge's cruise to the other's. During the overlap every rate
+//! is a convex mix of the two cruises (one ramps down as the other ramps up), so speeds
+//! and angle rates stay within their limits; the acceleration is `S'(x)/R` times the
+//! change of velocity, so `R = 1.5 * max(|dV_head| / accel, max_j |d omega_j| /
+//! angular_accel)` keeps it within its limits. A ramp from or to rest is the same rule
+//! with the other velocity zero. The ramps of an edge must fit (`r (U + W) / 2 <= 1`):
+//! where they do not, the edge's cruise is lowered until they do.
+//!
+//! Before that, a translation and the shape change beside it may be merged into one
+//! motion, straight in `zeta`, that moves head and shape at once (`super::merge`).
+//!
+//! What a blend or a merge can break is the chain's validity (the map, self-collision,
+//! the bend limit) and the clearance the planner kept: the sampled trajectory is checked
+//! exactly ([`super::check_samples`]), and where the motion is not the plan's own every
+//! body must also keep `Settings::clearance` from the map. A blended corner where the
+//! check fails is unblended, else a merged pair there is split, and the timing redone,
+//! until the whole passes. Without blends the chain is on the plan's own edges, resting
+//! on a sample at every waypoint, so only a plan that is itself inadmissible fails.
+
+use aerial_chain_core::ChainParams;
+
+use super::check::{check_with_margin, Violation};
+use super::merge::{self, Demand};
+use super::{Plan, Settings, TrajectoryError, MAX_SAMPLES};
+use crate::map::Grid;
+use crate::sim::reference::{Reference, Scaling, Segment};
+
+/// Peak of the smoothstep's derivative: a ramp of length `R` that changes a rate by
+/// `dv` accelerates by at most `1.5 dv / R`.
+const RAMP_PEAK: f64 = 1.5;
+
+/// Rounds of lowering cruise rates until every edge's ramps fit.
+const FIT_ROUNDS: usize = 200;
+
+/// A timed trajectory: its samples, and the analytic motion they were taken from.
+#[derive(Clone, Debug)]
+pub struct Trajectory {
+    params: ChainParams,
+    settings: Settings,
+    reference: Reference,
+    times: Vec<f64>,
+    zetas: Vec<Vec<f64>>,
+    corners: usize,
+    blended: usize,
+    merged: usize,
+    stop_go: f64,
+    head_path: f64,
+}
+
+impl Trajectory {
+    /// The chain.
+    pub fn params(&self) -> &ChainParams {
+        &self.params
+    }
+    /// The settings it was made with.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+    /// The analytic motion (what `arc sim` flies): `zeta` and its derivatives at any time.
+    pub fn reference(&self) -> &Reference {
+        &self.reference
+    }
+    /// Sample times (s): the multiples of the sample spacing from 0.
+    pub fn times(&self) -> &[f64] {
+        &self.times
+    }
+    /// `zeta` at every sample (angles continuous, not wrapped).
+    pub fn zetas(&self) -> &[Vec<f64>] {
+        &self.zetas
+    }
+    /// Time of the last sample, where the chain rests at the plan's end (s).
+    pub fn duration(&self) -> f64 {
+        self.times.last().copied().unwrap_or(0.0)
+    }
+    /// Places where two edges meet (edges that change nothing left out).
+    pub fn corners(&self) -> usize {
+        self.corners
+    }
+    /// Corners flown blended (the next edge ramping up as the one before ramps down).
+    pub fn blended(&self) -> usize {
+        self.blended
+    }
+    /// Pairs of a translation and a shape change flown at once, as one move.
+    pub fn merged(&self) -> usize {
+        self.merged
+    }
+    /// The duration when the chain stops at every waypoint, as `arc sim` timed plans (s).
+    pub fn stop_go_duration(&self) -> f64 {
+        self.stop_go
+    }
+    /// Length of the head's path (m).
+    pub fn head_path_m(&self) -> f64 {
+        self.head_path
+    }
+}
+
+/// Times `plan` within `settings` and blends its corners where the blended motion is
+/// admissible on `grid` (whose choice about unknown space is the one checked). Fails when
+/// the plan breaks its format, cannot be timed, or is not admissible even without blends.
+pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory, TrajectoryError> {
+    let params = plan.check()?;
+    settings.validate()?;
+    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
+    let l = params.link_length as f64;
+    let limits = settings.limits.to_reference();
+    let timed = Reference::new(params.n(), l, &waypoints, &limits)?;
+    let edges: Vec<Segment> = timed.segments().to_vec();
+    let stop_go = timed.duration();
+    let steps = (stop_go / settings.dt).ceil() as usize + edges.len() + 1;
+    if steps > MAX_SAMPLES {
+        return Err(TrajectoryError::TooLong(steps));
+    }
+    let head_path = edges
+        .iter()
+        .map(|s| (s.delta[0].powi(2) + s.delta[1].powi(2) + s.delta[2].powi(2)).sqrt())
+        .sum();
+    let demands: Vec<Demand> = edges.iter().map(|e| Demand::of(e, l)).collect();
+    let mut merged = merge::candidates(&edges, settings.blend);
+    // blend[k]: the motion that starts with edge k is blended with the one before.
+    let mut blend: Vec<bool> = (0..edges.len()).map(|k| k > 0 && settings.blend).collect();
+    // What the last round checked: its segments, and the first sample it found wrong.
+    let mut last: Option<(Vec<Segment>, usize)> = None;
+    loop {
+        let (motions, firsts, max_rates) = merge::assemble(&edges, &demands, &merged, &limits);
+        let merged_m: Vec<bool> = firsts
+            .iter()
+            .map(|&k| merged.get(k + 1).copied().unwrap_or(false))
+            .collect();
+        let mut blend_m: Vec<bool> = firsts.iter().map(|&k| blend[k]).collect();
+        let timing = Timing {
+            settings,
+            edges: &motions,
+            max_rates,
+        };
+        let segments = timing.segments(&mut blend_m);
+        firsts
+            .iter()
+            .zip(&blend_m)
+            .for_each(|(&k, &b)| blend[k] = b);
+        let reference = Reference::from_segments(params.n(), &waypoints[0], segments);
+        let (times, zetas) = sample(&reference, settings.dt);
+        let windows = windows(reference.segments(), &blend_m, &merged_m, settings.dt);
+        let margin = settings.clearance;
+        let required = |t: f64| match windows.iter().any(|w| w.0 <= t && t <= w.1) {
+            true => margin,
+            false => 0.0,
+        };
+        // Samples before the first segment that changed passed last round's check.
+        let from = last.as_ref().map_or(0, |(before, bad)| {
+            resume_at(before, reference.segments(), settings.dt).min(bad.saturating_sub(2))
+        });
+        let lim = &settings.limits;
+        let part = (&times[from..], &zetas[from..]);
+        let rep = check_with_margin(grid, &params, lim, part, margin, &required);
+        let Some(mut v) = rep.violation else {
+            return Ok(Trajectory {
+                params,
+                settings: *settings,
+                reference,
+                times,
+                zetas,
+                corners: edges.len().saturating_sub(1),
+                blended: blend_m.iter().filter(|b| **b).count(),
+                merged: merged.iter().filter(|b| **b).count(),
+                stop_go,
+                head_path,
+            });
+        };
+        v.sample += from;
+        let segs = reference.segments();
+        last = Some((segs.to_vec(), v.sample));
+        if let Some(m) = corner_near(segs, &blend_m, &v, settings.dt) {
+            blend[firsts[m]] = false;
+        } else if let Some(m) = motion_near(segs, &v, settings.dt).filter(|&m| merged_m[m]) {
+            merged[firsts[m] + 1] = false;
+        } else {
+            return Err(TrajectoryError::Inadmissible(v));
+        }
+    }
+}
+
+/// The times (one sample either side) where the motion is not the plan's own: the
+/// overlap of every blended corner and every merged motion.
+fn windows(segments: &[Segment], blend: &[bool], merged: &[bool], dt: f64) -> Vec<(f64, f64)> {
+    let end = |s: &Segment| s.t0 + s.duration;
+    let mut w = Vec::new();
+    for (m, s) in segments.iter().enumerate() {
+        if blend[m] && m > 0 {
+            w.push((s.t0 - dt, end(&segments[m - 1]) + dt));
+        }
+        if merged[m] {
+            w.push((s.t0 - dt, end(s) + dt));
+        }
+    }
+    w
+}
+
+/// The sample from which a trajectory of `now` segments must be checked again when one
+/// of `before` segments passed up to there: two samples before the first segment that
+/// differs (the acceleration at a sample looks one back).
+fn resume_at(before: &[Segment], now: &[Segment], dt: f64) -> usize {
+    let first = before.iter().zip(now).position(|(a, b)| a != b);
+    let t = match first {
+        Some(i) => now[i].t0.min(before[i].t0),
+        None if before.len() == now.len() => return usize::MAX,
+        None => now.get(before.len()).map_or(0.0, |s| s.t0),
+    };
+    ((t / dt).floor().max(0.0) as usize).saturating_sub(2)
+}
+
+/// The largest change of any angle of `eta` in a change of `zeta` by `delta`.
+pub(super) fn max_angle(delta: &[f64]) -> f64 {
+    delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()))
+}
+
+/// The motion whose time (two samples either side) holds `v`, the last if several.
+fn motion_near(segments: &[Segment], v: &Violation, dt: f64) -> Option<usize> {
+    let pad = 2.0 * dt;
+    (0..segments.len()).rev().find(|&m| {
+        v.t >= segments[m].t0 - pad && v.t <= segments[m].t0 + segments[m].duration + pad
+    })
+}
+
+/// The samples of `r`: every multiple of `dt` up to the first at or after its end (an
+/// unblended edge starts on one, so the chain is sampled at rest at its waypoint).
+fn sample(r: &Reference, dt: f64) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let last = ((r.duration() / dt) - 1e-9).ceil().max(0.0) as usize;
+    (0..=last)
+        .map(|j| {
+            let t = j as f64 * dt;
+            (t, r.zeta(t))
+        })
+        .unzip()
+}
+
+/// The blended corner whose overlap (two samples either side) holds `v`.
+fn corner_near(segments: &[Segment], blend: &[bool], v: &Violation, dt: f64) -> Option<usize> {
+    let pad = 2.0 * dt;
+    (1..segments.len()).find(|&k| {
+        let prev = &segments[k - 1];
+        blend[k] && v.t >= segments[k].t0 - pad && v.t <= prev.t0 + prev.duration + pad
+    })
+}
+
+/// What timing the edges needs.
+struct Timing<'a> {
+    settings: &'a Settings,
+    edges: &'a [Segment],
+    max_rates: Vec<f64>,
+}
+
+impl Timing<'_> {
+    /// The length of a ramp that takes the chain from cruising along `from` to
+    /// cruising along `to` (`None`: at rest) within the acceleration limits.
+    fn ramp(&self, from: Option<(&Segment, f64)>, to: Option<(&Segment, f64)>) -> f64 {
+        let lim = &self.settings.limits;
+        let v = |e: Option<(&Segment, f64)>, j: usize| e.map_or(0.0, |(s, r)| r * s.delta[j]);
+        let head = (0..3)
+            .map(|j| (v(to, j) - v(from, j)).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let dim = self.edges.first().map_or(0, |e| e.delta.len());
+        let angles = (3..dim).fold(0.0f64, |m, j| m.max((v(to, j) - v(from, j)).abs()));
+        RAMP_PEAK * (head / lim.accel).max(angles / lim.angular_accel)
+    }
+
+    /// Ramps up and down of every edge at cruise rates `rates`.
+    fn ramps(&self, rates: &[f64], blend: &[bool]) -> (Vec<f64>, Vec<f64>) {
+        let m = self.edges.len();
+        let at = |k: usize| Some((&self.edges[k], rates[k]));
+        let up: Vec<f64> = (0..m)
+            .map(|k| match blend[k] {
+                true => self.ramp(at(k - 1), at(k)),
+                false => self.ramp(None, at(k)),
+            })
+            .collect();
+        let down = (0..m)
+            .map(|k| match k + 1 < m && blend[k + 1] {
+                true => up[k + 1],
+                false => self.ramp(at(k), None),
+            })
+            .collect();
+        (up, down)
+    }
+
+    /// The timed segments: cruise rates lowered until every edge's ramps fit (an edge
+    /// that never fits is unblended on both sides, which always fits), then laid out.
+    fn segments(&self, blend: &mut [bool]) -> Vec<Segment> {
+        let m = self.edges.len();
+        let mut rates = self.max_rates.clone();
+        let (up, down) = loop {
+            let mut fitted = false;
+            for _ in 0..FIT_ROUNDS {
+                let (up, down) = self.ramps(&rates, blend);
+                let mut all = true;
+                for k in 0..m {
+                    let excess = rates[k] * (up[k] + down[k]) / 2.0;
+                    if excess > 1.0 {
+                        rates[k] /= excess.sqrt() * 1.001;
+                        all = false;
+                    }
+                }
+                if all {
+                    fitted = true;
+                    break;
+                }
+            }
+            let (up, down) = self.ramps(&rates, blend);
+            if fitted {
+                break (up, down);
+            }
+            for k in 0..m {
+                if rates[k] * (up[k] + down[k]) / 2.0 > 1.0 {
+                    blend[k] = false;
+                    if k + 1 < m {
+                        blend[k + 1] = false;
+                    }
+                }
+            }
+        };
+        let dt = self.settings.dt;
+        let mut end = 0.0f64;
+        let mut out: Vec<Segment> = Vec::with_capacity(m);
+        for k in 0..m {
+            let scaling = Scaling::with_ramps(rates[k], up[k], down[k]);
+            let t0 = match blend[k] {
+                true => end - up[k],
+                false => ((end / dt) - 1e-9).ceil().max(0.0) * dt,
+            };
+            end = t0 + scaling.duration;
+            out.push(Segment {
+                t0,
+                duration: scaling.duration,
+                scaling,
+                ..self.edges[k].clone()
+            });
+        }
+        out
+    }
+}

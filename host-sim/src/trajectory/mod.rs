@@ -1,0 +1,166 @@
+//! Timed trajectories: a plan's waypoints turned into a motion in time that the chain
+//! can fly without stopping at every waypoint (docs/model.md, "Trajectories").
+//!
+//! Every edge of the plan is timed as `arc sim` times it (a smoothstep speed ramp, a
+//! cruise at the limit, the mirror ramp), and then consecutive edges are blended: the
+//! next edge starts while the one before is still ramping down, so a corner is rounded
+//! and a shape change runs while the head slows down or speeds up; a translation and the
+//! shape change beside it may also be merged into one move. A blend or merge is kept
+//! only where the motion is admissible, checked exactly as `arc verify` checks edges,
+//! and keeps the planner's clearance margin; elsewhere the trajectory keeps the plan's
+//! "finish one edge, then start the next". The result is sampled on a uniform time grid, and the samples are the
+//! trajectory: [`check_samples`] checks them independently of how they were made.
+//!
+//! - `build`: [`build`] and [`Trajectory`], the generator;
+//! - `check`: [`check_samples`], the exact check of sampled motion and its limits;
+//! - `merge`: a translation and a shape change flown at once, where admissible;
+//! - `file`: [`TrajectoryFile`], the `arc-trajectory/1` JSON file and its CSV form.
+
+mod build;
+mod check;
+mod file;
+mod merge;
+#[cfg(test)]
+mod tests;
+
+// The one place this module names the plan file's types: the other files take them
+// from here.
+use crate::plan_file::{ChainSection, FormatError, MapSection, Plan};
+
+pub use build::{build, Trajectory};
+pub use check::{check_samples, CheckReport, Peaks, Problem, Violation, LIMIT_TOLERANCE};
+pub use file::{FileError, SampleRow, TrajectoryFile, TrajectoryStats, FORMAT};
+
+use serde::{Deserialize, Serialize};
+
+/// Sample spacing of a trajectory by default (s): 50 Hz.
+pub const DEFAULT_DT: f64 = 0.02;
+
+/// The limits a trajectory keeps at every sample (docs/model.md, "Trajectories").
+/// The defaults are `arc sim`'s.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Limits {
+    /// Largest speed of any unit centre (m/s).
+    pub speed: f64,
+    /// Largest acceleration of the head (m/s^2).
+    pub accel: f64,
+    /// Largest rate of any angle of `eta`: head yaw, link pitches and yaws (rad/s).
+    pub angular_rate: f64,
+    /// Largest angular acceleration of any angle of `eta` (rad/s^2).
+    pub angular_accel: f64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        let r = crate::sim::ReferenceLimits::default();
+        Self {
+            speed: r.speed,
+            accel: r.accel,
+            angular_rate: r.angular_rate,
+            angular_accel: r.angular_accel,
+        }
+    }
+}
+
+impl Limits {
+    /// Checks that every limit is a finite positive number.
+    pub fn validate(&self) -> Result<(), TrajectoryError> {
+        for (name, v) in [
+            ("speed", self.speed),
+            ("accel", self.accel),
+            ("angular_rate", self.angular_rate),
+            ("angular_accel", self.angular_accel),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(TrajectoryError::Limit { name, value: v });
+            }
+        }
+        Ok(())
+    }
+
+    /// The same limits for `arc sim`'s reference, without a hold at the start.
+    pub fn to_reference(&self) -> crate::sim::ReferenceLimits {
+        crate::sim::ReferenceLimits {
+            speed: self.speed,
+            accel: self.accel,
+            angular_rate: self.angular_rate,
+            angular_accel: self.angular_accel,
+            start_hold: 0.0,
+        }
+    }
+}
+
+/// How a trajectory is made.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// The limits.
+    pub limits: Limits,
+    /// Sample spacing (s), in `(0, 0.1]`.
+    pub dt: f64,
+    /// Blend consecutive edges where admissible (false: stop at every waypoint).
+    pub blend: bool,
+    /// Clearance (m) every body keeps from the map wherever the motion is not the
+    /// plan's own (a blend, a merge), so that a controller's tracking error cannot turn
+    /// a shortcut into a contact; the planner's default margin.
+    pub clearance: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            limits: Limits::default(),
+            dt: DEFAULT_DT,
+            blend: true,
+            clearance: crate::collision::DEFAULT_CLEARANCE,
+        }
+    }
+}
+
+/// Most samples one trajectory may have (a 5.5-hour flight at 50 Hz).
+pub const MAX_SAMPLES: usize = 1_000_000;
+
+/// Why a trajectory cannot be made.
+#[derive(Debug, thiserror::Error)]
+pub enum TrajectoryError {
+    /// The plan breaks the plan format.
+    #[error("plan: {0}")]
+    Plan(#[from] FormatError),
+    /// A limit that is not a positive number.
+    #[error("limit {name} = {value} must be a positive number")]
+    Limit {
+        /// The limit's name.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// A sample spacing outside `(0, 0.1]` s.
+    #[error("sample spacing dt = {0} s must lie in (0, 0.1]")]
+    Dt(f64),
+    /// The plan cannot be timed (an edge that changes both head and shape).
+    #[error("plan: {0}")]
+    Timing(#[from] crate::sim::ReferenceError),
+    /// The flight would need more samples than [`MAX_SAMPLES`].
+    #[error("the trajectory would take {0} samples, more than {MAX_SAMPLES}")]
+    TooLong(usize),
+    /// Even without blends the sampled motion is not admissible: the plan itself fails
+    /// the exact check between its samples.
+    #[error("the plan is not admissible as a trajectory: {0}")]
+    Inadmissible(Violation),
+}
+
+impl Settings {
+    /// Checks the limits and the sample spacing.
+    pub fn validate(&self) -> Result<(), TrajectoryError> {
+        self.limits.validate()?;
+        if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= 0.1) {
+            return Err(TrajectoryError::Dt(self.dt));
+        }
+        if !(self.clearance.is_finite() && self.clearance >= 0.0) {
+            return Err(TrajectoryError::Limit {
+                name: "clearance",
+                value: self.clearance,
+            });
+        }
+        Ok(())
+    }
+}

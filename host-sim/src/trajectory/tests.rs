@@ -1,0 +1,335 @@
+//! Trajectories: limits and validity checked at every sample by code that knows
+//! nothing of the generator, blends refused where they would touch the map, the
+//! checker's verdicts, and the file.
+
+use aerial_chain_core::{ChainParams, Shape};
+
+use super::*;
+use crate::collision::exact::check_config_exact;
+use crate::map::{Cell, Grid};
+use crate::plan_file::{Waypoint, FORMAT as PLAN_FORMAT};
+
+fn plan(params: &ChainParams, points: &[([f64; 3], Shape)]) -> Plan {
+    Plan {
+        format: PLAN_FORMAT.into(),
+        chain: ChainSection::from_params(params),
+        map: MapSection::new(0.1, true),
+        waypoints: points.iter().map(|(h, s)| Waypoint::new(*h, s)).collect(),
+        stats: Default::default(),
+    }
+}
+
+/// A free room of 4 x 4 x 2 m.
+fn room() -> Grid {
+    Grid::new(0.1, [0, 0, 0], [40, 40, 20], Cell::Free, true).unwrap()
+}
+
+/// Translation, yaw rotation, translation at a right angle, a climb.
+fn tour(params: &ChainParams) -> Plan {
+    let s = Shape::line(3, 0.0);
+    let r = s.rotated(0.6);
+    plan(
+        params,
+        &[
+            ([1.5, 1.0, 1.0], s),
+            ([2.8, 1.0, 1.0], s),
+            ([2.8, 1.0, 1.0], r),
+            ([2.8, 2.6, 1.0], r),
+            ([2.8, 2.6, 1.5], r),
+        ],
+    )
+}
+
+/// Unit centres by paper Eq. 2, written out here so the test does not lean on the
+/// library's kinematics.
+fn units(l: f64, z: &[f64]) -> Vec<[f64; 3]> {
+    let mut p = vec![[z[0], z[1], z[2]]];
+    for k in 0..(z.len() - 4) / 2 {
+        let (th, ps) = (z[4 + 2 * k], z[5 + 2 * k]);
+        let q = p[k];
+        p.push([
+            q[0] - l * ps.cos() * th.cos(),
+            q[1] - l * ps.sin() * th.cos(),
+            q[2] + l * th.sin(),
+        ]);
+    }
+    p
+}
+
+/// Every limit at every sample by differences, and every sample valid by the exact
+/// test: the test's own reading of docs/model.md, independent of the generator.
+fn assert_respects_limits(
+    grid: &Grid,
+    params: &ChainParams,
+    lim: &Limits,
+    t: &[f64],
+    z: &[Vec<f64>],
+) {
+    let l = params.link_length as f64;
+    let slack = 1.0 + 1e-6;
+    let angle = |a: f64| {
+        (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+    };
+    for j in 0..z.len() {
+        let head = [z[j][0], z[j][1], z[j][2]];
+        check_config_exact(grid, params, head, &z[j][3..], 0.0)
+            .unwrap_or_else(|v| panic!("sample {j} at {} s: {v}", t[j]));
+        if j + 1 == z.len() {
+            continue;
+        }
+        let h = t[j + 1] - t[j];
+        assert!(h > 0.0);
+        let (a, b) = (units(l, &z[j]), units(l, &z[j + 1]));
+        for (u, (p, q)) in a.iter().zip(&b).enumerate() {
+            let v =
+                ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt() / h;
+            assert!(v <= lim.speed * slack, "unit {u} at {v} m/s, t = {}", t[j]);
+        }
+        for (i, (x0, x1)) in z[j].iter().zip(&z[j + 1]).enumerate().skip(3) {
+            let w = angle(x1 - x0).abs() / h;
+            assert!(w <= lim.angular_rate * slack, "angle {i} at {w} rad/s");
+        }
+        if j > 0 {
+            let h0 = t[j] - t[j - 1];
+            let acc = |i: usize| {
+                2.0 * ((z[j + 1][i] - z[j][i]) / h - (z[j][i] - z[j - 1][i]) / h0) / (h + h0)
+            };
+            let a = (acc(0).powi(2) + acc(1).powi(2) + acc(2).powi(2)).sqrt();
+            assert!(a <= lim.accel * slack, "head at {a} m/s^2, t = {}", t[j]);
+            for i in 3..z[j].len() {
+                assert!(
+                    acc(i).abs() <= lim.angular_accel * slack,
+                    "angle {i} accelerates at {}",
+                    acc(i)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn blended_tour_keeps_every_limit_and_is_faster() {
+    let params = ChainParams::new(3);
+    let (grid, plan) = (room(), tour(&params));
+    let s = Settings::default();
+    let tr = build(&plan, &grid, &s).unwrap();
+    assert_eq!(tr.corners(), 3);
+    assert_eq!(
+        tr.merged(),
+        1,
+        "the first translation and the rotation fly at once"
+    );
+    assert_eq!(tr.blended(), 2, "a free room admits every blend");
+    assert!(
+        tr.duration() < 0.8 * tr.stop_go_duration(),
+        "{} vs {}",
+        tr.duration(),
+        tr.stop_go_duration()
+    );
+    assert_respects_limits(&grid, &params, &s.limits, tr.times(), tr.zetas());
+    let rep = check_samples(&grid, &params, &s.limits, tr.times(), tr.zetas(), 0.5);
+    assert!(rep.ok, "{:?}", rep.violation);
+    // Starts at the plan's start, ends at rest at its end.
+    let (first, last) = (&tr.zetas()[0], tr.zetas().last().unwrap());
+    assert_eq!(first, &plan.waypoints[0].zeta);
+    let goal = &plan.waypoints[4].zeta;
+    for i in 0..goal.len() {
+        let d = crate::collision::verify::wrap(last[i] - goal[i]);
+        assert!(
+            d.abs() < 1e-9,
+            "zeta[{i}] ends at {} not {}",
+            last[i],
+            goal[i]
+        );
+    }
+    let n = tr.zetas().len();
+    let moved = (0..3)
+        .map(|i| (last[i] - tr.zetas()[n - 2][i]).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        moved / s.dt < 1e-3,
+        "at rest at the end: {} m/s",
+        moved / s.dt
+    );
+    // Without blends: the stop-and-go timing, every corner at rest.
+    let plain = build(&plan, &grid, &Settings { blend: false, ..s }).unwrap();
+    assert_eq!((plain.blended(), plain.merged()), (0, 0));
+    assert!((plain.duration() - plain.stop_go_duration()).abs() <= 4.0 * s.dt);
+    assert_respects_limits(&grid, &params, &s.limits, plain.times(), plain.zetas());
+}
+
+/// Head along +x, then up: the chain's tail rounds the corner below a voxel that the
+/// plan's own edges pass at 5 mm.
+fn corner(params: &ChainParams) -> Plan {
+    let s = Shape::line(3, 0.0);
+    plan(
+        params,
+        &[
+            ([1.6, 1.0, 1.045], s),
+            ([2.955, 1.0, 1.045], s),
+            ([2.955, 1.0, 1.8], s),
+        ],
+    )
+}
+
+#[test]
+fn a_blend_that_would_touch_the_map_is_not_flown() {
+    let params = ChainParams::new(3);
+    let s = Settings::default();
+    let free = build(&corner(&params), &room(), &s).unwrap();
+    assert_eq!(free.blended(), 1);
+    let mut grid = room();
+    grid.fill_box([1.71, 0.51, 1.21], [1.79, 1.49, 1.29], Cell::Occupied);
+    let blocked = build(&corner(&params), &grid, &s).unwrap();
+    assert_eq!(
+        blocked.blended(),
+        0,
+        "the rounded corner brings the tail onto the voxel"
+    );
+    assert_respects_limits(&grid, &params, &s.limits, blocked.times(), blocked.zetas());
+    // The blended one does touch it: the check says where.
+    let rep = check_samples(&grid, &params, &s.limits, free.times(), free.zetas(), 0.0);
+    let v = rep.violation.expect("the blend touches the voxel");
+    assert!(matches!(v.problem, Problem::Invalid(_)), "{v}");
+}
+
+#[test]
+fn the_check_names_what_is_wrong() {
+    let params = ChainParams::new(3);
+    let grid = room();
+    let lim = Limits::default();
+    let tr = build(&tour(&params), &grid, &Settings::default()).unwrap();
+    let (t, z) = (tr.times().to_vec(), tr.zetas().to_vec());
+    let check = |t: &[f64], z: &[Vec<f64>]| {
+        check_samples(&grid, &params, &lim, t, z, 0.0)
+            .violation
+            .map(|v| v.problem)
+    };
+    assert_eq!(check(&t, &z), None);
+    let fast: Vec<f64> = t.iter().map(|x| x * 0.6).collect();
+    assert!(matches!(
+        check(&fast, &z),
+        Some(
+            Problem::Speed { .. }
+                | Problem::Accel { .. }
+                | Problem::AngularRate { .. }
+                | Problem::AngularAccel { .. }
+        )
+    ));
+    let mut back = t.clone();
+    back[5] = back[4];
+    assert!(matches!(check(&back, &z), Some(Problem::Time { .. })));
+    let mut short = z.clone();
+    short[7].pop();
+    assert!(matches!(check(&t, &short), Some(Problem::Sample { .. })));
+    let mut out = z.clone();
+    let j = z.len() / 2;
+    out[j][2] = 1.95;
+    out[j + 1][2] = 1.95;
+    let p = check(&t, &out).unwrap();
+    assert!(
+        matches!(
+            p,
+            Problem::Invalid(_) | Problem::Speed { .. } | Problem::Accel { .. }
+        ),
+        "{p}"
+    );
+    // Slow enough for the limits, but the jump passes through the ceiling.
+    let slow: Vec<f64> = t.iter().map(|x| x * 1000.0).collect();
+    assert!(matches!(check(&slow, &out), Some(Problem::Invalid(_))));
+}
+
+#[test]
+fn file_round_trips_and_refuses_bad_records() {
+    let params = ChainParams::new(3);
+    let plan = tour(&params);
+    let tr = build(&plan, &room(), &Settings::default()).unwrap();
+    let file = TrajectoryFile::new(&tr, &plan);
+    let text = serde_json::to_string(&file).unwrap();
+    let back = TrajectoryFile::parse(&text, "t.json").unwrap();
+    assert_eq!(back, file, "numbers read back exactly");
+    assert_eq!(back.zetas(), tr.zetas());
+    let csv = file.to_csv();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), tr.times().len() + 1);
+    let cols = lines[0].split(',').count();
+    assert_eq!(cols, 1 + 8 + 3 * 7);
+    assert!(lines.iter().all(|l| l.split(',').count() == cols));
+    let mut bad = file.clone();
+    bad.samples[3].p[1][0] += 0.01;
+    let e = TrajectoryFile::parse(&serde_json::to_string(&bad).unwrap(), "t.json").unwrap_err();
+    assert!(e.to_string().contains("samples[3].p[1]"), "{e}");
+    let mut bad = file.clone();
+    let last = bad.samples.len() - 1;
+    bad.samples[last].q[0] = [1.0, 0.0, 0.0, 0.0];
+    let e = TrajectoryFile::parse(&serde_json::to_string(&bad).unwrap(), "t.json").unwrap_err();
+    assert!(
+        e.to_string().contains(&format!("samples[{last}].q[0]")),
+        "{e}"
+    );
+    let e = TrajectoryFile::parse(
+        &text.replace("arc-trajectory/1", "arc-trajectory/9"),
+        "t.json",
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("format"), "{e}");
+    assert!(TrajectoryFile::parse("{}", "t.json").is_err());
+}
+
+#[test]
+fn blended_reference_is_smooth_and_within_limits_between_samples() {
+    let params = ChainParams::new(3);
+    let tr = build(&tour(&params), &room(), &Settings::default()).unwrap();
+    let r = tr.reference();
+    let lim = Limits::default();
+    let (h, mut t) = (1e-5, 0.01);
+    while t < r.duration() {
+        let (a, b, c) = (r.sample(t - h), r.sample(t), r.sample(t + h));
+        assert!(((c.p - a.p) / (2.0 * h) - b.v).norm() < 1e-5, "t = {t}");
+        assert!(((c.v - a.v) / (2.0 * h) - b.a).norm() < 1e-3, "t = {t}");
+        assert!(b.a.norm() <= lim.accel * (1.0 + 1e-9) && b.v.norm() <= lim.speed * (1.0 + 1e-9));
+        for k in 0..2 {
+            let d = (c.links[k].yaw - a.links[k].yaw) / (2.0 * h) - b.links[k].yaw_rate;
+            assert!(d.abs() < 1e-5);
+            assert!(b.links[k].yaw_acc.abs() <= lim.angular_accel * (1.0 + 1e-9));
+            assert!(b.links[k].yaw_rate.abs() <= lim.angular_rate * (1.0 + 1e-9));
+        }
+        t += 0.0173;
+    }
+}
+
+#[test]
+fn bad_settings_and_plans_are_refused() {
+    let params = ChainParams::new(3);
+    let grid = room();
+    let s = Settings {
+        dt: 0.0,
+        ..Settings::default()
+    };
+    assert!(matches!(
+        build(&tour(&params), &grid, &s),
+        Err(TrajectoryError::Dt(_))
+    ));
+    let s = Settings {
+        limits: Limits {
+            speed: -1.0,
+            ..Limits::default()
+        },
+        ..Settings::default()
+    };
+    assert!(matches!(
+        build(&tour(&params), &grid, &s),
+        Err(TrajectoryError::Limit { .. })
+    ));
+    let mut mixed = tour(&params);
+    mixed.waypoints[1].zeta[4] = 0.3;
+    let e = build(&mixed, &grid, &Settings::default()).unwrap_err();
+    assert!(e.to_string().contains("changes both"), "{e}");
+    // A plan through a wall is inadmissible with or without blends.
+    let mut wall = room();
+    wall.fill_box([2.0, 0.0, 0.0], [2.1, 4.0, 2.0], Cell::Occupied);
+    assert!(matches!(
+        build(&tour(&params), &wall, &Settings::default()),
+        Err(TrajectoryError::Inadmissible(_))
+    ));
+}

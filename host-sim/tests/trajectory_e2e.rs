@@ -1,0 +1,170 @@
+//! End to end: `arc plan --trajectory` and `arc trajectory` write trajectories that
+//! `arc verify --trajectory` checks exactly (every limit at every sample, every
+//! configuration between samples), and bad trajectories are refused with the reason.
+
+mod support;
+
+use support::{arc_ok, expect, plan_scenario, s};
+
+/// Plans `scenario` for `units` with its trajectory, and verifies the trajectory.
+fn plan_and_verify(scenario: &str, units: u8) -> serde_json::Value {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let plan = dir.path().join("plan.json");
+    let tr = dir.path().join("t.json");
+    plan_scenario(scenario, units, &["--trajectory", s(&tr)], &plan)
+        .unwrap_or_else(|e| panic!("{scenario} N={units}: {e}"));
+    arc_ok(&["verify", "--scenario", scenario, "--trajectory", s(&tr)])
+        .unwrap_or_else(|e| panic!("{scenario} N={units}: trajectory not verified: {e}"));
+    let text = std::fs::read_to_string(&tr).expect("trajectory");
+    serde_json::from_str(&text).expect("trajectory is JSON")
+}
+
+#[test]
+fn window_plan_and_trajectory_verify() {
+    let v = plan_and_verify("window", 4);
+    assert_eq!(v["format"], "arc-trajectory/1");
+    let st = &v["stats"];
+    let f = |k: &str| st[k].as_f64().unwrap_or_else(|| panic!("stats.{k}"));
+    assert!(f("duration_s") < f("stop_go_s"), "{st}");
+    assert!(f("blended") >= 1.0, "{st}");
+}
+
+#[test]
+fn maze_plan_and_trajectory_verify() {
+    let v = plan_and_verify("maze", 5);
+    let st = &v["stats"];
+    let f = |k: &str| st[k].as_f64().unwrap_or_else(|| panic!("stats.{k}"));
+    assert!(f("duration_s") < f("stop_go_s"), "{st}");
+}
+
+#[test]
+fn trajectory_command_csv_and_refusals() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let d = dir.path();
+    let plan = d.join("plan.json");
+    plan_scenario("window", 4, &[], &plan).expect("plan");
+    let (json, csv) = (d.join("t.json"), d.join("t.csv"));
+    let make = |out: &std::path::Path, more: &[&str]| {
+        let mut args = vec!["trajectory", "--scenario", "window", "--plan", s(&plan)];
+        args.extend_from_slice(&["--out", s(out)]);
+        args.extend_from_slice(more);
+        expect(&args, d, if more.is_empty() { 0 } else { 2 })
+    };
+    for out in [&json, &csv] {
+        make(out, &[]);
+    }
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header = text.lines().next().unwrap();
+    assert!(
+        header.starts_with("t,x1,y1,z1,psi1_r,theta1,psi1,"),
+        "{header}"
+    );
+    assert!(header.ends_with(",u4_qz"), "{header}");
+    // The same trajectory checked against a lower speed limit: invalid, and why.
+    let o = expect(
+        &[
+            "verify",
+            "--scenario",
+            "window",
+            "--trajectory",
+            s(&json),
+            "--speed",
+            "0.3",
+        ],
+        d,
+        1,
+    );
+    assert!(o.stderr.contains("above the limit 0.3 m/s"), "{}", o.stderr);
+    // Checked on another map: the chain touches it.
+    let o = expect(
+        &["verify", "--scenario", "maze", "--trajectory", s(&json)],
+        d,
+        1,
+    );
+    assert!(o.stderr.contains("INVALID"), "{}", o.stderr);
+    // Malformed files and flags are bad input, named.
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let mut bad = v.clone();
+    bad["samples"][3]["zeta"][0] = serde_json::json!(99.0);
+    let badf = d.join("bad.json");
+    std::fs::write(&badf, bad.to_string()).unwrap();
+    let o = expect(
+        &["verify", "--scenario", "window", "--trajectory", s(&badf)],
+        d,
+        2,
+    );
+    assert!(o.stderr.contains("samples[3].p[0]"), "{}", o.stderr);
+    let o = expect(
+        &["verify", "--scenario", "window", "--trajectory", s(&csv)],
+        d,
+        2,
+    );
+    assert!(o.stderr.contains("t.csv"), "{}", o.stderr);
+    let o = make(&json, &["--dt", "0"]);
+    assert!(o.stderr.contains("--dt"), "{}", o.stderr);
+    let o = expect(
+        &[
+            "plan",
+            "--scenario",
+            "window",
+            "--out",
+            "-",
+            "--trajectory",
+            "-",
+        ],
+        d,
+        2,
+    );
+    assert!(o.stderr.contains("--trajectory -"), "{}", o.stderr);
+    expect(&["verify", "--scenario", "window"], d, 2);
+    expect(
+        &[
+            "verify",
+            "--scenario",
+            "window",
+            "--plan",
+            s(&plan),
+            "--trajectory",
+            s(&json),
+        ],
+        d,
+        2,
+    );
+}
+
+/// `arc sim --trajectory` flies a trajectory file as it is, to the goal without contact.
+#[test]
+fn a_trajectory_file_is_flown() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (plan, tr, out) = (
+        dir.path().join("plan.json"),
+        dir.path().join("t.json"),
+        dir.path().join("sim.json"),
+    );
+    plan_scenario("window", 4, &["--trajectory", s(&tr)], &plan).expect("plan");
+    arc_ok(&[
+        "sim",
+        "--scenario",
+        "window",
+        "--trajectory",
+        s(&tr),
+        "--out",
+        s(&out),
+    ])
+    .unwrap_or_else(|e| panic!("arc sim --trajectory: {e}"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).expect("sim output")).unwrap();
+    let r = &v["report"];
+    assert_eq!(r["reached_goal"], true);
+    assert_eq!(r["contact"], false);
+    let t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&tr).expect("trajectory")).unwrap();
+    let planned = t["stats"]["duration_s"].as_f64().unwrap();
+    // The 1 s hold at the start, then the trajectory's own time.
+    let flown = r["planned_duration"].as_f64().unwrap();
+    assert!(
+        (flown - (planned + 1.0)).abs() < 1e-6,
+        "{flown} vs {planned}"
+    );
+}
