@@ -42,6 +42,11 @@ pub enum SettingsError {
 }
 
 pub use clearance::{footprint, MapClearance};
+
+// The type of `Sample::units` and `Sample::links`, so that users of a recorded flight
+// (the Python bindings) can name it.
+pub use flight::BodySample;
+
 pub use controller::{ChainController, ControllerConfig};
 pub use dynamics::{BodyState, ChainDynamics, Formulation, UnitCommand, V3};
 pub use flight::{

@@ -1,0 +1,52 @@
+"""The Aerial Robotic Chain from Python.
+
+N quadrotors joined by rigid links, planned through OctoMap maps by the ARCplanner,
+checked by the exact verifier and flown by the chain's simulation. A thin layer over
+the Rust library ``aerial_chain`` (the ``arc`` command line uses the same code)::
+
+    import aerial_chain as ac
+
+    world = ac.Map.scenario("window")              # or ac.Map.from_file("map.bt")
+    plan = ac.plan(world, units=5)                   # the defaults of `arc plan`
+    ac.verify(world, plan)                           # raises VerifyError if INVALID
+    plan.unit_positions()                            # (waypoints, N, 3) numpy array
+    flight = ac.simulate(world, plan)                # flight.unit_positions: (T, N, 3)
+
+Bad input raises ``MapError``, ``PlanError``, ``VerifyError`` or ``SimError``, all
+subclasses of ``ArcError`` (a ``ValueError``), with a message naming the file, field
+or argument and the value.
+"""
+
+from ._native import (
+    DEFAULT_CLEARANCE,
+    SCENARIOS,
+    ArcError,
+    Flight,
+    Map,
+    MapError,
+    Plan,
+    PlanError,
+    SimError,
+    VerifyError,
+    VerifyReport,
+    plan,
+    simulate,
+    verify,
+)
+
+__all__ = [
+    "DEFAULT_CLEARANCE",
+    "SCENARIOS",
+    "ArcError",
+    "Flight",
+    "Map",
+    "MapError",
+    "Plan",
+    "PlanError",
+    "SimError",
+    "VerifyError",
+    "VerifyReport",
+    "plan",
+    "simulate",
+    "verify",
+]

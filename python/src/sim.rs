@@ -1,0 +1,179 @@
+//! `simulate()`: a plan flown by the chain's dynamics and control stack (`arc sim`),
+//! and the recorded `Flight` as NumPy arrays.
+
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
+use pyo3::prelude::*;
+
+use aerial_chain::sim::{BodySample, FlightReport, MapClearance, Sample, SimConfig};
+
+use crate::map::Map;
+use crate::plan::Plan;
+use crate::{err, json_to_py, SimError};
+
+/// A flight: the chain's states every `record_every`-th step of the simulation, and
+/// its report. Arrays are indexed by sample first (`T` samples), then by unit.
+#[pyclass(module = "aerial_chain", frozen)]
+pub struct Flight {
+    /// The recorded samples.
+    samples: Vec<Sample>,
+    /// The summary of the whole flight.
+    report: FlightReport,
+}
+
+impl Flight {
+    /// One array of `(T, N, K)` from `K` numbers of every unit of every sample.
+    fn per_unit<'py, const K: usize>(
+        &self,
+        py: Python<'py>,
+        field: impl Fn(&BodySample) -> [f32; K],
+    ) -> Bound<'py, PyArray3<f64>> {
+        let n = self.report.units;
+        let v: Vec<f64> = self
+            .samples
+            .iter()
+            .flat_map(|s| s.units.iter().flat_map(&field).map(f64::from))
+            .collect();
+        Array3::from_shape_vec((self.samples.len(), n, K), v)
+            .expect("N units per sample")
+            .into_pyarray(py)
+    }
+
+    /// One array of `(T, K)` from `K` numbers of every sample.
+    fn per_sample<'py, const K: usize>(
+        &self,
+        py: Python<'py>,
+        field: impl Fn(&Sample) -> [f32; K],
+    ) -> Bound<'py, PyArray2<f64>> {
+        let v: Vec<f64> = self
+            .samples
+            .iter()
+            .flat_map(&field)
+            .map(f64::from)
+            .collect();
+        Array2::from_shape_vec((self.samples.len(), K), v)
+            .expect("K numbers per sample")
+            .into_pyarray(py)
+    }
+}
+
+#[pymethods]
+impl Flight {
+    /// Time of every sample, a `(T,)` array (s).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from_iter(self.samples.iter().map(|s| s.t)).into_pyarray(py)
+    }
+
+    /// Every unit's centre, a `(T, N, 3)` array (m, head first).
+    #[getter]
+    fn unit_positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        self.per_unit(py, |b| b.p)
+    }
+
+    /// Every unit's full rigid-body state, a `(T, N, 13)` array: position (m), attitude
+    /// quaternion `[w, x, y, z]`, velocity (m/s), angular velocity in the world frame
+    /// (rad/s).
+    #[getter]
+    fn unit_states<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        self.per_unit(py, |b| {
+            let mut x = [0.0; 13];
+            for (slot, v) in x
+                .iter_mut()
+                .zip(b.p.iter().chain(&b.q).chain(&b.v).chain(&b.w))
+            {
+                *slot = *v;
+            }
+            x
+        })
+    }
+
+    /// The reference head position the controller tracked, a `(T, 3)` array (m).
+    #[getter]
+    fn head_reference<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.per_sample(py, |s| s.head_ref)
+    }
+
+    /// The summary (`arc sim --out`'s `report`): time to complete, tracking errors,
+    /// clearance to the map, joint-limit excursions, ...
+    #[getter]
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report)
+    }
+
+    /// True when the chain reached the plan's goal without touching the map or itself.
+    #[getter]
+    fn success(&self) -> bool {
+        self.report.success()
+    }
+
+    fn __len__(&self) -> usize {
+        self.samples.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Flight(N = {}, {} samples over {:.2} s, {})",
+            self.report.units,
+            self.samples.len(),
+            self.report.simulated_time,
+            if self.report.success() {
+                "arrived without contact"
+            } else {
+                "did not succeed"
+            }
+        )
+    }
+}
+
+/// Flies `plan` on `map` with the chain's dynamics and control stack (`arc sim`, same
+/// defaults): `rate` (Hz), largest unit `speed` (m/s), head `accel` (m/s^2), shape
+/// `angular_rate` (rad/s), arrival within `goal_tol` (m) and `settle_time` (s) of the
+/// plan's end. Keeps one step in `record_every`. Raises `SimError` for settings outside
+/// their limits or a plan the simulation cannot fly; a flight that fails is no error
+/// (`Flight.success`, `Flight.report`).
+#[pyfunction]
+#[pyo3(signature = (
+    map, plan, rate = 500.0, speed = 0.5, accel = 0.5, angular_rate = 0.4, goal_tol = 0.1,
+    settle_time = 10.0, record_every = 10
+))]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments, each with a default.
+pub fn simulate(
+    py: Python<'_>,
+    map: &Map,
+    plan: &Plan,
+    rate: f64,
+    speed: f64,
+    accel: f64,
+    angular_rate: f64,
+    goal_tol: f64,
+    settle_time: f64,
+    record_every: usize,
+) -> PyResult<Flight> {
+    if record_every == 0 {
+        return Err(err::<SimError>("record_every = 0: at least 1"));
+    }
+    let mut cfg = SimConfig {
+        rate,
+        goal_tolerance: goal_tol,
+        settle_time,
+        ..SimConfig::default()
+    };
+    cfg.limits.speed = speed;
+    cfg.limits.accel = accel;
+    cfg.limits.angular_rate = angular_rate;
+    cfg.validate()
+        .map_err(|e| err::<SimError>(format!("simulation settings: {e}")))?;
+    let params = plan.params;
+    let waypoints: Vec<Vec<f64>> = plan.plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
+    let flight = py
+        .detach(|| {
+            let obstacles = MapClearance::new(&map.grid, &params);
+            aerial_chain::sim::simulate(&params, &waypoints, &cfg, Some(&obstacles))
+        })
+        .map_err(err::<SimError>)?;
+    Ok(Flight {
+        samples: flight.samples.into_iter().step_by(record_every).collect(),
+        report: flight.report,
+    })
+}
