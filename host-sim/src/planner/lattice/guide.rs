@@ -61,6 +61,19 @@ impl<'a> Guide<'a> {
         guide
     }
 
+    /// A guide that knows nothing but the straight line to `goal`.
+    pub(super) fn straight(lat: &'a HeadLattice, regions: &'a Regions, goal: [f64; 3]) -> Self {
+        Self {
+            lat,
+            regions,
+            dist: Vec::new(),
+            next: Vec::new(),
+            connected: false,
+            reach: 0.0,
+            goal,
+        }
+    }
+
     fn node(&self, k: u64) -> Option<u32> {
         self.regions.node_of(self.lat.voxel_of(k))
     }

@@ -75,6 +75,9 @@ const CLEARANCE_REF: f64 = 0.5;
 const HEURISTIC_WEIGHT: f64 = 2.5;
 /// Longest step (lattice spacings) in open space.
 const MAX_JUMP: f64 = 16.0;
+/// Lattice points the first, straight-line-guided search may touch before the
+/// coarse guide is built.
+const QUICK_BUDGET: usize = 20_000;
 /// A string-pulled segment keeps the clearance of the points it replaces up to this
 /// much above the preferred radius (m).
 const KEEP_CAP: f64 = 0.3;
@@ -300,25 +303,32 @@ impl HeadLattice {
             field,
             map: KeyMap::default(),
         };
-        let mut expanded = 0;
         let regions = self.regions(field);
+        // First the straight line as the heuristic, within a small budget: where no wall
+        // stands in the way (a corridor, open air) it finds the route at once, for less
+        // than the guide's Dijkstra over the map would cost.
+        let quick = Limit {
+            budget: QUICK_BUDGET.min(budget),
+            deadline,
+        };
+        let straight = guide::Guide::straight(self, regions, goal);
+        if let Search::Found(keys, n) = self.search(&mut nodes, start, goal, 2, &quick, &straight) {
+            return self.finish(ctx_min, &mut nodes, start, goal, keys, n);
+        }
+        let mut expanded = self.searched.take().unwrap_or(0);
+        Self::reset(&mut nodes);
         let starts = self.anchors(&mut nodes, start, 1);
         let goals = self.anchors(&mut nodes, goal, 1);
         let guide = guide::Guide::new(self, regions, &starts, &goals, goal);
         match self.search(&mut nodes, start, goal, 2, &limit, &guide) {
             Search::Found(keys, n) => {
-                return self.finish(ctx_min, &mut nodes, start, goal, keys, n)
+                return self.finish(ctx_min, &mut nodes, start, goal, keys, n + expanded)
             }
             Search::Budget => return LatticeOutcome::Budget,
             _ => {}
         }
-        if let Some(n) = self.searched.take() {
-            expanded = n;
-        }
-        // The clearances stay valid; the search state does not.
-        for n in nodes.map.values_mut() {
-            (n.g, n.parent, n.closed, n.flooded) = (f64::INFINITY, u64::MAX, false, false);
-        }
+        expanded += self.searched.take().unwrap_or(0);
+        Self::reset(&mut nodes);
         match self.search(&mut nodes, start, goal, 1, &limit, &guide) {
             Search::Found(keys, n) => {
                 self.finish(ctx_min, &mut nodes, start, goal, keys, n + expanded)
@@ -331,6 +341,13 @@ impl HeadLattice {
             },
             Search::NoAnchor(side) => LatticeOutcome::NoAnchor { side },
             Search::Exhausted | Search::Budget => LatticeOutcome::Budget,
+        }
+    }
+
+    /// Forgets the search state of every point touched (their clearances stay valid).
+    fn reset(nodes: &mut Nodes) {
+        for n in nodes.map.values_mut() {
+            (n.g, n.parent, n.closed, n.flooded) = (f64::INFINITY, u64::MAX, false, false);
         }
     }
 
