@@ -87,8 +87,6 @@ pub struct CoarseGraph {
     pub edge_start: Vec<u32>,
     /// Edges: the neighbour and the distance between the two centres (m).
     pub edges: Vec<(u32, f32)>,
-    /// Block edge (m): how far a voxel can be from its node's centre, per axis.
-    pub block_m: f64,
 }
 
 impl Regions {
@@ -292,7 +290,6 @@ impl Regions {
             centre,
             edge_start,
             edges,
-            block_m: self.block as f64 * r,
         };
         count
     }
