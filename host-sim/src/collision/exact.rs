@@ -328,10 +328,11 @@ pub fn exact_clearance(field: &DistanceField, p: [f64; 3], stop: f64, cap: f64) 
         }
         for dz in -k..=k {
             for dy in -k..=k {
-                for dx in -k..=k {
-                    if dx.abs().max(dy.abs()).max(dz.abs()) != k {
-                        continue;
-                    }
+                // On the ring's faces in z or y every x belongs to the ring; inside
+                // them only its two x faces do (the shell, not the whole cube).
+                let face = dz.abs() == k || dy.abs() == k;
+                let step = if face { 1 } else { (2 * k).max(1) };
+                for dx in (-k..=k).step_by(step as usize) {
                     let i = [c0[0] + dx, c0[1] + dy, c0[2] + dz];
                     if !g.is_obstacle(i) {
                         continue;

@@ -43,6 +43,7 @@
 //! holds with the nearest grid voxel's centre (the triangle inequality works with any
 //! centre). Unit centres must be inside the bounding box anyway (checked separately).
 
+use rayon::prelude::*;
 use std::sync::OnceLock;
 
 use super::grid::Grid;
@@ -167,71 +168,158 @@ fn edt_1d(f: &[u32], walls: bool, out: &mut [u32], v: &mut [i64], z: &mut [f64])
 pub(crate) fn squared_edt(grid: &Grid) -> Vec<u32> {
     let [nx, ny, nz] = grid.dims();
     let walls = grid.unknown_is_occupied();
-    let mut d: Vec<u32> = Vec::with_capacity(nx * ny * nz);
-    for z in 0..nz {
-        for y in 0..ny {
-            for x in 0..nx {
+    let mut d: Vec<u32> = vec![NONE; nx * ny * nz];
+    // x: contiguous rows, the obstacles set first. The passes are separable, so each
+    // runs its 1D transforms in parallel (rayon), every thread with its own scratch.
+    d.par_chunks_exact_mut(nx).enumerate().for_each_init(
+        || Scratch::new(nx),
+        |s, (k, r)| {
+            let (y, z) = (k % ny, k / ny);
+            for (x, c) in r.iter_mut().enumerate() {
                 let occ = match grid.cell_local([x, y, z]) {
                     super::grid::Cell::Occupied => true,
                     super::grid::Cell::Free => false,
                     super::grid::Cell::Unknown => walls,
                 };
-                d.push(if occ { 0 } else { NONE });
+                *c = if occ { 0 } else { NONE };
             }
-        }
-    }
-    let m = nx.max(ny).max(nz);
-    let mut row = vec![0u32; m];
-    let mut out = vec![0u32; m];
-    let mut v = vec![0i64; m + 3];
-    let mut zz = vec![0f64; m + 4];
-    // x: contiguous rows.
-    for r in d.chunks_exact_mut(nx) {
-        row[..nx].copy_from_slice(r);
-        edt_1d(&row[..nx], walls, &mut out[..nx], &mut v, &mut zz);
-        r.copy_from_slice(&out[..nx]);
-    }
-    // y: stride nx inside each z slab.
-    for z in 0..nz {
-        let slab = &mut d[z * nx * ny..(z + 1) * nx * ny];
-        for x in 0..nx {
-            for y in 0..ny {
-                row[y] = slab[x + nx * y];
+            s.transform(r, walls);
+        },
+    );
+    // y: stride nx inside each z slab; slabs in parallel.
+    d.par_chunks_exact_mut(nx * ny).for_each_init(
+        || Scratch::new(ny),
+        |s, slab| {
+            for x in 0..nx {
+                s.transform_strided(slab, x, nx, ny, walls);
             }
-            edt_1d(&row[..ny], walls, &mut out[..ny], &mut v, &mut zz);
-            for y in 0..ny {
-                slab[x + nx * y] = out[y];
-            }
-        }
-    }
-    // z: stride nx * ny; process a block of x at a time for locality.
+        },
+    );
+    // z: stride nx * ny. Columns of different y never share a cell, so each y is a
+    // task writing only its own cells (see `Columns`); 64 columns at a time, copied
+    // out by rows, for locality.
     let plane = nx * ny;
-    let mut block = vec![0u32; nz * 64];
-    for y in 0..ny {
-        let mut x0 = 0;
-        while x0 < nx {
-            let w = 64.min(nx - x0);
-            for z in 0..nz {
-                let base = x0 + nx * y + plane * z;
-                block[z * 64..z * 64 + w].copy_from_slice(&d[base..base + w]);
+    let cols = Columns(d.as_mut_ptr(), d.len());
+    (0..ny).into_par_iter().for_each_init(
+        || (Scratch::new(nz), vec![0u32; nz * BLOCK]),
+        |(s, block), y| {
+            for x0 in (0..nx).step_by(BLOCK) {
+                let w = BLOCK.min(nx - x0);
+                // SAFETY: cells `x + nx y + plane z` for this task's `y` are written
+                // by this task only, and every index is below `d.len()`.
+                unsafe { cols.transform_block(s, block, x0 + nx * y, w, plane, nz, walls) };
             }
-            for j in 0..w {
-                for z in 0..nz {
-                    row[z] = block[z * 64 + j];
-                }
-                edt_1d(&row[..nz], walls, &mut out[..nz], &mut v, &mut zz);
-                for z in 0..nz {
-                    block[z * 64 + j] = out[z];
-                }
-            }
-            for z in 0..nz {
-                let base = x0 + nx * y + plane * z;
-                d[base..base + w].copy_from_slice(&block[z * 64..z * 64 + w]);
-            }
-            x0 += w;
+        },
+    );
+    d
+}
+
+/// Scratch space of the 1D transform for lines of up to `n` cells.
+struct Scratch {
+    row: Vec<u32>,
+    out: Vec<u32>,
+    v: Vec<i64>,
+    z: Vec<f64>,
+}
+
+impl Scratch {
+    fn new(n: usize) -> Self {
+        Self {
+            row: vec![0; n],
+            out: vec![0; n],
+            v: vec![0; n + 3],
+            z: vec![0.0; n + 4],
         }
     }
-    d
+
+    /// The 1D transform of the contiguous line `line`, in place.
+    fn transform(&mut self, line: &mut [u32], walls: bool) {
+        let n = line.len();
+        self.row[..n].copy_from_slice(line);
+        edt_1d(
+            &self.row[..n],
+            walls,
+            &mut self.out[..n],
+            &mut self.v,
+            &mut self.z,
+        );
+        line.copy_from_slice(&self.out[..n]);
+    }
+
+    /// The 1D transform of the `n` cells `first + k stride` of `cells`, in place.
+    fn transform_strided(
+        &mut self,
+        cells: &mut [u32],
+        first: usize,
+        stride: usize,
+        n: usize,
+        walls: bool,
+    ) {
+        for k in 0..n {
+            self.row[k] = cells[first + k * stride];
+        }
+        edt_1d(
+            &self.row[..n],
+            walls,
+            &mut self.out[..n],
+            &mut self.v,
+            &mut self.z,
+        );
+        for k in 0..n {
+            cells[first + k * stride] = self.out[k];
+        }
+    }
+}
+
+/// The field's cells, shared by the z pass's tasks, each of which touches only the
+/// columns of its own y.
+#[derive(Clone, Copy)]
+struct Columns(*mut u32, usize);
+
+// SAFETY: the tasks that share it write disjoint cells (see `squared_edt`).
+unsafe impl Send for Columns {}
+unsafe impl Sync for Columns {}
+
+/// Columns the z pass copies out together.
+const BLOCK: usize = 64;
+
+impl Columns {
+    /// The 1D transforms of the `w` columns starting at `first` (cells
+    /// `first + j + k stride`, `j < w`, `k < n`), in place, through `block`.
+    ///
+    /// # Safety
+    /// No other thread may touch these cells meanwhile, and they must all be below
+    /// the length.
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn transform_block(
+        &self,
+        s: &mut Scratch,
+        block: &mut [u32],
+        first: usize,
+        w: usize,
+        stride: usize,
+        n: usize,
+        walls: bool,
+    ) {
+        debug_assert!(n == 0 || first + w - 1 + (n - 1) * stride < self.1);
+        for k in 0..n {
+            let src = std::slice::from_raw_parts(self.0.add(first + k * stride), w);
+            block[k * BLOCK..k * BLOCK + w].copy_from_slice(src);
+        }
+        for j in 0..w {
+            for k in 0..n {
+                s.row[k] = block[k * BLOCK + j];
+            }
+            edt_1d(&s.row[..n], walls, &mut s.out[..n], &mut s.v, &mut s.z);
+            for k in 0..n {
+                block[k * BLOCK + j] = s.out[k];
+            }
+        }
+        for k in 0..n {
+            let dst = std::slice::from_raw_parts_mut(self.0.add(first + k * stride), w);
+            dst.copy_from_slice(&block[k * BLOCK..k * BLOCK + w]);
+        }
+    }
 }
 
 /// Rounds a non-negative `f64` down to an `f32`.

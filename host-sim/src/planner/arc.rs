@@ -29,8 +29,9 @@ use crate::tables::ShapeTables;
 /// Counters and timings of one query.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Stats {
-    /// Setup (the head roadmap and the labelled free regions), query and
-    /// collision-check times.
+    /// Search structures built for this query (the labelled free regions and the
+    /// uniform head roadmap, when it needed them and they were not built before),
+    /// the query's other time, and its collision-check time.
     pub timings: Timings,
     /// Head edges flown.
     pub edges: usize,
@@ -63,6 +64,9 @@ pub struct Stats {
     pub lattice_expanded: usize,
     /// Head route search time (s), part of the query time.
     pub lattice_s: f64,
+    /// Time (s) this query spent labelling the map's free regions (0 when it did not
+    /// need them or they were labelled before), part of `timings.roadmap_s`.
+    pub regions_s: f64,
     /// Points of the head route added to the roadmap (start and goal included).
     pub route_points: usize,
     /// Full-chain collision checks (configurations, translations, shape changes).
@@ -124,17 +128,37 @@ impl ArcPlanner {
         })
     }
 
-    /// Builds the head roadmap (once; later calls do nothing), cut short at
-    /// `deadline` (the roadmap is then smaller).
-    fn setup_until(&mut self, deadline: Option<Instant>) {
-        if self.roadmap.is_none() {
-            let t = Instant::now();
-            if self.settings.head_lattice {
-                self.lattice.regions(self.ctx.field());
-            }
-            self.build_roadmap(self.settings.vertices, deadline);
-            self.roadmap_s = t.elapsed().as_secs_f64();
+    /// Builds what every query needs before it starts: the uniform head roadmap
+    /// when the lattice is off (the paper's planner). With the lattice on, nothing: a
+    /// query first flies the lattice's head route, and only a query that needs them
+    /// labels the free regions or builds the uniform roadmap (both kept until
+    /// [`Planner::clear`]). Returns the time spent (s).
+    fn setup_until(&mut self, deadline: Option<Instant>) -> f64 {
+        if self.settings.head_lattice {
+            return 0.0;
         }
+        self.ensure_roadmap(deadline)
+    }
+
+    /// Builds the uniform head roadmap if there is none yet, cut short at `deadline`
+    /// (the roadmap is then smaller). Returns the time spent (s).
+    fn ensure_roadmap(&mut self, deadline: Option<Instant>) -> f64 {
+        if self.roadmap.is_some() {
+            return 0.0;
+        }
+        let t = Instant::now();
+        self.build_roadmap(self.settings.vertices, deadline);
+        let spent = t.elapsed().as_secs_f64();
+        self.roadmap_s += spent;
+        spent
+    }
+
+    /// Labels the map's free regions if that has not been done. Returns the time
+    /// spent (s).
+    fn ensure_regions(&self) -> f64 {
+        let t = Instant::now();
+        self.lattice.regions(self.ctx.field());
+        t.elapsed().as_secs_f64()
     }
 
     /// (Re)builds the roadmap with `vertices` vertices, or fewer if `deadline` passes.
@@ -142,6 +166,12 @@ impl ArcPlanner {
     /// smaller one. The radius shrinks as `(M_VT / vertices)^(1/3)`, so the number of
     /// neighbours stays the same.
     fn build_roadmap(&mut self, vertices: usize, deadline: Option<Instant>) {
+        self.roadmap = Some(self.sampled_roadmap(vertices, deadline));
+    }
+
+    /// A roadmap of `vertices` uniform samples (0: an empty one, for a query over
+    /// the lattice's head route alone).
+    fn sampled_roadmap(&self, vertices: usize, deadline: Option<Instant>) -> Roadmap {
         let mut rng = Pcg64::seed_from_u64(self.settings.seed);
         let weight = (
             self.settings.clearance_weight,
@@ -150,9 +180,7 @@ impl ArcPlanner {
         let r_t =
             self.settings.r_t * (self.settings.vertices as f64 / vertices.max(1) as f64).cbrt();
         let near = (r_t, self.settings.max_neighbours);
-        self.roadmap = Some(Roadmap::build(
-            &self.ctx, vertices, near, weight, &mut rng, deadline,
-        ));
+        Roadmap::build(&self.ctx, vertices, near, weight, &mut rng, deadline)
     }
 
     /// The settings.
@@ -160,8 +188,9 @@ impl ArcPlanner {
         &self.settings
     }
 
-    /// The lattice's head route (`Ok(None)`: the lattice cannot say within `budget`);
-    /// [`PlanError::Separated`] when it proves that none exists. Adds its time to `s`.
+    /// The lattice's head route guided by the labelled regions (`Ok(None)`: the
+    /// lattice cannot say within `budget`); [`PlanError::Separated`] when it proves
+    /// that none exists. Adds its time to `s`.
     fn head_route(
         &self,
         start: [f64; 3],
@@ -173,7 +202,7 @@ impl ArcPlanner {
         let t = Instant::now();
         let outcome = self
             .lattice
-            .route_within(&self.ctx_min, start, goal, budget, deadline);
+            .guided_route(&self.ctx_min, start, goal, budget, deadline);
         *s += t.elapsed().as_secs_f64();
         match outcome {
             lattice::LatticeOutcome::Found(r) if r.points.len() >= 2 => Ok(Some(r)),
@@ -235,60 +264,150 @@ impl ArcPlanner {
         Ok(())
     }
 
-    /// Plans `query` ([`Planner::solve`]): the online construction over the head
-    /// roadmap, with the lattice's head route and roadmap growth where it fails.
+    /// Plans `query` ([`Planner::solve`]). With the lattice on, first the quick
+    /// straight-line head route ([`lattice::HeadLattice::quick_route`]) and the online
+    /// construction along it alone: where no wall stands between start and goal (open
+    /// air, a corridor, a window facing the start) that is the whole query. Else the
+    /// construction over the uniform head roadmap ([`Self::solve_on_roadmap`]).
     fn solve_query(
         &mut self,
         query: &Query,
         stop: Termination,
     ) -> Result<Solution<Stats>, PlanError> {
-        let (start, goal) = query.ends();
-        // The time limit covers the roadmap too (when it is built here) and growth.
+        // The time limit covers what the query builds (regions, roadmap) and growth.
         let began = Instant::now();
         let deadline = stop.deadline(began);
-        self.setup_until(deadline);
-        let query_began = Instant::now();
         let checks_before = self.check_count();
+        let mut built = Built {
+            roadmap_s: self.setup_until(deadline),
+            ..Built::default()
+        };
         self.check_query(query)?;
+        let mut on_route = None;
         if self.settings.head_lattice {
-            // The labelled regions refuse a sealed-off goal at once, whatever the map.
-            if let Some(sep) = self.lattice.separation(self.ctx.field(), start, goal) {
-                return Err(self.separated(sep));
-            }
+            let (start, goal) = query.ends();
+            let t = Instant::now();
+            built.route = self
+                .lattice
+                .quick_route(&self.ctx_min, start, goal, deadline);
+            built.lattice_s += t.elapsed().as_secs_f64();
+            on_route = self.solve_on_route(query, stop, began, &built)?;
         }
-        // The head route over the lattice ([`lattice`]), searched when the uniform
-        // roadmap fails (where it works, it is cheaper in rooms and mazes): the route
-        // joins the roadmap, and a proof that none exists ends the query.
-        let mut route = None;
-        let (mut lattice_expanded, mut lattice_s) = (0, 0.0);
-        let mut lattice_done = !self.settings.head_lattice;
-        // Like OMPL's PRM, grow the roadmap while the query fails and time remains.
+        let (steps, mut stats) = match on_route {
+            Some((steps, mut stats)) => {
+                if let Some(r) = &self.roadmap {
+                    (stats.roadmap_vertices, stats.roadmap_edges) =
+                        (r.vertex_count(), r.edge_count());
+                }
+                (steps, stats)
+            }
+            None => {
+                built.roadmap_s += self.ensure_roadmap(deadline);
+                self.solve_on_roadmap(query, stop, began, &mut built)?
+            }
+        };
+        stats.collision_checks = self.check_count() - checks_before;
+        stats.lattice_expanded = built.route.as_ref().map_or(0, |r| r.expanded);
+        stats.lattice_s = built.lattice_s;
+        stats.route_points = built.route.as_ref().map_or(0, |r| r.points.len());
+        stats.regions_s = built.regions_s;
+        stats.timings.roadmap_s = built.regions_s + built.roadmap_s;
+        stats.timings.planning_s =
+            (began.elapsed().as_secs_f64() - stats.timings.roadmap_s).max(0.0);
+        Ok(Solution { steps, stats })
+    }
+
+    /// The online construction along the lattice's head route in `built` alone (no
+    /// sampled vertices): `Ok(None)` when there is no route or the chain cannot
+    /// follow it. A plan that gives way below the preferred clearance where the head's
+    /// route itself keeps it is refused too: the uniform roadmap may hold a route on
+    /// which the whole chain keeps it.
+    fn solve_on_route(
+        &self,
+        query: &Query,
+        stop: Termination,
+        began: Instant,
+        built: &Built,
+    ) -> Result<Option<(Vec<Step>, Stats)>, PlanError> {
+        let Some(route) = &built.route else {
+            return Ok(None);
+        };
+        let mut roadmap = self.sampled_roadmap(0, stop.deadline(began));
+        let inner = &route.points[1..route.points.len() - 1];
+        match Construction::new(self, &mut roadmap, query, Some(inner), stop, began).run() {
+            Ok((_, stats))
+                if stats.min_margin < self.ctx.clearance_margin() - 1e-9
+                    && route.narrowest_margin >= self.ctx.clearance_margin() =>
+            {
+                Ok(None)
+            }
+            Ok(solved) => Ok(Some(solved)),
+            Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. }) => Ok(None),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// The lattice search guided by the labelled free regions (labelled now if need
+    /// be), where the uniform roadmap failed: a proof that start and goal lie in
+    /// separate regions ends the query; a route found is flown alone
+    /// ([`Self::solve_on_route`]) and else joins the roadmap.
+    fn guided_attempt(
+        &self,
+        query: &Query,
+        stop: Termination,
+        began: Instant,
+        built: &mut Built,
+    ) -> Result<Option<(Vec<Step>, Stats)>, PlanError> {
+        let (start, goal) = query.ends();
+        built.regions_s += self.ensure_regions();
+        if let Some(sep) = self.lattice.separation(self.ctx.field(), start, goal) {
+            return Err(self.separated(sep));
+        }
+        if built.route.is_some() {
+            return Ok(None); // the quick route was tried alone before
+        }
+        let (budget, deadline) = (self.lattice.budget, stop.deadline(began));
+        built.route = self.head_route(start, goal, budget, deadline, &mut built.lattice_s)?;
+        self.solve_on_route(query, stop, began, built)
+    }
+
+    /// The online construction over the uniform head roadmap (joined by the lattice's
+    /// route when `built` holds one). Where it fails, the guided lattice search
+    /// ([`Self::guided_attempt`]) runs once; then, like OMPL's PRM, the roadmap grows
+    /// while the query fails and time remains.
+    fn solve_on_roadmap(
+        &mut self,
+        query: &Query,
+        stop: Termination,
+        began: Instant,
+        built: &mut Built,
+    ) -> Result<(Vec<Step>, Stats), PlanError> {
+        let deadline = stop.deadline(began);
+        let mut guided = !self.settings.head_lattice;
         let mut growths = 0;
-        let (steps, mut stats, size) = loop {
+        loop {
             if expired(deadline) {
                 return Err(PlanError::TimeLimit { replans: 0 });
             }
-            let mut roadmap = self.roadmap.take().expect("setup built the roadmap");
-            let inner = route
-                .as_ref()
-                .map(|r: &lattice::HeadRoute| &r.points[1..r.points.len() - 1]);
+            let route = built.route.as_ref();
+            let inner = route.map(|r| &r.points[1..r.points.len() - 1]);
+            let mut roadmap = self.roadmap.take().expect("the query built the roadmap");
             let result = Construction::new(self, &mut roadmap, query, inner, stop, began).run();
             roadmap.clear_query();
             let size = (roadmap.vertex_count(), roadmap.edge_count());
             self.roadmap = Some(roadmap);
             match result {
-                Ok((steps, stats)) => break (steps, stats, size),
+                Ok((steps, mut stats)) => {
+                    stats.roadmap_growths = growths;
+                    (stats.roadmap_vertices, stats.roadmap_edges) = size;
+                    return Ok((steps, stats));
+                }
                 Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
-                    if !lattice_done && !expired(deadline) =>
+                    if !guided && !expired(deadline) =>
                 {
-                    // The roadmap alone failed: now the full lattice search.
-                    lattice_done = true;
-                    let budget = self.lattice.budget;
-                    if let Some(r) =
-                        self.head_route(start, goal, budget, deadline, &mut lattice_s)?
-                    {
-                        lattice_expanded = r.expanded;
-                        route = Some(r);
+                    guided = true;
+                    if let Some(solved) = self.guided_attempt(query, stop, began, built)? {
+                        return Ok(solved);
                     }
                 }
                 Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })
@@ -315,17 +434,21 @@ impl ArcPlanner {
                 }
                 Err(e) => return Err(e),
             }
-        };
-        stats.roadmap_growths = growths;
-        stats.collision_checks = self.check_count() - checks_before;
-        stats.lattice_expanded = lattice_expanded;
-        stats.lattice_s = lattice_s;
-        stats.route_points = route.as_ref().map_or(0, |r| r.points.len());
-        stats.timings.roadmap_s = self.roadmap_s;
-        stats.timings.planning_s = query_began.elapsed().as_secs_f64();
-        (stats.roadmap_vertices, stats.roadmap_edges) = size;
-        Ok(Solution { steps, stats })
+        }
     }
+}
+
+/// What a query built and searched before its construction, timed apart.
+#[derive(Default)]
+struct Built {
+    /// The lattice's head route, if one was found.
+    route: Option<lattice::HeadRoute>,
+    /// Time (s) the lattice searches took.
+    lattice_s: f64,
+    /// Time (s) spent labelling the free regions in this query.
+    regions_s: f64,
+    /// Time (s) spent building the uniform roadmap in this query (not its growth).
+    roadmap_s: f64,
 }
 
 /// Yaw of the direction from the head to the centroid of the units of `shape`.
@@ -346,8 +469,9 @@ impl Planner for ArcPlanner {
         &self.ctx
     }
 
-    /// Builds the head roadmap (once; later calls do nothing until [`Self::clear`]).
-    /// The head roadmap serves any query, so the query is not read.
+    /// Builds the uniform head roadmap when the lattice is off (once; later calls do
+    /// nothing until [`Self::clear`]); with the lattice on, the queries build what
+    /// they need. The head roadmap serves any query, so the query is not read.
     fn setup(&mut self, _query: &Query, stop: Termination) {
         self.setup_until(stop.deadline(Instant::now()));
     }

@@ -204,6 +204,9 @@ impl Roadmap {
 
     /// The sampled vertices within `r_T` of `p`, by index, with their distances.
     fn sampled_within_r_t(&self, p: [f64; 3]) -> Vec<(VertexId, f64)> {
+        if self.sampled == 0 {
+            return Vec::new(); // a route-only roadmap: nothing sampled to join
+        }
         let mut near = self
             .tree
             .within_unsorted::<SquaredEuclidean>(&p, self.r_t * self.r_t);

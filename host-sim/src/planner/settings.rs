@@ -39,7 +39,8 @@ pub struct Settings {
     pub mode: Mode,
     /// Shape preference.
     pub prefer: Preference,
-    /// Seed of the roadmap sampler.
+    /// Seed of the uniform roadmap's sampler (unused by a query that flies the
+    /// lattice's head route alone).
     pub seed: u64,
     /// Replans (dropped head edges) allowed without progress (the chain reaching a
     /// vertex farther along its way than before) before the roadmap grows.

@@ -30,7 +30,8 @@ pub struct PlanArgs {
     /// Shape preference: least (change only when needed) or coverage (PN where it fits).
     #[arg(long, value_enum, default_value_t = Preference::Least)]
     prefer: Preference,
-    /// Seed of the head roadmap.
+    /// Seed of the uniform head roadmap (a query that flies the lattice's head route
+    /// alone builds none, and the seed does not change its plan).
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Head roadmap vertices M_VT.
@@ -272,9 +273,10 @@ pub fn run(a: PlanArgs) -> CliResult {
         ),
     )?;
     report.line(format_args!(
-        "  setup {:.1} ms, roadmap {:.1} ms ({} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
+        "  setup {:.1} ms, search structures {:.1} ms (free regions {:.1} ms, uniform roadmap of {} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
         setup_s * 1e3,
         s.timings.roadmap_s * 1e3,
+        s.regions_s * 1e3,
         s.roadmap_vertices,
         s.timings.planning_s * 1e3,
         s.timings.collision_s * 1e3,

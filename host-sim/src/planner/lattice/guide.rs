@@ -25,7 +25,8 @@ use super::{dist, HeadLattice};
 /// Coarse distances to one goal.
 pub(super) struct Guide<'a> {
     lat: &'a HeadLattice,
-    regions: &'a Regions,
+    /// The labelled regions (`None`: the straight-line guide, before they exist).
+    regions: Option<&'a Regions>,
     /// Distance to the goal per node (m); infinite where not settled.
     dist: Vec<f32>,
     /// The next node towards the goal (`u32::MAX`: the goal itself is next).
@@ -50,7 +51,7 @@ impl<'a> Guide<'a> {
         let nodes = regions.coarse().centre.len();
         let mut guide = Self {
             lat,
-            regions,
+            regions: Some(regions),
             dist: vec![f32::INFINITY; nodes],
             next: vec![u32::MAX; nodes],
             connected: false,
@@ -62,10 +63,10 @@ impl<'a> Guide<'a> {
     }
 
     /// A guide that knows nothing but the straight line to `goal`.
-    pub(super) fn straight(lat: &'a HeadLattice, regions: &'a Regions, goal: [f64; 3]) -> Self {
+    pub(super) fn straight(lat: &'a HeadLattice, goal: [f64; 3]) -> Self {
         Self {
             lat,
-            regions,
+            regions: None,
             dist: Vec::new(),
             next: Vec::new(),
             connected: false,
@@ -75,13 +76,15 @@ impl<'a> Guide<'a> {
     }
 
     fn node(&self, k: u64) -> Option<u32> {
-        self.regions.node_of(self.lat.voxel_of(k))
+        self.regions?.node_of(self.lat.voxel_of(k))
     }
 
     /// Dijkstra from the goal's nodes until every node of the start's anchors is
     /// settled (or nothing is left).
     fn search(&mut self, starts: &[u64], goals: &[u64]) {
-        let coarse = self.regions.coarse();
+        let Some(coarse) = self.regions.map(Regions::coarse) else {
+            return;
+        };
         let mut targets: Vec<u32> = starts.iter().filter_map(|&k| self.node(k)).collect();
         targets.sort_unstable();
         targets.dedup();
@@ -150,7 +153,10 @@ impl<'a> Guide<'a> {
         let via = match self.next[n] {
             u32::MAX => straight,
             m => {
-                let c = self.regions.coarse().centre[m as usize];
+                let Some(regions) = self.regions else {
+                    return straight;
+                };
+                let c = regions.coarse().centre[m as usize];
                 dist(p, c) + self.dist[m as usize] as f64
             }
         };

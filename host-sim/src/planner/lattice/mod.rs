@@ -77,7 +77,7 @@ const HEURISTIC_WEIGHT: f64 = 2.5;
 const MAX_JUMP: f64 = 16.0;
 /// Lattice points the first, straight-line-guided search may touch before the
 /// coarse guide is built.
-const QUICK_BUDGET: usize = 20_000;
+const QUICK_BUDGET: usize = 10_000;
 /// A string-pulled segment keeps the clearance of the points it replaces up to this
 /// much above the preferred radius (m).
 const KEEP_CAP: f64 = 0.3;
@@ -296,6 +296,58 @@ impl HeadLattice {
         budget: usize,
         deadline: Option<std::time::Instant>,
     ) -> LatticeOutcome {
+        match self.quick_route(ctx_min, start, goal, deadline) {
+            Some(route) => LatticeOutcome::Found(route),
+            None => self.guided_route(ctx_min, start, goal, budget, deadline),
+        }
+    }
+
+    /// The straight line as the heuristic, within a small budget and without the
+    /// labelled regions: where no wall stands in the way (a corridor, open air, a
+    /// window facing the start) it finds the route at once, for less than labelling
+    /// the map's regions would cost. `None`: not found within the budget (which
+    /// proves nothing).
+    pub fn quick_route(
+        &self,
+        ctx_min: &CollisionContext,
+        start: [f64; 3],
+        goal: [f64; 3],
+        deadline: Option<std::time::Instant>,
+    ) -> Option<HeadRoute> {
+        let mut nodes = Nodes {
+            lat: self,
+            field: ctx_min.field(),
+            map: KeyMap::default(),
+        };
+        let quick = Limit {
+            budget: QUICK_BUDGET.min(self.budget),
+            deadline,
+        };
+        let straight = guide::Guide::straight(self, goal);
+        let found = self.search(&mut nodes, start, goal, 2, &quick, &straight);
+        self.searched.take();
+        match found {
+            Search::Found(keys, n) => {
+                match self.finish(ctx_min, &mut nodes, start, goal, keys, n) {
+                    LatticeOutcome::Found(route) => Some(route),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
+    }
+
+    /// The search guided by the labelled regions' coarse graph ([`guide`]): first
+    /// over the voxel centres, then over the whole half-cell lattice with the floods
+    /// that prove a failure. Labels the regions first if that has not been done.
+    pub fn guided_route(
+        &self,
+        ctx_min: &CollisionContext,
+        start: [f64; 3],
+        goal: [f64; 3],
+        budget: usize,
+        deadline: Option<std::time::Instant>,
+    ) -> LatticeOutcome {
         let limit = Limit { budget, deadline };
         let field = ctx_min.field();
         let mut nodes = Nodes {
@@ -304,30 +356,17 @@ impl HeadLattice {
             map: KeyMap::default(),
         };
         let regions = self.regions(field);
-        // First the straight line as the heuristic, within a small budget: where no wall
-        // stands in the way (a corridor, open air) it finds the route at once, for less
-        // than the guide's Dijkstra over the map would cost.
-        let quick = Limit {
-            budget: QUICK_BUDGET.min(budget),
-            deadline,
-        };
-        let straight = guide::Guide::straight(self, regions, goal);
-        if let Search::Found(keys, n) = self.search(&mut nodes, start, goal, 2, &quick, &straight) {
-            return self.finish(ctx_min, &mut nodes, start, goal, keys, n);
-        }
-        let mut expanded = self.searched.take().unwrap_or(0);
-        Self::reset(&mut nodes);
         let starts = self.anchors(&mut nodes, start, 1);
         let goals = self.anchors(&mut nodes, goal, 1);
         let guide = guide::Guide::new(self, regions, &starts, &goals, goal);
         match self.search(&mut nodes, start, goal, 2, &limit, &guide) {
             Search::Found(keys, n) => {
-                return self.finish(ctx_min, &mut nodes, start, goal, keys, n + expanded)
+                return self.finish(ctx_min, &mut nodes, start, goal, keys, n)
             }
             Search::Budget => return LatticeOutcome::Budget,
             _ => {}
         }
-        expanded += self.searched.take().unwrap_or(0);
+        let expanded = self.searched.take().unwrap_or(0);
         Self::reset(&mut nodes);
         match self.search(&mut nodes, start, goal, 1, &limit, &guide) {
             Search::Found(keys, n) => {

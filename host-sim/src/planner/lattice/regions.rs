@@ -55,6 +55,18 @@ const MIN_BLOCK: f64 = 0.4;
 /// Most blocks over the map's box (the block edge grows to stay below).
 const MAX_BLOCKS: f64 = 100_000.0;
 
+/// One slab's union-find ([`Regions::join_rows`]).
+struct Slab {
+    /// Its first segment.
+    first: usize,
+    /// Parents of its segments, by index from `first`.
+    parent: Vec<u32>,
+    /// Touching pairs within a block that reach into the slab before.
+    back: Vec<(u32, u32)>,
+    /// Touching pairs across blocks.
+    across: Vec<(u32, u32)>,
+}
+
 /// Connected regions of relaxed-free voxels, and the coarse graph over them.
 #[derive(Clone, Debug)]
 pub struct Regions {
@@ -143,63 +155,80 @@ impl Regions {
         [self.segs[i][0] / b, y as u32 / b, z as u32 / b]
     }
 
-    /// Calls `f(i, j)` for every pair of touching segments, `i` in row `(y, z)` and `j`
-    /// in the same row (the pieces of one run cut at a block boundary) or in one of the
-    /// four neighbouring rows seen before it, with whether the two share a block.
-    fn each_touching(&self, mut f: impl FnMut(usize, usize, bool)) {
-        let [_, ny, nz] = self.dims;
-        for z in 0..nz {
-            for y in 0..ny {
-                let here = self.row(y, z);
-                for i in here.start + 1..here.end {
-                    if self.segs[i - 1][1] + 1 == self.segs[i][0] {
-                        f(i - 1, i, false);
-                    }
+    /// Calls `f(i, j, same_block)` for every pair of touching segments, `i` in a row
+    /// of plane `z` and `j` in the same row (the pieces of one run cut at a block
+    /// boundary) or in one of the four neighbouring rows seen before it (`y - 1` in
+    /// this plane, `y - 1..=y + 1` in plane `z - 1`), with whether the two share a
+    /// block.
+    fn touching_in(&self, z: usize, mut f: impl FnMut(usize, usize, bool)) {
+        let ny = self.dims[1];
+        for y in 0..ny {
+            let here = self.row(y, z);
+            for i in here.start + 1..here.end {
+                if self.segs[i - 1][1] + 1 == self.segs[i][0] {
+                    f(i - 1, i, false);
                 }
-                for (dy, dz) in [(-1, 0), (-1, -1), (0, -1), (1, -1)] {
-                    let (yy, zz) = (y as i64 + dy, z as i64 + dz);
-                    if yy < 0 || zz < 0 || yy >= ny as i64 {
-                        continue;
+            }
+            for (dy, dz) in [(-1, 0), (-1, -1), (0, -1), (1, -1)] {
+                let (yy, zz) = (y as i64 + dy, z as i64 + dz);
+                if yy < 0 || zz < 0 || yy >= ny as i64 {
+                    continue;
+                }
+                let (yy, zz) = (yy as usize, zz as usize);
+                let there = self.row(yy, zz);
+                let (mut i, mut j) = (here.start, there.start);
+                while i < here.end && j < there.end {
+                    let (ra, rb) = (self.segs[i], self.segs[j]);
+                    if ra[0] <= rb[1] + 1 && rb[0] <= ra[1] + 1 {
+                        f(i, j, self.block_of(i, y, z) == self.block_of(j, yy, zz));
                     }
-                    let (yy, zz) = (yy as usize, zz as usize);
-                    let there = self.row(yy, zz);
-                    let (mut i, mut j) = (here.start, there.start);
-                    while i < here.end && j < there.end {
-                        let (ra, rb) = (self.segs[i], self.segs[j]);
-                        if ra[0] <= rb[1] + 1 && rb[0] <= ra[1] + 1 {
-                            f(i, j, self.block_of(i, y, z) == self.block_of(j, yy, zz));
-                        }
-                        // Advance the segment that ends first: it touches nothing further.
-                        if ra[1] < rb[1] {
-                            i += 1;
-                        } else {
-                            j += 1;
-                        }
+                    // Advance the segment that ends first: it touches nothing further.
+                    if ra[1] < rb[1] {
+                        i += 1;
+                    } else {
+                        j += 1;
                     }
                 }
             }
         }
     }
 
+    /// The first segment of plane `z` (`z = dims[2]`: the end).
+    fn plane_start(&self, z: usize) -> usize {
+        self.row_start[z * self.dims[1]] as usize
+    }
+
     /// Union-find over the segments: a touching pair within one block joins a coarse
     /// node. Sets every segment's node; returns the touching pairs across blocks.
+    ///
+    /// Slabs of planes are joined in parallel, each in its own union-find; the pairs
+    /// that reach back into the slab before are joined afterwards. The sets, and so
+    /// the numbering (nodes in order of their first segment), are the same as a
+    /// serial sweep's.
     fn join_rows(&mut self) -> Vec<(u32, u32)> {
+        let nz = self.dims[2];
+        let slab = nz.div_ceil(rayon::current_num_threads().max(1) * 4).max(1);
+        let slabs: Vec<Slab> = (0..nz.div_ceil(slab))
+            .into_par_iter()
+            .map(|k| self.join_slab(k * slab, ((k + 1) * slab).min(nz)))
+            .collect();
+        let mut parent = Vec::with_capacity(self.segs.len());
+        let (mut back, mut across) = (Vec::new(), Vec::new());
+        for s in slabs {
+            parent.extend(s.parent.into_iter().map(|p| p + s.first as u32));
+            back.extend(s.back);
+            across.extend(s.across);
+        }
+        for (i, j) in back {
+            union(&mut parent, i, j);
+        }
+        // Coarse nodes: the roots, numbered in order.
         let n = self.segs.len();
-        let mut local: Vec<u32> = (0..n as u32).collect();
-        let mut across = Vec::new();
-        self.each_touching(|i, j, same_block| {
-            if same_block {
-                union(&mut local, i as u32, j as u32);
-            } else {
-                across.push((i as u32, j as u32));
-            }
-        });
-        // Coarse nodes: the local roots, numbered in order.
         let mut number = vec![u32::MAX; n];
         let mut count = 0u32;
         self.node = (0..n)
             .map(|i| {
-                let root = find(&mut local, i as u32) as usize;
+                let root = find(&mut parent, i as u32) as usize;
                 if number[root] == u32::MAX {
                     number[root] = count;
                     count += 1;
@@ -208,6 +237,25 @@ impl Regions {
             })
             .collect();
         across
+    }
+
+    /// The union-find of the segments of planes `z0..z1` alone.
+    fn join_slab(&self, z0: usize, z1: usize) -> Slab {
+        let (s0, s1) = (self.plane_start(z0), self.plane_start(z1));
+        let mut slab = Slab {
+            first: s0,
+            parent: (0..(s1 - s0) as u32).collect(),
+            back: Vec::new(),
+            across: Vec::new(),
+        };
+        for z in z0..z1 {
+            self.touching_in(z, |i, j, same_block| match (same_block, j >= s0) {
+                (false, _) => slab.across.push((i as u32, j as u32)),
+                (true, true) => union(&mut slab.parent, (i - s0) as u32, (j - s0) as u32),
+                (true, false) => slab.back.push((i as u32, j as u32)),
+            });
+        }
+        slab
     }
 
     /// The regions: the connected components of the coarse graph (its nodes are
@@ -233,8 +281,7 @@ impl Regions {
     }
 
     /// The coarse graph: node centres from the segments, edges where segments of two
-    /// nodes touch across a block boundary.
-    /// Returns the voxels of each node.
+    /// nodes touch across a block boundary. Returns the voxels of each node.
     fn build_coarse(&mut self, field: &DistanceField, across: &[(u32, u32)]) -> Vec<f64> {
         let nodes = self.node.iter().map(|&k| k as usize + 1).max().unwrap_or(0);
         let mut sum = vec![[0f64; 3]; nodes];
