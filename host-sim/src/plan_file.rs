@@ -137,7 +137,9 @@ pub struct Waypoint {
 /// hold one.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Timings {
-    /// Roadmap build.
+    /// Search structures built before or during the query: the roadmap (for the ARC
+    /// planner, the labelled free regions and the uniform head roadmap, when the query
+    /// needed them and they were not built before).
     pub roadmap_s: f64,
     /// The query.
     pub planning_s: f64,

@@ -1,11 +1,14 @@
-//! The ARCplanner (paper Sec. 3): a head roadmap, then per head edge the cheapest
+//! The ARCplanner (paper Sec. 3): a head route, then per head edge the cheapest
 //! shape that gets the whole chain along it.
 //!
-//! [`ArcPlanner`] holds the map context, the chain's shape tables, the settings and
-//! the head roadmap `G_T` ([`super::roadmap`]), built by [`Planner::setup`] and shared
-//! by the queries until [`Planner::clear`]. A query ([`Planner::solve`]) runs the
-//! online construction ([`super::construction`]) over the roadmap; where it fails, the
-//! lattice's head route ([`super::lattice`]) joins the roadmap, then the roadmap grows.
+//! [`ArcPlanner`] holds the map context, the chain's shape tables, the settings, the
+//! head lattice ([`super::lattice`]) and the uniform head roadmap `G_T`
+//! ([`super::roadmap`]). A query ([`Planner::solve`]) runs the online construction
+//! ([`super::construction`]) along the lattice's quick head route alone first; where
+//! that fails, over the uniform roadmap, then with the labelled free regions' guided
+//! route, then over a growing roadmap (docs/architecture.md, "How a query finds its
+//! head route"). The regions and the roadmap are built by the first query that needs
+//! them and shared by the later ones until [`Planner::clear`].
 
 use std::time::Instant;
 
@@ -484,6 +487,7 @@ impl Planner for ArcPlanner {
 
     fn clear(&mut self) {
         self.roadmap = None;
+        self.lattice.clear();
     }
 
     fn roadmap_stats(&self) -> Stats {

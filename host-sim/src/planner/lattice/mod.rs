@@ -179,6 +179,12 @@ impl HeadLattice {
             .get_or_init(|| Regions::label(field, self.r_min))
     }
 
+    /// Forgets the labelled regions (the next query that needs them labels them
+    /// again).
+    pub fn clear(&mut self) {
+        self.regions = std::sync::OnceLock::new();
+    }
+
     /// [`LatticeOutcome::Separated`] when the labelled regions prove that no lattice
     /// route joins `start` and `goal`; `None` when they cannot tell.
     pub fn separation(
