@@ -297,18 +297,16 @@ impl ArcPlanner {
             on_route = self.solve_on_route(query, stop, began, &built)?;
         }
         let (steps, mut stats) = match on_route {
-            Some((steps, mut stats)) => {
-                if let Some(r) = &self.roadmap {
-                    (stats.roadmap_vertices, stats.roadmap_edges) =
-                        (r.vertex_count(), r.edge_count());
-                }
-                (steps, stats)
-            }
+            Some(solved) => solved,
             None => {
                 built.roadmap_s += self.ensure_roadmap(deadline);
                 self.solve_on_roadmap(query, stop, began, &mut built)?
             }
         };
+        if let Some(r) = &self.roadmap {
+            // Built by this query or an earlier one, whether or not the plan used it.
+            (stats.roadmap_vertices, stats.roadmap_edges) = (r.vertex_count(), r.edge_count());
+        }
         stats.collision_checks = self.check_count() - checks_before;
         stats.lattice_expanded = built.route.as_ref().map_or(0, |r| r.expanded);
         stats.lattice_s = built.lattice_s;

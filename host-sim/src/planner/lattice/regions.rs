@@ -205,7 +205,7 @@ impl Regions {
     /// that reach back into the slab before are joined afterwards. The sets, and so
     /// the numbering (nodes in order of their first segment), are the same as a
     /// serial sweep's.
-    fn join_rows(&mut self) -> Vec<(u32, u32)> {
+    fn join_rows(&mut self) -> Vec<Vec<(u32, u32)>> {
         let nz = self.dims[2];
         let slab = nz.div_ceil(rayon::current_num_threads().max(1) * 4).max(1);
         let slabs: Vec<Slab> = (0..nz.div_ceil(slab))
@@ -217,7 +217,8 @@ impl Regions {
         for s in slabs {
             parent.extend(s.parent.into_iter().map(|p| p + s.first as u32));
             back.extend(s.back);
-            across.extend(s.across);
+            // Kept per slab: on a large map they are tens of millions of pairs.
+            across.push(s.across);
         }
         for (i, j) in back {
             union(&mut parent, i, j);
@@ -282,7 +283,7 @@ impl Regions {
 
     /// The coarse graph: node centres from the segments, edges where segments of two
     /// nodes touch across a block boundary. Returns the voxels of each node.
-    fn build_coarse(&mut self, field: &DistanceField, across: &[(u32, u32)]) -> Vec<f64> {
+    fn build_coarse(&mut self, field: &DistanceField, across: &[Vec<(u32, u32)>]) -> Vec<f64> {
         let nodes = self.node.iter().map(|&k| k as usize + 1).max().unwrap_or(0);
         let mut sum = vec![[0f64; 3]; nodes];
         let mut count = vec![0f64; nodes];
@@ -310,7 +311,7 @@ impl Regions {
         // Neighbour lists; a node has a few dozen neighbours at most, and the same
         // pair comes up row after row, so a linear check dedups cheaply.
         let mut adjacent: Vec<Vec<u32>> = vec![Vec::new(); nodes];
-        for &(i, j) in across {
+        for &(i, j) in across.iter().flatten() {
             let (a, b) = (self.node[i as usize], self.node[j as usize]);
             if a == b {
                 continue;
