@@ -19,7 +19,7 @@ use aerial_chain_core::ChainParams;
 
 use super::Limits;
 use crate::collision::exact::{check_config_exact, positions_f64, ExactViolation};
-use crate::collision::verify::{wrap, MAX_INTERVALS};
+use crate::collision::verify::{wrap, zeta_delta, MAX_INTERVALS};
 use crate::map::Grid;
 
 /// A limit holds when the measured value is at most `limit * (1 + LIMIT_TOLERANCE)`:
@@ -352,15 +352,7 @@ impl Checker<'_> {
     /// Every configuration of the interval `z0 -> z1` at the `r_v / 4` rule, its end
     /// included; the error carries the fraction of the interval.
     fn interval(&mut self, z0: &[f64], z1: &[f64], t0: f64, dt: f64) -> Result<(), (f64, Problem)> {
-        let d: Vec<f64> = (0..z0.len())
-            .map(|j| {
-                if j < 3 {
-                    z1[j] - z0[j]
-                } else {
-                    wrap(z1[j] - z0[j])
-                }
-            })
-            .collect();
+        let d = zeta_delta(z0, z1);
         let head = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         let links = (0..(z0.len() - 4) / 2)
             .map(|k| (d[4 + 2 * k].powi(2) + d[5 + 2 * k].powi(2)).sqrt())
