@@ -6,11 +6,18 @@ use aerial_chain_core::kinematics::positions_into;
 use aerial_chain_core::validity::{check_shape, Body, Violation};
 use aerial_chain_core::{ChainParams, Shape};
 
+use nalgebra::Point3;
+
 use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 
 /// Distance from point `p` to the closed box `lo..hi`.
-pub fn point_box_distance(p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> f64 {
+pub fn point_box_distance(
+    p: impl Into<Point3<f64>>,
+    lo: impl Into<Point3<f64>>,
+    hi: impl Into<Point3<f64>>,
+) -> f64 {
+    let (p, lo, hi) = (p.into(), lo.into(), hi.into());
     let mut s = 0.0;
     for a in 0..3 {
         let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
@@ -26,7 +33,13 @@ pub fn point_box_distance(p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> f64 {
 /// crosses a slab face (at most six parameters). On each piece the minimiser of the
 /// quadratic is found in closed form and clamped to the piece, so the global minimum is
 /// the smallest of these candidates and the piece ends.
-pub fn segment_box_distance(a: [f64; 3], b: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> f64 {
+pub fn segment_box_distance(
+    a: impl Into<Point3<f64>>,
+    b: impl Into<Point3<f64>>,
+    lo: impl Into<Point3<f64>>,
+    hi: impl Into<Point3<f64>>,
+) -> f64 {
+    let (a, b, lo, hi) = (a.into(), b.into(), lo.into(), hi.into());
     let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let mut ts = [0.0f64; 8];
     let mut n = 0;
@@ -88,7 +101,12 @@ pub fn segment_box_distance(a: [f64; 3], b: [f64; 3], lo: [f64; 3], hi: [f64; 3]
 }
 
 /// Distance from point `p` to the segment `a b` (f64).
-pub fn point_segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+pub fn point_segment_distance(
+    p: impl Into<Point3<f64>>,
+    a: impl Into<Point3<f64>>,
+    b: impl Into<Point3<f64>>,
+) -> f64 {
+    let (p, a, b) = (p.into(), a.into(), b.into());
     let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let ap = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
     let len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
@@ -111,7 +129,7 @@ pub struct Nearest {
     /// Exact distance from the body's core (centre point or segment) to the cube (m).
     pub distance: f64,
     /// Centre of that obstacle voxel (m).
-    pub voxel: [f64; 3],
+    pub voxel: Point3<f64>,
 }
 
 /// Nearest obstacle cube to the segment `a b` (a point when `a == b`) among those at
@@ -119,7 +137,13 @@ pub struct Nearest {
 /// Exact: every voxel intersecting the segment's bounding box grown by `reach` is
 /// examined (a voxel outside it is more than `reach` away along some axis), including
 /// voxels outside the grid (unknown, obstacles when unknown space counts as occupied).
-pub fn nearest_obstacle(grid: &Grid, a: [f64; 3], b: [f64; 3], reach: f64) -> Option<Nearest> {
+pub fn nearest_obstacle(
+    grid: &Grid,
+    a: impl Into<Point3<f64>>,
+    b: impl Into<Point3<f64>>,
+    reach: f64,
+) -> Option<Nearest> {
+    let (a, b) = (a.into(), b.into());
     if !(reach.is_finite() && reach >= 0.0) || a.iter().chain(b.iter()).any(|v| !v.is_finite()) {
         return None;
     }
@@ -175,10 +199,14 @@ pub fn nearest_obstacle(grid: &Grid, a: [f64; 3], b: [f64; 3], reach: f64) -> Op
 
 /// Unit centres of a chain in `f64` (paper Eq. 2), from a head position and the shape
 /// angles `eta` (`2N - 1` numbers; only the link pitches and yaws matter).
-pub fn positions_f64(link_length: f64, head: [f64; 3], eta: &[f64]) -> Vec<[f64; 3]> {
+pub fn positions_f64(
+    link_length: f64,
+    head: impl Into<Point3<f64>>,
+    eta: &[f64],
+) -> Vec<Point3<f64>> {
     let mut p = vec![nalgebra::Vector3::zeros(); eta.len().saturating_sub(1) / 2 + 1];
-    positions_into(link_length, head.into(), eta, &mut p);
-    p.into_iter().map(Into::into).collect()
+    positions_into(link_length, head.into().coords, eta, &mut p);
+    p.into_iter().map(Point3::from).collect()
 }
 
 /// Why a configuration is invalid by the exact test.
@@ -191,7 +219,7 @@ pub enum ExactViolation {
         /// The unit.
         body: Body,
         /// Its centre (m).
-        point: [f64; 3],
+        point: Point3<f64>,
     },
     /// A body is within its radius of an obstacle cube (item 3).
     Map {
@@ -200,7 +228,7 @@ pub enum ExactViolation {
         /// Its distance to the cube minus its radius (m, <= 0).
         clearance: f64,
         /// Centre of the obstacle voxel (m).
-        voxel: [f64; 3],
+        voxel: Point3<f64>,
     },
     /// The shape angles are not a valid `eta` for the chain.
     BadShape,
@@ -254,10 +282,11 @@ pub const CONTACT_TOLERANCE: f64 = 1e-9;
 pub fn check_config_exact(
     grid: &Grid,
     params: &ChainParams,
-    head: [f64; 3],
+    head: impl Into<Point3<f64>>,
     eta: &[f64],
     horizon: f64,
 ) -> Result<ExactClearance, ExactViolation> {
+    let head = head.into();
     let n = params.n();
     if eta.len() != 2 * n - 1 || eta.iter().chain(head.iter()).any(|v| !v.is_finite()) {
         return Err(ExactViolation::BadShape);
@@ -315,7 +344,13 @@ pub fn check_config_exact(
 /// when it is above `stop` and below `cap`; otherwise some value `<= stop` (the first
 /// cube found within `stop`) or `>= cap`. The voxels are visited in rings around the
 /// one holding `p`, nearest first, so a blocked point is settled after a few.
-pub fn exact_clearance(field: &DistanceField, p: [f64; 3], stop: f64, cap: f64) -> f64 {
+pub fn exact_clearance(
+    field: &DistanceField,
+    p: impl Into<Point3<f64>>,
+    stop: f64,
+    cap: f64,
+) -> f64 {
+    let p = p.into();
     let g = field.grid();
     let r = g.resolution();
     let c0 = g.lattice_index(p);

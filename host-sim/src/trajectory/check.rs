@@ -16,6 +16,7 @@
 
 use aerial_chain_core::validity::Body;
 use aerial_chain_core::ChainParams;
+use nalgebra::Point3;
 
 use super::Limits;
 use crate::collision::exact::{check_config_exact, positions_f64, ExactViolation};
@@ -239,7 +240,7 @@ impl Checker<'_> {
             }
         }
         let l = self.params.link_length as f64;
-        let units: Vec<Vec<[f64; 3]>> = zetas
+        let units: Vec<Vec<Point3<f64>>> = zetas
             .iter()
             .map(|z| positions_f64(l, [z[0], z[1], z[2]], &z[3..]))
             .collect();
@@ -287,8 +288,8 @@ impl Checker<'_> {
     /// Unit speeds and angle rates over one interval.
     fn rates(
         &mut self,
-        p0: &[[f64; 3]],
-        p1: &[[f64; 3]],
+        p0: &[Point3<f64>],
+        p1: &[Point3<f64>],
         z0: &[f64],
         z1: &[f64],
         dt: f64,
@@ -383,6 +384,6 @@ fn exceeds(value: f64, limit: f64) -> bool {
     value > limit * (1.0 + LIMIT_TOLERANCE)
 }
 
-fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+fn dist(a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
