@@ -6,18 +6,13 @@ use aerial_chain_core::kinematics::positions_into;
 use aerial_chain_core::validity::{check_shape, Body, Violation};
 use aerial_chain_core::{ChainParams, Shape};
 
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector3};
 
 use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 
 /// Distance from point `p` to the closed box `lo..hi`.
-pub fn point_box_distance(
-    p: impl Into<Point3<f64>>,
-    lo: impl Into<Point3<f64>>,
-    hi: impl Into<Point3<f64>>,
-) -> f64 {
-    let (p, lo, hi) = (p.into(), lo.into(), hi.into());
+pub fn point_box_distance(p: Point3<f64>, lo: Point3<f64>, hi: Point3<f64>) -> f64 {
     let mut s = 0.0;
     for a in 0..3 {
         let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
@@ -34,12 +29,11 @@ pub fn point_box_distance(
 /// quadratic is found in closed form and clamped to the piece, so the global minimum is
 /// the smallest of these candidates and the piece ends.
 pub fn segment_box_distance(
-    a: impl Into<Point3<f64>>,
-    b: impl Into<Point3<f64>>,
-    lo: impl Into<Point3<f64>>,
-    hi: impl Into<Point3<f64>>,
+    a: Point3<f64>,
+    b: Point3<f64>,
+    lo: Point3<f64>,
+    hi: Point3<f64>,
 ) -> f64 {
-    let (a, b, lo, hi) = (a.into(), b.into(), lo.into(), hi.into());
     let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let mut ts = [0.0f64; 8];
     let mut n = 0;
@@ -101,12 +95,7 @@ pub fn segment_box_distance(
 }
 
 /// Distance from point `p` to the segment `a b` (f64).
-pub fn point_segment_distance(
-    p: impl Into<Point3<f64>>,
-    a: impl Into<Point3<f64>>,
-    b: impl Into<Point3<f64>>,
-) -> f64 {
-    let (p, a, b) = (p.into(), a.into(), b.into());
+pub fn point_segment_distance(p: Point3<f64>, a: Point3<f64>, b: Point3<f64>) -> f64 {
     let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let ap = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
     let len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
@@ -178,8 +167,8 @@ pub fn nearest_obstacle(
                 if dc - half_diag > limit {
                     continue;
                 }
-                let vlo = [c[0] - 0.5 * r, c[1] - 0.5 * r, c[2] - 0.5 * r];
-                let vhi = [c[0] + 0.5 * r, c[1] + 0.5 * r, c[2] + 0.5 * r];
+                let half = Vector3::repeat(0.5 * r);
+                let (vlo, vhi) = (c - half, c + half);
                 let d = if point {
                     point_box_distance(a, vlo, vhi)
                 } else {
@@ -372,11 +361,8 @@ pub fn exact_clearance(
                         continue;
                     }
                     let c = g.voxel_center(i);
-                    let d = point_box_distance(
-                        p,
-                        [c[0] - r / 2.0, c[1] - r / 2.0, c[2] - r / 2.0],
-                        [c[0] + r / 2.0, c[1] + r / 2.0, c[2] + r / 2.0],
-                    );
+                    let half = Vector3::repeat(r / 2.0);
+                    let d = point_box_distance(p, c - half, c + half);
                     if d < best {
                         best = d;
                         if d <= stop {
@@ -397,22 +383,23 @@ mod tests {
 
     #[test]
     fn box_distances_by_hand() {
-        let (lo, hi) = ([0.0; 3], [1.0; 3]);
-        assert_eq!(point_box_distance([0.5, 0.5, 0.5], lo, hi), 0.0);
-        assert!((point_box_distance([2.0, 0.5, 0.5], lo, hi) - 1.0).abs() < 1e-12);
-        assert!((point_box_distance([2.0, 2.0, 0.5], lo, hi) - 2f64.sqrt()).abs() < 1e-12);
+        let (lo, hi) = (Point3::origin(), Point3::new(1.0, 1.0, 1.0));
+        let p = Point3::new;
+        assert_eq!(point_box_distance(p(0.5, 0.5, 0.5), lo, hi), 0.0);
+        assert!((point_box_distance(p(2.0, 0.5, 0.5), lo, hi) - 1.0).abs() < 1e-12);
+        assert!((point_box_distance(p(2.0, 2.0, 0.5), lo, hi) - 2f64.sqrt()).abs() < 1e-12);
         // A segment passing diagonally above an edge.
-        let d = segment_box_distance([-1.0, 2.0, 0.5], [2.0, -1.0, 0.5], lo, hi);
+        let d = segment_box_distance(p(-1.0, 2.0, 0.5), p(2.0, -1.0, 0.5), lo, hi);
         // The line x + y = 1 passes through the box's face diagonal: distance 0.
         assert!(d.abs() < 1e-12);
-        let d = segment_box_distance([-1.0, 3.0, 0.5], [3.0, -1.0, 0.5], lo, hi);
+        let d = segment_box_distance(p(-1.0, 3.0, 0.5), p(3.0, -1.0, 0.5), lo, hi);
         // x + y = 2: closest to corner (1, 1): distance sqrt(2)/2... (1,1) to line = 0/ sqrt2? (1+1-2)/sqrt2 = 0.
         assert!(d.abs() < 1e-12);
-        let d = segment_box_distance([0.0, 3.0, 0.5], [3.0, 0.0, 0.5], lo, hi);
+        let d = segment_box_distance(p(0.0, 3.0, 0.5), p(3.0, 0.0, 0.5), lo, hi);
         // x + y = 3: corner (1,1) at distance 1/sqrt(2).
         assert!((d - 0.5f64.sqrt()).abs() < 1e-12);
         // Parallel segment, beyond the end.
-        let d = segment_box_distance([3.0, 0.5, 2.0], [5.0, 0.5, 2.0], lo, hi);
+        let d = segment_box_distance(p(3.0, 0.5, 2.0), p(5.0, 0.5, 2.0), lo, hi);
         assert!((d - 5f64.sqrt()).abs() < 1e-12);
     }
 
@@ -426,12 +413,13 @@ mod tests {
             size in proptest::array::uniform3(0.05f64..1.0),
         ) {
             let hi = [lo[0] + size[0], lo[1] + size[1], lo[2] + size[2]];
+            let (a, b, lo, hi) = (a.into(), b.into(), lo.into(), hi.into());
             let d = segment_box_distance(a, b, lo, hi);
             let mut best = f64::INFINITY;
             for i in 0..=2000 {
                 let t = i as f64 / 2000.0;
                 let p = [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])];
-                best = best.min(point_box_distance(p, lo, hi));
+                best = best.min(point_box_distance(p.into(), lo, hi));
             }
             prop_assert!(d <= best + 1e-9, "{} > {}", d, best);
             let len = ((b[0]-a[0]).powi(2) + (b[1]-a[1]).powi(2) + (b[2]-a[2]).powi(2)).sqrt();

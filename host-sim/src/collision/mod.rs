@@ -396,11 +396,8 @@ impl CollisionContext {
         head: impl Into<Point3<f64>>,
         shape: &Shape,
     ) -> Result<(), Collision> {
-        let head = head.into();
-        self.counters.configs.fetch_add(1, Ordering::Relaxed);
-        self.check_input(head, shape)?;
         // The map first: in clutter it rejects most configurations, and cheaply.
-        self.placement(head, shape)?;
+        self.check_placement(head, shape)?;
         shape_validity(&self.params, shape).map_err(Collision::Shape)
     }
 
@@ -414,10 +411,6 @@ impl CollisionContext {
         let head = head.into();
         self.counters.configs.fetch_add(1, Ordering::Relaxed);
         self.check_input(head, shape)?;
-        self.placement(head, shape)
-    }
-
-    fn placement(&self, head: Point3<f64>, shape: &Shape) -> Result<(), Collision> {
         let n = shape.units();
         let p = self.points(head, shape);
         let mut c = [0.0f64; MAX_UNITS];
