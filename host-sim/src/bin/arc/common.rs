@@ -369,15 +369,12 @@ pub fn start_shape(params: &ChainParams, name: &str, yaw: f32) -> Result<Shape, 
 }
 
 /// The motion `arc sim` flies and `arc verify` checks: a plan, or a trajectory in its
-/// place.
+/// place. Exactly one of the two is given.
 #[derive(Args, Debug)]
+#[group(required = true, multiple = false)]
 pub struct MotionArgs {
     /// The plan (JSON, arc-plan/1); `-` reads it from standard input.
-    #[arg(
-        long,
-        required_unless_present = "trajectory",
-        conflicts_with = "trajectory"
-    )]
+    #[arg(long)]
     plan: Option<PathBuf>,
     /// A trajectory instead of a plan (JSON, arc-trajectory/1), taken with its own
     /// timing (the chain moves linearly between its samples); `-` reads it from
@@ -395,7 +392,7 @@ pub enum MotionFile<'a> {
 }
 
 impl MotionArgs {
-    /// The one file given (clap refuses both; this refuses neither).
+    /// The one file given (clap refuses both and neither).
     pub fn file(&self) -> Result<MotionFile<'_>, CliError> {
         match (&self.plan, &self.trajectory) {
             (Some(p), None) => Ok(MotionFile::Plan(p)),
