@@ -197,6 +197,17 @@ fn shape_validity(params: &ChainParams, shape: &Shape) -> Result<(), Violation> 
     })
 }
 
+/// A body swept along a segment: the capsule of radius `r` around `a b`, with the
+/// distance field's proven bounds `ca`, `cb` at its ends.
+#[derive(Clone, Copy)]
+struct Capsule {
+    a: Point3<f64>,
+    b: Point3<f64>,
+    r: f64,
+    ca: f64,
+    cb: f64,
+}
+
 /// Unit centres in the world frame (f64 head + f32 core offsets), head first.
 type WorldPoints = [Point3<f64>; MAX_UNITS];
 
@@ -352,7 +363,15 @@ impl CollisionContext {
         let (ca, cb) = (self.bound(a, self.unit_r), self.bound(b, self.unit_r));
         ca > self.unit_r
             && cb > self.unit_r
-            && self.segment_free(a, b, self.unit_r, ca, cb).is_none()
+            && self
+                .segment_free(Capsule {
+                    a,
+                    b,
+                    r: self.unit_r,
+                    ca,
+                    cb,
+                })
+                .is_none()
     }
 
     /// Whether `p` is inside the map's bounds by at least [`FK_TOLERANCE`] (so that the
@@ -430,7 +449,7 @@ impl CollisionContext {
             }
         }
         for k in 0..n - 1 {
-            if let Some(at) = self.segment_free(p[k], p[k + 1], self.link_r, c[k], c[k + 1]) {
+            if let Some(at) = self.segment_free(self.link(p[k], p[k + 1], c[k], c[k + 1])) {
                 return Err(Collision::Map {
                     body: Body::Link(k as u8),
                     point: at,
@@ -440,17 +459,16 @@ impl CollisionContext {
         Ok(())
     }
 
-    /// Sphere tracing of the capsule of radius `r` around segment `a b`, where `ca`, `cb`
-    /// are the field's bounds at the ends. `None` when proven free, else the point where
-    /// the proof failed.
-    fn segment_free(
-        &self,
-        a: Point3<f64>,
-        b: Point3<f64>,
-        r: f64,
-        ca: f64,
-        cb: f64,
-    ) -> Option<Point3<f64>> {
+    /// A link's capsule between unit centres `a` and `b`, whose bounds are `ca` and `cb`.
+    fn link(&self, a: Point3<f64>, b: Point3<f64>, ca: f64, cb: f64) -> Capsule {
+        let r = self.link_r;
+        Capsule { a, b, r, ca, cb }
+    }
+
+    /// Sphere tracing of `capsule`. `None` when proven free, else the point where the
+    /// proof failed.
+    fn segment_free(&self, capsule: Capsule) -> Option<Point3<f64>> {
+        let Capsule { a, b, r, ca, cb } = capsule;
         let len = (b - a).norm();
         // Points within ca - r of a (and cb - r of b) are proven free by the ends' bounds.
         let mut t = ca - r;
@@ -475,17 +493,11 @@ impl CollisionContext {
         }
     }
 
-    /// A proven lower bound on `distance - r` over the segment `a b`, from the bounds at
-    /// its ends (`ca`, `cb`) and at the centres of pieces, halving pieces until the
-    /// Lipschitz loss is at most half the local bound (or the piece is tiny).
-    fn segment_margin(
-        &self,
-        a: Point3<f64>,
-        b: Point3<f64>,
-        r: f64,
-        ca: f64,
-        cb: f64,
-    ) -> (f64, Point3<f64>) {
+    /// A proven lower bound on `distance - r` over `capsule`, from the bounds at its ends
+    /// and at the centres of pieces, halving pieces until the Lipschitz loss is at most
+    /// half the local bound (or the piece is tiny).
+    fn segment_margin(&self, capsule: Capsule) -> (f64, Point3<f64>) {
+        let Capsule { a, b, r, ca, cb } = capsule;
         let len = (b - a).norm();
         let wmin = self.field.grid().resolution() / 16.0;
         // Iterative refinement over a small stack of pieces [t0, t1] (in metres).
@@ -592,7 +604,7 @@ impl CollisionContext {
             for k in 0..n - 1 {
                 if horizon[n + k] <= u {
                     let (a, b) = (p0[k] + off, p0[k + 1] + off);
-                    let (m, at) = self.segment_margin(a, b, self.link_r, c[k], c[k + 1]);
+                    let (m, at) = self.segment_margin(self.link(a, b, c[k], c[k + 1]));
                     if m < self.min_step {
                         let collision = Collision::Map {
                             body: Body::Link(k as u8),
@@ -692,7 +704,7 @@ impl CollisionContext {
             }
             for k in 0..n - 1 {
                 if horizon[n + k] <= t {
-                    let (m, at) = self.segment_margin(p[k], p[k + 1], self.link_r, c[k], c[k + 1]);
+                    let (m, at) = self.segment_margin(self.link(p[k], p[k + 1], c[k], c[k + 1]));
                     if m < self.min_step {
                         let collision = Collision::Map {
                             body: Body::Link(k as u8),
