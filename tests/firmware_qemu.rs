@@ -412,19 +412,24 @@ fn host_table(units: u8, count: usize, name: &str) -> PathBuf {
     path
 }
 
+/// The firmware `name` built with a table written on the host ([`host_table`]), run.
+fn run_with_host_table(units: u8, count: usize, name: &str) -> Run {
+    let table = host_table(units, count, &format!("{name}.table"));
+    let elf = build(
+        name,
+        &[],
+        &[("ARC_TABLE", table.to_str().expect("utf-8 path"))],
+    );
+    run(&elf)
+}
+
 #[test]
 fn host_written_tables_are_checked_against_the_unit_chain() {
     require_qemu();
     // For this chain (N = 6), with 64 SRS shapes: the script's SRS shape 105 is
     // not there, so that command is refused and the run fails, but the table is
     // accepted and every shape it has is reached.
-    let own = host_table(6, 64, "host-n6.table");
-    let elf = build(
-        "host-n6",
-        &[],
-        &[("ARC_TABLE", own.to_str().expect("utf-8 path"))],
-    );
-    let r = run(&elf);
+    let r = run_with_host_table(6, 64, "host-n6");
     assert_clean(&r);
     r.expect_line("table valid: format v1, chain N=6", "no table summary");
     r.expect_line("6 LSC + 64 SRS shapes", "wrong shape count");
@@ -441,13 +446,7 @@ fn host_written_tables_are_checked_against_the_unit_chain() {
     );
 
     // For another chain (N = 5): refused before any command is flown.
-    let other = host_table(5, 16, "host-n5.table");
-    let elf = build(
-        "host-n5",
-        &[],
-        &[("ARC_TABLE", other.to_str().expect("utf-8 path"))],
-    );
-    let r = run(&elf);
+    let r = run_with_host_table(5, 16, "host-n5");
     assert_safe_mode(&r, "ChainMismatch");
 }
 
