@@ -64,18 +64,19 @@ pub(super) fn free_body(pos: &V3, rot: GQuat, mprops: MassProperties) -> RigidBo
         .build()
 }
 
-/// Link `k`'s body, at the middle of unit centres `k` and `k + 1`, turned by `rot`.
+/// Link `k`'s body, at the middle of unit centres `k` and `k + 1`, turned by
+/// `link_rot[k]`.
 fn link_body(
     world: &mut PhysicsWorld,
     p: &[V3],
+    link_rot: &[M3],
     k: usize,
-    rot: &M3,
     mass: MassProperties,
 ) -> RigidBodyHandle {
     let mid = 0.5 * (p[k] + p[k + 1]);
     world
         .bodies
-        .insert(free_body(&mid, to_glam_rotation(rot), mass))
+        .insert(free_body(&mid, to_glam_rotation(&link_rot[k]), mass))
 }
 
 /// One end of a joint: the body, where the joint sits on the body's axis (m), and how
@@ -132,7 +133,7 @@ pub(super) fn build_full(
         );
     }
     for k in 0..n - 1 {
-        links.push(link_body(world, p, k, &link_rot[k], link_mass));
+        links.push(link_body(world, p, link_rot, k, link_mass));
     }
     // The joints' reference frames are chosen so that zero joint coordinates
     // are the start configuration (a multibody places its children from its
@@ -175,10 +176,10 @@ pub(super) fn build_lumped(
     let half = (0.5 * model.link_length()) as f32;
     let (mut links, mut joints, mut link_com) =
         (Vec::with_capacity(n - 1), Vec::new(), vec![0.0; n - 1]);
-    for k in 0..n - 1 {
+    for (k, com) in link_com.iter_mut().enumerate() {
         let (mp, xc) = lumped_mass(model, k == 0);
-        link_com[k] = xc;
-        links.push(link_body(world, p, k, &link_rot[k], mp));
+        *com = xc;
+        links.push(link_body(world, p, link_rot, k, mp));
     }
     for k in 1..n - 1 {
         // Link k-1's back end is link k's front end (unit k's centre).
