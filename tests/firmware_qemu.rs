@@ -107,6 +107,20 @@ impl Run {
         self.lines_with(needle).next().is_some()
     }
 
+    /// The first decoded log line containing `needle`; fails with `what` (and the
+    /// run's context) when there is none.
+    fn expect_line<'a>(&'a self, needle: &'a str, what: &str) -> &'a str {
+        self.lines_with(needle)
+            .next()
+            .unwrap_or_else(|| panic!("{what}; {}", self.context()))
+    }
+
+    /// Fails with `what` (and the run's context) when a decoded log line contains
+    /// `needle`.
+    fn forbid(&self, needle: &str, what: &str) {
+        assert!(!self.has(needle), "{what}; {}", self.context());
+    }
+
     /// Exit status and whole log, for failure messages.
     fn context(&self) -> String {
         format!("exit status {:?}; decoded log:\n{}", self.status, self.log)
@@ -220,12 +234,9 @@ fn number_after(line: &str, key: &str) -> f64 {
 
 /// Common checks of a run that must not have crashed.
 fn assert_clean(r: &Run) {
-    assert!(!r.has("panic"), "firmware panicked; {}", r.context());
-    assert!(!r.has("hard fault"), "firmware faulted; {}", r.context());
-    let stack = r
-        .lines_with("stack peak")
-        .next()
-        .unwrap_or_else(|| panic!("no stack report; {}", r.context()));
+    r.forbid("panic", "firmware panicked");
+    r.forbid("hard fault", "firmware faulted");
+    let stack = r.expect_line("stack peak", "no stack report");
     let peak = number_after(stack, "stack peak ") as u64;
     assert!(
         peak > 0 && peak <= STACK_BUDGET,
@@ -243,26 +254,15 @@ fn assert_mission_success(r: &Run, srs: u64) -> Vec<u64> {
         r.context()
     );
     assert_clean(r);
-    let summary = r
-        .lines_with("table valid:")
-        .next()
-        .unwrap_or_else(|| panic!("no table summary; {}", r.context()));
+    let summary = r.expect_line("table valid:", "no table summary");
     assert!(summary.contains("format v1"), "{summary}");
     assert!(summary.contains("chain N=6"), "{summary}");
     assert!(
         summary.contains(&format!("6 LSC + {srs} SRS shapes")),
         "{summary}"
     );
-    assert!(
-        !r.has("SAFE MODE"),
-        "valid table took safe mode; {}",
-        r.context()
-    );
-    assert!(
-        !r.has("NOT settled"),
-        "a target was missed; {}",
-        r.context()
-    );
+    r.forbid("SAFE MODE", "valid table took safe mode");
+    r.forbid("NOT settled", "a target was missed");
 
     let commanded: Vec<u64> = r
         .lines_with("go to shape")
@@ -281,7 +281,7 @@ fn assert_mission_success(r: &Run, srs: u64) -> Vec<u64> {
         r.context()
     );
     let total = number_after(
-        r.lines_with("command 1/").next().expect("first command"),
+        r.expect_line("command 1/", "no first command"),
         "command 1/",
     ) as usize;
     assert_eq!(
@@ -329,15 +329,8 @@ fn assert_safe_mode(r: &Run, reason: &str) {
         r.context()
     );
     assert_clean(r);
-    assert!(
-        !r.has("table valid"),
-        "corrupt table accepted; {}",
-        r.context()
-    );
-    let why = r
-        .lines_with("SAFE MODE: table rejected")
-        .next()
-        .unwrap_or_else(|| panic!("no safe-mode report; {}", r.context()));
+    r.forbid("table valid", "corrupt table accepted");
+    let why = r.expect_line("SAFE MODE: table rejected", "no safe-mode report");
     assert!(
         why.contains(reason),
         "safe mode for another reason than {reason}: {why}"
@@ -356,21 +349,13 @@ fn assert_safe_mode(r: &Run, reason: &str) {
         "{}",
         r.context()
     );
-    assert!(
-        !r.has("settled shape"),
-        "a shape was flown in safe mode; {}",
-        r.context()
-    );
-    let held = r
-        .lines_with("attitude held within")
-        .next()
-        .unwrap_or_else(|| panic!("no hold report; {}", r.context()));
+    r.forbid("settled shape", "a shape was flown in safe mode");
+    let held = r.expect_line("attitude held within", "no hold report");
     let e = number_after(held, "held within ");
     assert!(e < TOLERANCE_DEG, "attitude not held: {held}");
-    assert!(
-        r.has("safe mode: no target reached: exit failure"),
-        "{}",
-        r.context()
+    r.expect_line(
+        "safe mode: no target reached: exit failure",
+        "no safe-mode exit report",
     );
 }
 
@@ -427,32 +412,32 @@ fn host_table(units: u8, count: usize, name: &str) -> PathBuf {
     path
 }
 
+/// The firmware `name` built with a table written on the host ([`host_table`]), run.
+fn run_with_host_table(units: u8, count: usize, name: &str) -> Run {
+    let table = host_table(units, count, &format!("{name}.table"));
+    let elf = build(
+        name,
+        &[],
+        &[("ARC_TABLE", table.to_str().expect("utf-8 path"))],
+    );
+    run(&elf)
+}
+
 #[test]
 fn host_written_tables_are_checked_against_the_unit_chain() {
     require_qemu();
     // For this chain (N = 6), with 64 SRS shapes: the script's SRS shape 105 is
     // not there, so that command is refused and the run fails, but the table is
     // accepted and every shape it has is reached.
-    let own = host_table(6, 64, "host-n6.table");
-    let elf = build(
-        "host-n6",
-        &[],
-        &[("ARC_TABLE", own.to_str().expect("utf-8 path"))],
-    );
-    let r = run(&elf);
+    let r = run_with_host_table(6, 64, "host-n6");
     assert_clean(&r);
-    assert!(
-        r.has("table valid: format v1, chain N=6"),
-        "{}",
-        r.context()
+    r.expect_line("table valid: format v1, chain N=6", "no table summary");
+    r.expect_line("6 LSC + 64 SRS shapes", "wrong shape count");
+    r.expect_line(
+        "go to shape 105 refused: NoSuchShape",
+        "the missing shape was not refused",
     );
-    assert!(r.has("6 LSC + 64 SRS shapes"), "{}", r.context());
-    assert!(
-        r.has("go to shape 105 refused: NoSuchShape"),
-        "{}",
-        r.context()
-    );
-    assert!(!r.has("NOT settled"), "{}", r.context());
+    r.forbid("NOT settled", "a target was missed");
     assert_eq!(
         r.status.code(),
         Some(1),
@@ -461,13 +446,7 @@ fn host_written_tables_are_checked_against_the_unit_chain() {
     );
 
     // For another chain (N = 5): refused before any command is flown.
-    let other = host_table(5, 16, "host-n5.table");
-    let elf = build(
-        "host-n5",
-        &[],
-        &[("ARC_TABLE", other.to_str().expect("utf-8 path"))],
-    );
-    let r = run(&elf);
+    let r = run_with_host_table(5, 16, "host-n5");
     assert_safe_mode(&r, "ChainMismatch");
 }
 
@@ -488,7 +467,7 @@ fn table_flashed_apart_from_the_program() {
     std::fs::write(&slot, &image).expect("write slot image");
     let loader = format!("loader,file={},addr=0x080C0000", slot.display());
     let r = run_with(&elf, &["-device", &loader]);
-    assert!(r.has("table external"), "{}", r.context());
+    r.expect_line("table external", "the external table was not used");
     assert_mission_success(&r, 100);
 }
 
@@ -501,7 +480,7 @@ fn head_and_tail_units_steer_their_links() {
         let elf = build(&format!("unit{unit}"), &[], &[("ARC_UNIT", unit)]);
         let r = run(&elf);
         let up = format!("ARC unit {unit} of 6 up: steers link {link},");
-        assert!(r.has(&up), "expected {up:?}; {}", r.context());
+        r.expect_line(&up, &format!("expected {up:?}"));
         assert_mission_success(&r, 100);
     }
 }

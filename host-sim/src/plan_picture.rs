@@ -2,6 +2,8 @@
 //! the head's path, the chain drawn at the start, at every shape change (library
 //! shapes and random shapes in different colours) and at the end.
 
+use nalgebra::Point3;
+
 use crate::collision::exact::positions_f64;
 use crate::map::grid::Grid;
 use crate::picture::{palette, Colour, Figure, Panel};
@@ -65,7 +67,7 @@ pub fn draw(grid: &Grid, plan: &Plan, title: &str, goal: Option<[f64; 3]>) -> Fi
     let l = params.map(|p| p.link_length as f64).unwrap_or(0.5);
     let ru = params.map(|p| p.unit_radius as f64).unwrap_or(0.15);
     let heads: Vec<[f64; 3]> = plan.waypoints.iter().map(|w| w.xi()).collect();
-    let bodies: Vec<Vec<[f64; 3]>> = plan
+    let bodies: Vec<Vec<Point3<f64>>> = plan
         .waypoints
         .iter()
         .map(|w| positions_f64(l, w.xi(), w.eta()))
@@ -179,7 +181,7 @@ pub fn draw(grid: &Grid, plan: &Plan, title: &str, goal: Option<[f64; 3]>) -> Fi
 /// How many follow-the-leader shapes a picture shows, evenly spread over the plan.
 const FOLLOW_DRAWN: usize = 4;
 
-fn chain(p: &mut Panel, body: &[[f64; 3]], u: usize, v: usize, r: f64, c: Colour) {
+fn chain(p: &mut Panel, body: &[Point3<f64>], u: usize, v: usize, r: f64, c: Colour) {
     let projected: Vec<(f64, f64)> = body.iter().map(|q| (q[u], q[v])).collect();
     p.chain(&projected, r, c);
 }

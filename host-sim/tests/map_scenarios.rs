@@ -37,7 +37,7 @@ fn exported_scenarios_fly_from_the_file() {
             )
             .unwrap();
             let shape = s.start_shape(s.default_units).unwrap();
-            assert_eq!(ctx.check_config(s.start.into(), &shape), Ok(()), "{name}");
+            assert_eq!(ctx.check_config(s.start, &shape), Ok(()), "{name}");
             let mut plan = s.route_plan(&p, 0.1).unwrap();
             plan.map.unknown_is_occupied = unknown_is_occupied;
             let rep = verify_plan(&grid, &plan);

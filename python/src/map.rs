@@ -142,7 +142,7 @@ impl Map {
             .filter(|&(_, occupied)| occupied)
             .map(|(i, _)| self.grid.voxel_center(i))
             .filter(|c| (lo..=hi).contains(&c[2]))
-            .flatten()
+            .flat_map(|c| [c.x, c.y, c.z])
             .collect();
         let rows = centres.len() / 3;
         Array2::from_shape_vec((rows, 3), centres)

@@ -6,11 +6,13 @@ use aerial_chain_core::kinematics::positions_into;
 use aerial_chain_core::validity::{check_shape, Body, Violation};
 use aerial_chain_core::{ChainParams, Shape};
 
+use nalgebra::{Point3, Vector3};
+
 use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 
 /// Distance from point `p` to the closed box `lo..hi`.
-pub fn point_box_distance(p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> f64 {
+pub fn point_box_distance(p: Point3<f64>, lo: Point3<f64>, hi: Point3<f64>) -> f64 {
     let mut s = 0.0;
     for a in 0..3 {
         let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
@@ -26,7 +28,12 @@ pub fn point_box_distance(p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> f64 {
 /// crosses a slab face (at most six parameters). On each piece the minimiser of the
 /// quadratic is found in closed form and clamped to the piece, so the global minimum is
 /// the smallest of these candidates and the piece ends.
-pub fn segment_box_distance(a: [f64; 3], b: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> f64 {
+pub fn segment_box_distance(
+    a: Point3<f64>,
+    b: Point3<f64>,
+    lo: Point3<f64>,
+    hi: Point3<f64>,
+) -> f64 {
     let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let mut ts = [0.0f64; 8];
     let mut n = 0;
@@ -88,7 +95,7 @@ pub fn segment_box_distance(a: [f64; 3], b: [f64; 3], lo: [f64; 3], hi: [f64; 3]
 }
 
 /// Distance from point `p` to the segment `a b` (f64).
-pub fn point_segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+pub fn point_segment_distance(p: Point3<f64>, a: Point3<f64>, b: Point3<f64>) -> f64 {
     let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let ap = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
     let len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
@@ -111,7 +118,7 @@ pub struct Nearest {
     /// Exact distance from the body's core (centre point or segment) to the cube (m).
     pub distance: f64,
     /// Centre of that obstacle voxel (m).
-    pub voxel: [f64; 3],
+    pub voxel: Point3<f64>,
 }
 
 /// Nearest obstacle cube to the segment `a b` (a point when `a == b`) among those at
@@ -119,7 +126,13 @@ pub struct Nearest {
 /// Exact: every voxel intersecting the segment's bounding box grown by `reach` is
 /// examined (a voxel outside it is more than `reach` away along some axis), including
 /// voxels outside the grid (unknown, obstacles when unknown space counts as occupied).
-pub fn nearest_obstacle(grid: &Grid, a: [f64; 3], b: [f64; 3], reach: f64) -> Option<Nearest> {
+pub fn nearest_obstacle(
+    grid: &Grid,
+    a: impl Into<Point3<f64>>,
+    b: impl Into<Point3<f64>>,
+    reach: f64,
+) -> Option<Nearest> {
+    let (a, b) = (a.into(), b.into());
     if !(reach.is_finite() && reach >= 0.0) || a.iter().chain(b.iter()).any(|v| !v.is_finite()) {
         return None;
     }
@@ -154,8 +167,8 @@ pub fn nearest_obstacle(grid: &Grid, a: [f64; 3], b: [f64; 3], reach: f64) -> Op
                 if dc - half_diag > limit {
                     continue;
                 }
-                let vlo = [c[0] - 0.5 * r, c[1] - 0.5 * r, c[2] - 0.5 * r];
-                let vhi = [c[0] + 0.5 * r, c[1] + 0.5 * r, c[2] + 0.5 * r];
+                let half = Vector3::repeat(0.5 * r);
+                let (vlo, vhi) = (c - half, c + half);
                 let d = if point {
                     point_box_distance(a, vlo, vhi)
                 } else {
@@ -175,10 +188,14 @@ pub fn nearest_obstacle(grid: &Grid, a: [f64; 3], b: [f64; 3], reach: f64) -> Op
 
 /// Unit centres of a chain in `f64` (paper Eq. 2), from a head position and the shape
 /// angles `eta` (`2N - 1` numbers; only the link pitches and yaws matter).
-pub fn positions_f64(link_length: f64, head: [f64; 3], eta: &[f64]) -> Vec<[f64; 3]> {
+pub fn positions_f64(
+    link_length: f64,
+    head: impl Into<Point3<f64>>,
+    eta: &[f64],
+) -> Vec<Point3<f64>> {
     let mut p = vec![nalgebra::Vector3::zeros(); eta.len().saturating_sub(1) / 2 + 1];
-    positions_into(link_length, head.into(), eta, &mut p);
-    p.into_iter().map(Into::into).collect()
+    positions_into(link_length, head.into().coords, eta, &mut p);
+    p.into_iter().map(Point3::from).collect()
 }
 
 /// Why a configuration is invalid by the exact test.
@@ -191,7 +208,7 @@ pub enum ExactViolation {
         /// The unit.
         body: Body,
         /// Its centre (m).
-        point: [f64; 3],
+        point: Point3<f64>,
     },
     /// A body is within its radius of an obstacle cube (item 3).
     Map {
@@ -200,7 +217,7 @@ pub enum ExactViolation {
         /// Its distance to the cube minus its radius (m, <= 0).
         clearance: f64,
         /// Centre of the obstacle voxel (m).
-        voxel: [f64; 3],
+        voxel: Point3<f64>,
     },
     /// The shape angles are not a valid `eta` for the chain.
     BadShape,
@@ -254,10 +271,11 @@ pub const CONTACT_TOLERANCE: f64 = 1e-9;
 pub fn check_config_exact(
     grid: &Grid,
     params: &ChainParams,
-    head: [f64; 3],
+    head: impl Into<Point3<f64>>,
     eta: &[f64],
     horizon: f64,
 ) -> Result<ExactClearance, ExactViolation> {
+    let head = head.into();
     let n = params.n();
     if eta.len() != 2 * n - 1 || eta.iter().chain(head.iter()).any(|v| !v.is_finite()) {
         return Err(ExactViolation::BadShape);
@@ -315,7 +333,13 @@ pub fn check_config_exact(
 /// when it is above `stop` and below `cap`; otherwise some value `<= stop` (the first
 /// cube found within `stop`) or `>= cap`. The voxels are visited in rings around the
 /// one holding `p`, nearest first, so a blocked point is settled after a few.
-pub fn exact_clearance(field: &DistanceField, p: [f64; 3], stop: f64, cap: f64) -> f64 {
+pub fn exact_clearance(
+    field: &DistanceField,
+    p: impl Into<Point3<f64>>,
+    stop: f64,
+    cap: f64,
+) -> f64 {
+    let p = p.into();
     let g = field.grid();
     let r = g.resolution();
     let c0 = g.lattice_index(p);
@@ -338,11 +362,8 @@ pub fn exact_clearance(field: &DistanceField, p: [f64; 3], stop: f64, cap: f64) 
                         continue;
                     }
                     let c = g.voxel_center(i);
-                    let d = point_box_distance(
-                        p,
-                        [c[0] - r / 2.0, c[1] - r / 2.0, c[2] - r / 2.0],
-                        [c[0] + r / 2.0, c[1] + r / 2.0, c[2] + r / 2.0],
-                    );
+                    let half = Vector3::repeat(r / 2.0);
+                    let d = point_box_distance(p, c - half, c + half);
                     if d < best {
                         best = d;
                         if d <= stop {
@@ -363,22 +384,23 @@ mod tests {
 
     #[test]
     fn box_distances_by_hand() {
-        let (lo, hi) = ([0.0; 3], [1.0; 3]);
-        assert_eq!(point_box_distance([0.5, 0.5, 0.5], lo, hi), 0.0);
-        assert!((point_box_distance([2.0, 0.5, 0.5], lo, hi) - 1.0).abs() < 1e-12);
-        assert!((point_box_distance([2.0, 2.0, 0.5], lo, hi) - 2f64.sqrt()).abs() < 1e-12);
+        let (lo, hi) = (Point3::origin(), Point3::new(1.0, 1.0, 1.0));
+        let p = Point3::new;
+        assert_eq!(point_box_distance(p(0.5, 0.5, 0.5), lo, hi), 0.0);
+        assert!((point_box_distance(p(2.0, 0.5, 0.5), lo, hi) - 1.0).abs() < 1e-12);
+        assert!((point_box_distance(p(2.0, 2.0, 0.5), lo, hi) - 2f64.sqrt()).abs() < 1e-12);
         // A segment passing diagonally above an edge.
-        let d = segment_box_distance([-1.0, 2.0, 0.5], [2.0, -1.0, 0.5], lo, hi);
+        let d = segment_box_distance(p(-1.0, 2.0, 0.5), p(2.0, -1.0, 0.5), lo, hi);
         // The line x + y = 1 passes through the box's face diagonal: distance 0.
         assert!(d.abs() < 1e-12);
-        let d = segment_box_distance([-1.0, 3.0, 0.5], [3.0, -1.0, 0.5], lo, hi);
+        let d = segment_box_distance(p(-1.0, 3.0, 0.5), p(3.0, -1.0, 0.5), lo, hi);
         // x + y = 2: closest to corner (1, 1): distance sqrt(2)/2... (1,1) to line = 0/ sqrt2? (1+1-2)/sqrt2 = 0.
         assert!(d.abs() < 1e-12);
-        let d = segment_box_distance([0.0, 3.0, 0.5], [3.0, 0.0, 0.5], lo, hi);
+        let d = segment_box_distance(p(0.0, 3.0, 0.5), p(3.0, 0.0, 0.5), lo, hi);
         // x + y = 3: corner (1,1) at distance 1/sqrt(2).
         assert!((d - 0.5f64.sqrt()).abs() < 1e-12);
         // Parallel segment, beyond the end.
-        let d = segment_box_distance([3.0, 0.5, 2.0], [5.0, 0.5, 2.0], lo, hi);
+        let d = segment_box_distance(p(3.0, 0.5, 2.0), p(5.0, 0.5, 2.0), lo, hi);
         assert!((d - 5f64.sqrt()).abs() < 1e-12);
     }
 
@@ -392,12 +414,13 @@ mod tests {
             size in proptest::array::uniform3(0.05f64..1.0),
         ) {
             let hi = [lo[0] + size[0], lo[1] + size[1], lo[2] + size[2]];
+            let (a, b, lo, hi) = (a.into(), b.into(), lo.into(), hi.into());
             let d = segment_box_distance(a, b, lo, hi);
             let mut best = f64::INFINITY;
             for i in 0..=2000 {
                 let t = i as f64 / 2000.0;
                 let p = [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])];
-                best = best.min(point_box_distance(p, lo, hi));
+                best = best.min(point_box_distance(p.into(), lo, hi));
             }
             prop_assert!(d <= best + 1e-9, "{} > {}", d, best);
             let len = ((b[0]-a[0]).powi(2) + (b[1]-a[1]).powi(2) + (b[2]-a[2]).powi(2)).sqrt();

@@ -46,6 +46,8 @@ use aerial_chain_core::kinematics::offsets;
 use aerial_chain_core::validity::{check_shape, check_transition, Body, Violation};
 use aerial_chain_core::{ChainParams, Shape, MAX_UNITS};
 
+use nalgebra::{Point3, Vector3};
+
 use crate::map::distance::DistanceField;
 
 pub use verify::{verify_plan, verify_plan_with, EdgeKind, VerifyOptions, VerifyReport};
@@ -76,14 +78,14 @@ pub enum Collision {
         /// The unit.
         body: Body,
         /// Its centre (m).
-        point: [f64; 3],
+        point: Point3<f64>,
     },
     /// A body may touch an obstacle (conservative: its proven free margin is not positive).
     Map {
         /// The body.
         body: Body,
         /// Where its margin was lowest: the unit centre, or the point of the link (m).
-        point: [f64; 3],
+        point: Point3<f64>,
     },
     /// Bad input: non-finite numbers, or shapes of another chain size.
     BadInput(&'static str),
@@ -195,22 +197,21 @@ fn shape_validity(params: &ChainParams, shape: &Shape) -> Result<(), Violation> 
     })
 }
 
-/// Unit centres in the world frame (f64 head + f32 core offsets), head first.
-type WorldPoints = [[f64; 3]; MAX_UNITS];
+/// A body swept along a segment: the capsule of radius `r` around `a b`, with the
+/// distance field's proven bounds `ca`, `cb` at its ends.
+#[derive(Clone, Copy)]
+struct Capsule {
+    a: Point3<f64>,
+    b: Point3<f64>,
+    r: f64,
+    ca: f64,
+    cb: f64,
+}
 
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn norm(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
-}
-fn finite3(a: [f64; 3]) -> bool {
+/// Unit centres in the world frame (f64 head + f32 core offsets), head first.
+type WorldPoints = [Point3<f64>; MAX_UNITS];
+
+fn finite3(a: &Point3<f64>) -> bool {
     a.iter().all(|v| v.is_finite())
 }
 
@@ -313,7 +314,7 @@ impl CollisionContext {
 
     /// Proven lower bound on the distance from `p` to the nearest obstacle cube (m).
     #[inline]
-    pub fn clearance(&self, p: [f64; 3]) -> f64 {
+    pub fn clearance(&self, p: impl Into<Point3<f64>>) -> f64 {
         self.field.clearance(p)
     }
 
@@ -323,7 +324,7 @@ impl CollisionContext {
     /// one: at a coarse resolution a unit centred in an opening is otherwise refused
     /// although it is clear of both sides.
     #[inline]
-    fn bound(&self, p: [f64; 3], need: f64) -> f64 {
+    fn bound(&self, p: Point3<f64>, need: f64) -> f64 {
         let c = self.field.clearance_above(p, need);
         if c > need || c + self.field_loss < need {
             return c;
@@ -341,14 +342,20 @@ impl CollisionContext {
 
     /// Whether the head's unit sphere (grown by the clearance margin) is free at `p`
     /// and `p` is inside the map's bounds. Conservative.
-    pub fn is_head_free(&self, p: [f64; 3]) -> bool {
+    pub fn is_head_free(&self, p: impl Into<Point3<f64>>) -> bool {
+        let p = p.into();
         self.counters.head_points.fetch_add(1, Ordering::Relaxed);
         self.inside(p) && self.bound(p, self.unit_r) > self.unit_r
     }
 
     /// Whether the head's unit sphere can move along the straight segment `a b` (both
     /// ends inside the bounds, the swept sphere free). Conservative.
-    pub fn is_head_segment_free(&self, a: [f64; 3], b: [f64; 3]) -> bool {
+    pub fn is_head_segment_free(
+        &self,
+        a: impl Into<Point3<f64>>,
+        b: impl Into<Point3<f64>>,
+    ) -> bool {
+        let (a, b) = (a.into(), b.into());
         self.counters.head_segments.fetch_add(1, Ordering::Relaxed);
         if !(self.inside(a) && self.inside(b)) {
             return false;
@@ -356,38 +363,42 @@ impl CollisionContext {
         let (ca, cb) = (self.bound(a, self.unit_r), self.bound(b, self.unit_r));
         ca > self.unit_r
             && cb > self.unit_r
-            && self.segment_free(a, b, self.unit_r, ca, cb).is_none()
+            && self
+                .segment_free(Capsule {
+                    a,
+                    b,
+                    r: self.unit_r,
+                    ca,
+                    cb,
+                })
+                .is_none()
     }
 
     /// Whether `p` is inside the map's bounds by at least [`FK_TOLERANCE`] (so that the
     /// exact `f64` kinematics agree).
     #[inline]
-    fn inside(&self, p: [f64; 3]) -> bool {
+    fn inside(&self, p: Point3<f64>) -> bool {
         let (lo, hi) = self.field.grid().bounds();
         (0..3).all(|a| p[a] >= lo[a] + FK_TOLERANCE && p[a] <= hi[a] - FK_TOLERANCE)
     }
 
     /// Unit centres for `head` and `shape`.
-    fn points(&self, head: [f64; 3], shape: &Shape) -> WorldPoints {
+    fn points(&self, head: Point3<f64>, shape: &Shape) -> WorldPoints {
         let o = offsets(&self.params, shape);
-        let mut p = [[0.0; 3]; MAX_UNITS];
+        let mut p = [Point3::origin(); MAX_UNITS];
         for (q, v) in p.iter_mut().zip(o.iter()).take(shape.units()) {
-            *q = [
-                head[0] + v.x as f64,
-                head[1] + v.y as f64,
-                head[2] + v.z as f64,
-            ];
+            *q = head + v.cast::<f64>();
         }
         p
     }
 
-    fn check_input(&self, head: [f64; 3], shape: &Shape) -> Result<(), Collision> {
+    fn check_input(&self, head: Point3<f64>, shape: &Shape) -> Result<(), Collision> {
         if shape.units() != self.params.n() {
             return Err(Collision::BadInput(
                 "the shape is for another number of units",
             ));
         }
-        if !finite3(head) {
+        if !finite3(&head) {
             return Err(Collision::BadInput("the head position is not finite"));
         }
         if shape.as_slice().iter().any(|a| !a.is_finite()) {
@@ -399,23 +410,26 @@ impl CollisionContext {
     /// Conservative validity of one configuration: limits and self-collision (exact,
     /// core), every unit centre inside the bounds, and every body clear of obstacles by
     /// its radius plus the clearance margin (distance-field lower bounds).
-    pub fn check_config(&self, head: [f64; 3], shape: &Shape) -> Result<(), Collision> {
-        self.counters.configs.fetch_add(1, Ordering::Relaxed);
-        self.check_input(head, shape)?;
+    pub fn check_config(
+        &self,
+        head: impl Into<Point3<f64>>,
+        shape: &Shape,
+    ) -> Result<(), Collision> {
         // The map first: in clutter it rejects most configurations, and cheaply.
-        self.placement(head, shape)?;
+        self.check_placement(head, shape)?;
         shape_validity(&self.params, shape).map_err(Collision::Shape)
     }
 
     /// [`Self::check_config`] without the limits and self-collision part, for shapes
     /// already known to be valid (library and SRS shapes).
-    pub fn check_placement(&self, head: [f64; 3], shape: &Shape) -> Result<(), Collision> {
+    pub fn check_placement(
+        &self,
+        head: impl Into<Point3<f64>>,
+        shape: &Shape,
+    ) -> Result<(), Collision> {
+        let head = head.into();
         self.counters.configs.fetch_add(1, Ordering::Relaxed);
         self.check_input(head, shape)?;
-        self.placement(head, shape)
-    }
-
-    fn placement(&self, head: [f64; 3], shape: &Shape) -> Result<(), Collision> {
         let n = shape.units();
         let p = self.points(head, shape);
         let mut c = [0.0f64; MAX_UNITS];
@@ -435,7 +449,7 @@ impl CollisionContext {
             }
         }
         for k in 0..n - 1 {
-            if let Some(at) = self.segment_free(p[k], p[k + 1], self.link_r, c[k], c[k + 1]) {
+            if let Some(at) = self.segment_free(self.link(p[k], p[k + 1], c[k], c[k + 1])) {
                 return Err(Collision::Map {
                     body: Body::Link(k as u8),
                     point: at,
@@ -445,11 +459,17 @@ impl CollisionContext {
         Ok(())
     }
 
-    /// Sphere tracing of the capsule of radius `r` around segment `a b`, where `ca`, `cb`
-    /// are the field's bounds at the ends. `None` when proven free, else the point where
-    /// the proof failed.
-    fn segment_free(&self, a: [f64; 3], b: [f64; 3], r: f64, ca: f64, cb: f64) -> Option<[f64; 3]> {
-        let len = norm(sub(b, a));
+    /// A link's capsule between unit centres `a` and `b`, whose bounds are `ca` and `cb`.
+    fn link(&self, a: Point3<f64>, b: Point3<f64>, ca: f64, cb: f64) -> Capsule {
+        let r = self.link_r;
+        Capsule { a, b, r, ca, cb }
+    }
+
+    /// Sphere tracing of `capsule`. `None` when proven free, else the point where the
+    /// proof failed.
+    fn segment_free(&self, capsule: Capsule) -> Option<Point3<f64>> {
+        let Capsule { a, b, r, ca, cb } = capsule;
+        let len = (b - a).norm();
         // Points within ca - r of a (and cb - r of b) are proven free by the ends' bounds.
         let mut t = ca - r;
         let end = len - (cb - r);
@@ -459,9 +479,9 @@ impl CollisionContext {
         if len <= 0.0 {
             return if ca > r { None } else { Some(a) };
         }
-        let dir = scale(sub(b, a), 1.0 / len);
+        let dir = (b - a) * (1.0 / len);
         loop {
-            let s = add(a, scale(dir, t.min(len)));
+            let s = a + dir * t.min(len);
             let m = self.bound(s, r + self.min_step) - r;
             if m < self.min_step {
                 return Some(s);
@@ -473,18 +493,12 @@ impl CollisionContext {
         }
     }
 
-    /// A proven lower bound on `distance - r` over the segment `a b`, from the bounds at
-    /// its ends (`ca`, `cb`) and at the centres of pieces, halving pieces until the
-    /// Lipschitz loss is at most half the local bound (or the piece is tiny).
-    fn segment_margin(
-        &self,
-        a: [f64; 3],
-        b: [f64; 3],
-        r: f64,
-        ca: f64,
-        cb: f64,
-    ) -> (f64, [f64; 3]) {
-        let len = norm(sub(b, a));
+    /// A proven lower bound on `distance - r` over `capsule`, from the bounds at its ends
+    /// and at the centres of pieces, halving pieces until the Lipschitz loss is at most
+    /// half the local bound (or the piece is tiny).
+    fn segment_margin(&self, capsule: Capsule) -> (f64, Point3<f64>) {
+        let Capsule { a, b, r, ca, cb } = capsule;
+        let len = (b - a).norm();
         let wmin = self.field.grid().resolution() / 16.0;
         // Iterative refinement over a small stack of pieces [t0, t1] (in metres).
         let mut stack = [(0.0f64, 0.0f64); 48];
@@ -497,7 +511,7 @@ impl CollisionContext {
             let w = 0.5 * (t1 - t0);
             let tm = t0 + w;
             let s = if len > 0.0 {
-                add(a, scale(sub(b, a), tm / len))
+                a + (b - a) * (tm / len)
             } else {
                 a
             };
@@ -527,25 +541,26 @@ impl CollisionContext {
     /// body along the motion by certified horizons (see the module docs).
     pub fn check_translation(
         &self,
-        from: [f64; 3],
-        to: [f64; 3],
+        from: impl Into<Point3<f64>>,
+        to: impl Into<Point3<f64>>,
         shape: &Shape,
     ) -> Result<(), EdgeCollision> {
+        let (from, to) = (from.into(), to.into());
         self.counters.translations.fetch_add(1, Ordering::Relaxed);
         let at0 = |collision| EdgeCollision { t: 0.0, collision };
         self.check_input(from, shape).map_err(at0)?;
-        if !finite3(to) {
+        if !finite3(&to) {
             return Err(at0(Collision::BadInput("the head position is not finite")));
         }
         shape_validity(&self.params, shape).map_err(|v| at0(Collision::Shape(v)))?;
         let n = shape.units();
         let p0 = self.points(from, shape);
-        let delta = sub(to, from);
-        let dist = norm(delta);
+        let delta = to - from;
+        let dist = delta.norm();
         for (t, q) in [(0.0, from), (1.0, to)] {
-            let off = sub(q, from);
+            let off = q - from;
             for (i, u) in p0.iter().enumerate().take(n) {
-                let w = add(*u, off);
+                let w = u + off;
                 if !self.inside(w) {
                     return Err(EdgeCollision {
                         t,
@@ -558,9 +573,9 @@ impl CollisionContext {
             }
         }
         let dir = if dist > 0.0 {
-            scale(delta, 1.0 / dist)
+            delta * (1.0 / dist)
         } else {
-            [0.0; 3]
+            Vector3::zeros()
         };
         // Bodies: units 0..n, then links n..2n-1. horizon[b]: proven free for displacement < horizon.
         let nb = 2 * n - 1;
@@ -568,11 +583,11 @@ impl CollisionContext {
         let mut c = [0.0f64; MAX_UNITS];
         loop {
             let u = smallest(&horizon[..nb]).min(dist);
-            let off = scale(dir, u);
+            let off = dir * u;
             let frac = if dist > 0.0 { u / dist } else { 0.0 };
             // Units first (the links use their bounds).
             for i in 0..n {
-                let q = add(p0[i], off);
+                let q = p0[i] + off;
                 c[i] = self.bound(q, self.unit_r + self.min_step);
                 if horizon[i] <= u {
                     let m = c[i] - self.unit_r;
@@ -588,8 +603,8 @@ impl CollisionContext {
             }
             for k in 0..n - 1 {
                 if horizon[n + k] <= u {
-                    let (a, b) = (add(p0[k], off), add(p0[k + 1], off));
-                    let (m, at) = self.segment_margin(a, b, self.link_r, c[k], c[k + 1]);
+                    let (a, b) = (p0[k] + off, p0[k + 1] + off);
+                    let (m, at) = self.segment_margin(self.link(a, b, c[k], c[k + 1]));
                     if m < self.min_step {
                         let collision = Collision::Map {
                             body: Body::Link(k as u8),
@@ -613,10 +628,11 @@ impl CollisionContext {
     /// module docs).
     pub fn check_shape_change(
         &self,
-        head: [f64; 3],
+        head: impl Into<Point3<f64>>,
         from: &Shape,
         to: &Shape,
     ) -> Result<(), EdgeCollision> {
+        let head = head.into();
         self.counters.shape_changes.fetch_add(1, Ordering::Relaxed);
         let at0 = |collision| EdgeCollision { t: 0.0, collision };
         self.check_input(head, from).map_err(at0)?;
@@ -688,7 +704,7 @@ impl CollisionContext {
             }
             for k in 0..n - 1 {
                 if horizon[n + k] <= t {
-                    let (m, at) = self.segment_margin(p[k], p[k + 1], self.link_r, c[k], c[k + 1]);
+                    let (m, at) = self.segment_margin(self.link(p[k], p[k + 1], c[k], c[k + 1]));
                     if m < self.min_step {
                         let collision = Collision::Map {
                             body: Body::Link(k as u8),
@@ -710,7 +726,7 @@ impl CollisionContext {
 /// [`CollisionContext::check_config`] as a free function.
 pub fn check_config(
     ctx: &CollisionContext,
-    head: [f64; 3],
+    head: impl Into<Point3<f64>>,
     shape: &Shape,
 ) -> Result<(), Collision> {
     ctx.check_config(head, shape)
@@ -719,8 +735,8 @@ pub fn check_config(
 /// [`CollisionContext::check_translation`] as a free function.
 pub fn check_translation(
     ctx: &CollisionContext,
-    from: [f64; 3],
-    to: [f64; 3],
+    from: impl Into<Point3<f64>>,
+    to: impl Into<Point3<f64>>,
     shape: &Shape,
 ) -> Result<(), EdgeCollision> {
     ctx.check_translation(from, to, shape)
@@ -729,7 +745,7 @@ pub fn check_translation(
 /// [`CollisionContext::check_shape_change`] as a free function.
 pub fn check_shape_change(
     ctx: &CollisionContext,
-    head: [f64; 3],
+    head: impl Into<Point3<f64>>,
     from: &Shape,
     to: &Shape,
 ) -> Result<(), EdgeCollision> {

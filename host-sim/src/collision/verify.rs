@@ -39,6 +39,16 @@ pub fn wrap(a: f64) -> f64 {
     }
 }
 
+/// The change from configuration `a` to `b` (`zeta`, equal lengths): the head's
+/// displacement, then every angle's shortest signed difference ([`wrap`]).
+pub fn zeta_delta(a: &[f64], b: &[f64]) -> Vec<f64> {
+    a.iter()
+        .zip(b)
+        .enumerate()
+        .map(|(j, (x, y))| if j < 3 { y - x } else { wrap(y - x) })
+        .collect()
+}
+
 /// Which kind of edge joins two configurations.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EdgeKind {

@@ -46,6 +46,8 @@
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
+use nalgebra::Point3;
+
 use super::grid::Grid;
 
 /// Size of the exact `G(n)` table.
@@ -412,7 +414,8 @@ impl DistanceField {
     /// `p`, clamped into the grid), which is exact for a point between two voxel centres
     /// facing a flat wall, where a single centre would lose up to `r sqrt(3) / 2`.
     #[inline]
-    pub fn clearance(&self, p: [f64; 3]) -> f64 {
+    pub fn clearance(&self, p: impl Into<Point3<f64>>) -> f64 {
+        let p = p.into();
         let dims = self.grid.dims();
         let mut idx = [[0usize; 2]; 3];
         let mut d2 = [[0f64; 2]; 3];
@@ -452,7 +455,8 @@ impl DistanceField {
     /// centre of the voxel holding `p` only (one lookup). Use it first and fall back to
     /// [`Self::clearance`] when it is not enough.
     #[inline]
-    pub fn clearance_coarse(&self, p: [f64; 3]) -> f64 {
+    pub fn clearance_coarse(&self, p: impl Into<Point3<f64>>) -> f64 {
+        let p = p.into();
         let dims = self.grid.dims();
         let mut l = [0usize; 3];
         let mut d2 = 0.0;
@@ -472,7 +476,8 @@ impl DistanceField {
     /// [`Self::clearance_coarse`] when it exceeds `need`, else [`Self::clearance`]: a
     /// proven lower bound, as tight as the fine query wherever it matters for `need`.
     #[inline]
-    pub fn clearance_above(&self, p: [f64; 3], need: f64) -> f64 {
+    pub fn clearance_above(&self, p: impl Into<Point3<f64>>, need: f64) -> f64 {
+        let p = p.into();
         let c = self.clearance_coarse(p);
         if c > need {
             c
@@ -500,7 +505,7 @@ mod tests {
     use proptest::prelude::*;
 
     /// Exact distance from `p` to the closed cube of edge `r` centred at `c`.
-    fn point_cube(p: [f64; 3], c: [f64; 3], r: f64) -> f64 {
+    fn point_cube(p: [f64; 3], c: Point3<f64>, r: f64) -> f64 {
         let mut s = 0.0;
         for a in 0..3 {
             let d = ((p[a] - c[a]).abs() - 0.5 * r).max(0.0);

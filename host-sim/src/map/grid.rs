@@ -11,6 +11,8 @@
 //! is the user's choice ([`Grid::unknown_is_occupied`], `--unknown-free` sets it false);
 //! the grid keeps the three states so either choice can be made later.
 
+use nalgebra::Point3;
+
 /// Largest number of voxels a grid may hold (400 M: 400 MB of cells, 1.6 GB of distance
 /// field). Larger maps are refused with [`GridError::TooLarge`] rather than exhausting memory.
 pub const MAX_CELLS: usize = 400_000_000;
@@ -257,7 +259,8 @@ impl Grid {
     }
 
     /// Whether `p` lies in the bounding box (closed).
-    pub fn in_bounds(&self, p: [f64; 3]) -> bool {
+    pub fn in_bounds(&self, p: impl Into<Point3<f64>>) -> bool {
+        let p = p.into();
         let (lo, hi) = self.bounds;
         (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a])
     }
@@ -274,8 +277,9 @@ impl Grid {
 
     /// The lattice index of the voxel containing `p` (a point on a face belongs to the
     /// voxel above it). Saturates far outside the `i32` range.
-    pub fn lattice_index(&self, p: [f64; 3]) -> [i32; 3] {
-        p.map(|v| {
+    pub fn lattice_index(&self, p: impl Into<Point3<f64>>) -> [i32; 3] {
+        let p = p.into();
+        [p.x, p.y, p.z].map(|v| {
             (v / self.resolution)
                 .floor()
                 .clamp(i32::MIN as f64, i32::MAX as f64) as i32
@@ -283,8 +287,8 @@ impl Grid {
     }
 
     /// Centre of the voxel with lattice index `i` (m).
-    pub fn voxel_center(&self, i: [i32; 3]) -> [f64; 3] {
-        i.map(|v| (v as f64 + 0.5) * self.resolution)
+    pub fn voxel_center(&self, i: [i32; 3]) -> Point3<f64> {
+        i.map(|v| (v as f64 + 0.5) * self.resolution).into()
     }
 
     /// The grid-local index of lattice voxel `i`, if it is inside the grid.
@@ -342,7 +346,7 @@ impl Grid {
     }
 
     /// Whether the voxel containing `p` is an obstacle.
-    pub fn is_obstacle_at(&self, p: [f64; 3]) -> bool {
+    pub fn is_obstacle_at(&self, p: impl Into<Point3<f64>>) -> bool {
         self.is_obstacle(self.lattice_index(p))
     }
 
@@ -379,7 +383,13 @@ impl Grid {
 
     /// Sets every voxel whose centre lies in the closed metric box `lo..hi` to `state`
     /// (clipped to the grid). Used by the scenario generators.
-    pub fn fill_box(&mut self, lo: [f64; 3], hi: [f64; 3], state: Cell) {
+    pub fn fill_box(
+        &mut self,
+        lo: impl Into<Point3<f64>>,
+        hi: impl Into<Point3<f64>>,
+        state: Cell,
+    ) {
+        let (lo, hi) = (lo.into(), hi.into());
         let mut a0 = [0usize; 3];
         let mut a1 = [0usize; 3];
         for a in 0..3 {
@@ -405,7 +415,7 @@ impl Grid {
     /// Calls `f(lattice index, centre)` for every voxel of the grid whose centre
     /// satisfies `inside`; sets those voxels to `state`. Used by the scenario generators
     /// for curved shapes (cylinders).
-    pub fn fill_where(&mut self, state: Cell, mut inside: impl FnMut([f64; 3]) -> bool) {
+    pub fn fill_where(&mut self, state: Cell, mut inside: impl FnMut(Point3<f64>) -> bool) {
         for z in 0..self.dims[2] {
             for y in 0..self.dims[1] {
                 for x in 0..self.dims[0] {

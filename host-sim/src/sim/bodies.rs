@@ -64,6 +64,42 @@ pub(super) fn free_body(pos: &V3, rot: GQuat, mprops: MassProperties) -> RigidBo
         .build()
 }
 
+/// Link `k`'s body, at the middle of unit centres `k` and `k + 1`, turned by
+/// `link_rot[k]`.
+fn link_body(
+    world: &mut PhysicsWorld,
+    p: &[V3],
+    link_rot: &[M3],
+    k: usize,
+    mass: MassProperties,
+) -> RigidBodyHandle {
+    let mid = 0.5 * (p[k] + p[k + 1]);
+    world
+        .bodies
+        .insert(free_body(&mid, to_glam_rotation(&link_rot[k]), mass))
+}
+
+/// One end of a joint: the body, where the joint sits on the body's axis (m), and how
+/// the joint's frame is turned from the body's.
+type JointEnd = (RigidBodyHandle, f32, GQuat);
+
+/// Joins two bodies by a spherical joint between the frames of `first` and `second`;
+/// `index` names the joint if rapier refuses it.
+fn join(
+    world: &mut PhysicsWorld,
+    (a, xa, ra): JointEnd,
+    (b, xb, rb): JointEnd,
+    index: usize,
+) -> Result<MultibodyJointHandle, DynamicsError> {
+    let joint = SphericalJointBuilder::new()
+        .local_frame1(Pose::from_parts(GVec3::new(xa, 0.0, 0.0), ra))
+        .local_frame2(Pose::from_parts(GVec3::new(xb, 0.0, 0.0), rb));
+    world
+        .multibody_joints
+        .insert(a, b, joint, true)
+        .ok_or(DynamicsError::Joint(index))
+}
+
 /// The full formulation's bodies: units and links as bodies of their own, joined by
 /// spherical joints at the unit centres. Returns units, links and joints.
 pub(super) fn build_full(
@@ -97,42 +133,28 @@ pub(super) fn build_full(
         );
     }
     for k in 0..n - 1 {
-        let mid = 0.5 * (p[k] + p[k + 1]);
-        links.push(
-            world
-                .bodies
-                .insert(free_body(&mid, to_glam_rotation(&link_rot[k]), link_mass)),
-        );
+        links.push(link_body(world, p, link_rot, k, link_mass));
     }
     // The joints' reference frames are chosen so that zero joint coordinates
     // are the start configuration (a multibody places its children from its
     // joint coordinates, not from the bodies' initial poses).
     for k in 0..n - 1 {
-        let front = SphericalJointBuilder::new()
-            .local_frame1(Pose::from_parts(
-                GVec3::ZERO,
-                to_glam_rotation(&(r_unit.transpose() * link_rot[k])),
-            ))
-            .local_frame2(Pose::from_parts(
-                GVec3::new(half, 0.0, 0.0),
-                GQuat::IDENTITY,
-            ));
-        let h = world
-            .multibody_joints
-            .insert(units[k], links[k], front, true)
-            .ok_or(DynamicsError::Joint(2 * k))?;
-        joints.push(h);
-        let back = SphericalJointBuilder::new()
-            .local_frame1(Pose::from_parts(
-                GVec3::new(-half, 0.0, 0.0),
-                to_glam_rotation(&(link_rot[k].transpose() * r_unit)),
-            ))
-            .local_frame2(Pose::from_parts(GVec3::ZERO, GQuat::IDENTITY));
-        let h = world
-            .multibody_joints
-            .insert(links[k], units[k + 1], back, true)
-            .ok_or(DynamicsError::Joint(2 * k + 1))?;
-        joints.push(h);
+        let unit_to_link = to_glam_rotation(&(r_unit.transpose() * link_rot[k]));
+        let front = (units[k], 0.0, unit_to_link);
+        joints.push(join(
+            world,
+            front,
+            (links[k], half, GQuat::IDENTITY),
+            2 * k,
+        )?);
+        let link_to_unit = to_glam_rotation(&(link_rot[k].transpose() * r_unit));
+        let back = (links[k], -half, link_to_unit);
+        joints.push(join(
+            world,
+            back,
+            (units[k + 1], 0.0, GQuat::IDENTITY),
+            2 * k + 1,
+        )?);
     }
     Ok(ChainBodies {
         link_com: vec![0.0; links.len()],
@@ -154,32 +176,16 @@ pub(super) fn build_lumped(
     let half = (0.5 * model.link_length()) as f32;
     let (mut links, mut joints, mut link_com) =
         (Vec::with_capacity(n - 1), Vec::new(), vec![0.0; n - 1]);
-    for k in 0..n - 1 {
+    for (k, com) in link_com.iter_mut().enumerate() {
         let (mp, xc) = lumped_mass(model, k == 0);
-        link_com[k] = xc;
-        let mid = 0.5 * (p[k] + p[k + 1]);
-        links.push(
-            world
-                .bodies
-                .insert(free_body(&mid, to_glam_rotation(&link_rot[k]), mp)),
-        );
+        *com = xc;
+        links.push(link_body(world, p, link_rot, k, mp));
     }
     for k in 1..n - 1 {
         // Link k-1's back end is link k's front end (unit k's centre).
-        let joint = SphericalJointBuilder::new()
-            .local_frame1(Pose::from_parts(
-                GVec3::new(-half, 0.0, 0.0),
-                to_glam_rotation(&(link_rot[k - 1].transpose() * link_rot[k])),
-            ))
-            .local_frame2(Pose::from_parts(
-                GVec3::new(half, 0.0, 0.0),
-                GQuat::IDENTITY,
-            ));
-        let h = world
-            .multibody_joints
-            .insert(links[k - 1], links[k], joint, true)
-            .ok_or(DynamicsError::Joint(k))?;
-        joints.push(h);
+        let turn = to_glam_rotation(&(link_rot[k - 1].transpose() * link_rot[k]));
+        let back = (links[k - 1], -half, turn);
+        joints.push(join(world, back, (links[k], half, GQuat::IDENTITY), k)?);
     }
     Ok(ChainBodies {
         units: Vec::new(),

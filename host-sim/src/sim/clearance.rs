@@ -3,6 +3,7 @@
 //! distances), for [`super::flight::Obstacles`].
 
 use aerial_chain_core::ChainParams;
+use nalgebra::Point3;
 
 use super::dynamics::V3;
 use super::flight::Obstacles;
@@ -31,15 +32,11 @@ impl<'a> MapClearance<'a> {
     }
 }
 
-fn arr(v: &V3) -> [f64; 3] {
-    [v.x, v.y, v.z]
-}
-
 impl Obstacles for MapClearance<'_> {
     fn clearance(&self, units: &[V3]) -> (f64, String) {
         let mut best = (HORIZON, String::from("nothing within the search horizon"));
         for (i, p) in units.iter().enumerate() {
-            if !self.grid.in_bounds(arr(p)) {
+            if !self.grid.in_bounds(Point3::from(*p)) {
                 return (
                     -self.unit_radius,
                     format!(
@@ -62,7 +59,12 @@ impl Obstacles for MapClearance<'_> {
             .map(|(k, w)| ("link", k, &w[0], &w[1], self.link_radius));
         for (kind, i, a, b, radius) in unit_bodies.chain(link_bodies) {
             // The body's core is the segment a-b (a point for a unit).
-            if let Some(n) = nearest_obstacle(self.grid, arr(a), arr(b), HORIZON + radius) {
+            if let Some(n) = nearest_obstacle(
+                self.grid,
+                Point3::from(*a),
+                Point3::from(*b),
+                HORIZON + radius,
+            ) {
                 let c = n.distance - radius;
                 if c < best.0 {
                     let v = n.voxel;

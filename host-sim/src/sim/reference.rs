@@ -10,27 +10,13 @@
 //! moves every angle of `eta` linearly along its shortest signed difference with the
 //! head fixed. An edge that changes both is refused.
 
-use std::f64::consts::PI;
-
 use super::dynamics::{unit_positions, V3};
 use super::SettingsError;
-
-/// docs/model.md: "stays" means equal within this (angles compared after wrapping).
-pub const STAY_TOLERANCE: f64 = 1e-9;
+use crate::collision::verify::{zeta_delta, STAY_TOLERANCE};
 
 /// Peak acceleration of a smoothstep speed ramp, per unit of cruise rate over ramp
 /// time: `max d/dx (3x^2 - 2x^3) = 1.5`.
 const RAMP_PEAK_ACCEL: f64 = 1.5;
-
-/// Wraps an angle to `(-pi, pi]`.
-pub fn wrap(a: f64) -> f64 {
-    let w = a.rem_euclid(2.0 * PI);
-    if w > PI {
-        w - 2.0 * PI
-    } else {
-        w
-    }
-}
 
 /// Why a plan's waypoints cannot be timed into a reference.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -324,15 +310,7 @@ impl Reference {
         }
         for (i, pair) in waypoints.windows(2).enumerate() {
             let (a, b) = (&pair[0], &pair[1]);
-            let mut delta: Vec<f64> = (0..dim)
-                .map(|j| {
-                    if j < 3 {
-                        b[j] - a[j]
-                    } else {
-                        wrap(b[j] - a[j])
-                    }
-                })
-                .collect();
+            let mut delta = zeta_delta(a, b);
             let moves_head = delta[..3].iter().any(|d| d.abs() > STAY_TOLERANCE);
             let moves_shape = delta[3..].iter().any(|d| d.abs() > STAY_TOLERANCE);
             let (kind, scaling) = match (moves_head, moves_shape) {
@@ -497,12 +475,7 @@ impl Reference {
             .zip(times.windows(2))
             .enumerate()
             .map(|(i, (z, t))| {
-                let delta: Vec<f64> = (0..dim)
-                    .map(|j| match j {
-                        0..3 => z[1][j] - z[0][j],
-                        _ => wrap(z[1][j] - z[0][j]),
-                    })
-                    .collect();
+                let delta = zeta_delta(&z[0], &z[1]);
                 let h = t[1] - t[0];
                 Segment {
                     kind: SegmentKind::Translation,
@@ -578,6 +551,8 @@ impl Reference {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::collision::verify::wrap;
+    use std::f64::consts::PI;
 
     fn zeta(xi: [f64; 3], eta: &[f64]) -> Vec<f64> {
         let mut z = xi.to_vec();

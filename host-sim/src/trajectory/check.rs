@@ -16,10 +16,11 @@
 
 use aerial_chain_core::validity::Body;
 use aerial_chain_core::ChainParams;
+use nalgebra::Point3;
 
 use super::Limits;
 use crate::collision::exact::{check_config_exact, positions_f64, ExactViolation};
-use crate::collision::verify::{wrap, MAX_INTERVALS};
+use crate::collision::verify::{wrap, zeta_delta, MAX_INTERVALS};
 use crate::map::Grid;
 
 /// A limit holds when the measured value is at most `limit * (1 + LIMIT_TOLERANCE)`:
@@ -239,7 +240,7 @@ impl Checker<'_> {
             }
         }
         let l = self.params.link_length as f64;
-        let units: Vec<Vec<[f64; 3]>> = zetas
+        let units: Vec<Vec<Point3<f64>>> = zetas
             .iter()
             .map(|z| positions_f64(l, [z[0], z[1], z[2]], &z[3..]))
             .collect();
@@ -287,8 +288,8 @@ impl Checker<'_> {
     /// Unit speeds and angle rates over one interval.
     fn rates(
         &mut self,
-        p0: &[[f64; 3]],
-        p1: &[[f64; 3]],
+        p0: &[Point3<f64>],
+        p1: &[Point3<f64>],
         z0: &[f64],
         z1: &[f64],
         dt: f64,
@@ -352,15 +353,7 @@ impl Checker<'_> {
     /// Every configuration of the interval `z0 -> z1` at the `r_v / 4` rule, its end
     /// included; the error carries the fraction of the interval.
     fn interval(&mut self, z0: &[f64], z1: &[f64], t0: f64, dt: f64) -> Result<(), (f64, Problem)> {
-        let d: Vec<f64> = (0..z0.len())
-            .map(|j| {
-                if j < 3 {
-                    z1[j] - z0[j]
-                } else {
-                    wrap(z1[j] - z0[j])
-                }
-            })
-            .collect();
+        let d = zeta_delta(z0, z1);
         let head = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         let links = (0..(z0.len() - 4) / 2)
             .map(|k| (d[4 + 2 * k].powi(2) + d[5 + 2 * k].powi(2)).sqrt())
@@ -391,6 +384,6 @@ fn exceeds(value: f64, limit: f64) -> bool {
     value > limit * (1.0 + LIMIT_TOLERANCE)
 }
 
-fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+fn dist(a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }

@@ -111,7 +111,10 @@ impl TrajectoryFile {
             .map(|(t, z)| SampleRow {
                 t: *t,
                 zeta: z.clone(),
-                p: positions_f64(l, [z[0], z[1], z[2]], &z[3..]),
+                p: positions_f64(l, [z[0], z[1], z[2]], &z[3..])
+                    .into_iter()
+                    .map(Into::into)
+                    .collect(),
                 q: vec![yaw_quaternion(z[3]); params.n()],
             })
             .collect();

@@ -368,6 +368,40 @@ pub fn start_shape(params: &ChainParams, name: &str, yaw: f32) -> Result<Shape, 
         .rotated(aerial_chain_core::angle::diff(e.shape.head_yaw(), yaw)))
 }
 
+/// The motion `arc sim` flies and `arc verify` checks: a plan, or a trajectory in its
+/// place. Exactly one of the two is given.
+#[derive(Args, Debug)]
+#[group(required = true, multiple = false)]
+pub struct MotionArgs {
+    /// The plan (JSON, arc-plan/1); `-` reads it from standard input.
+    #[arg(long)]
+    plan: Option<PathBuf>,
+    /// A trajectory instead of a plan (JSON, arc-trajectory/1), taken with its own
+    /// timing (the chain moves linearly between its samples); `-` reads it from
+    /// standard input.
+    #[arg(long)]
+    trajectory: Option<PathBuf>,
+}
+
+/// The file given to [`MotionArgs`].
+pub enum MotionFile<'a> {
+    /// A plan (arc-plan/1).
+    Plan(&'a Path),
+    /// A trajectory (arc-trajectory/1).
+    Trajectory(&'a Path),
+}
+
+impl MotionArgs {
+    /// The one file given (clap refuses both and neither).
+    pub fn file(&self) -> Result<MotionFile<'_>, CliError> {
+        match (&self.plan, &self.trajectory) {
+            (Some(p), None) => Ok(MotionFile::Plan(p)),
+            (None, Some(t)) => Ok(MotionFile::Trajectory(t)),
+            _ => Err(CliError::input("give --plan or --trajectory")),
+        }
+    }
+}
+
 /// Reads a plan file (`-`: standard input) and checks it: the plan, its name for
 /// messages, and its chain's parameters.
 pub fn read_plan(

@@ -98,6 +98,8 @@ enum Command {
     Plan(Box<plan::PlanArgs>),
     /// Check a plan or a trajectory exactly against a map (docs/model.md), independent
     /// of the planner.
+    ///
+    /// A trajectory is checked against the limits given here, not the ones it records.
     #[command(
         after_help = "Examples:\n  arc verify --scenario window --plan window.json\n  arc verify --scenario window --trajectory window-t.json"
     )]

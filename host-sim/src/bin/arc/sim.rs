@@ -9,7 +9,7 @@ use clap::Args;
 use serde::Serialize;
 
 use super::checks;
-use super::common::{looser_assumption, read_plan, MapArgs, Report};
+use super::common::{looser_assumption, read_plan, MapArgs, MotionArgs, MotionFile, Report};
 use super::trajectory::{read_trajectory, TimingArgs};
 use super::{CliError, CliResult};
 use aerial_chain::map::Grid;
@@ -28,17 +28,8 @@ use aerial_chain::trajectory::{self, Trajectory, TrajectoryError};
 pub struct SimArgs {
     #[command(flatten)]
     map: MapArgs,
-    /// The plan to fly (JSON, arc-plan/1); `-` reads it from standard input.
-    #[arg(
-        long,
-        required_unless_present = "trajectory",
-        conflicts_with = "trajectory"
-    )]
-    plan: Option<PathBuf>,
-    /// A trajectory to fly as it is (JSON, arc-trajectory/1), instead of a plan;
-    /// the chain moves linearly between its samples.
-    #[arg(long)]
-    trajectory: Option<PathBuf>,
+    #[command(flatten)]
+    motion: MotionArgs,
     /// Write the flight (report and recorded states) as JSON; `-` writes it to
     /// standard output.
     #[arg(long)]
@@ -158,8 +149,8 @@ pub fn run(a: SimArgs) -> CliResult {
     // With `--out -` the flight is standard output; the report goes to standard error.
     let report = Report::new(a.out.as_deref().unwrap_or(Path::new("")));
     let say = |args: std::fmt::Arguments<'_>| report.line(args);
-    let (plan_name, waypoints, params, looser, loaded, motion) = match (&a.plan, &a.trajectory) {
-        (Some(path), None) => {
+    let (plan_name, waypoints, params, looser, loaded, motion) = match a.motion.file()? {
+        MotionFile::Plan(path) => {
             let (plan, name, params) = read_plan(path)?;
             // The flight is judged under the user's assumption about unknown space,
             // never the plan's: a plan made with looser assumptions fails (docs/model.md).
@@ -171,7 +162,7 @@ pub fn run(a: SimArgs) -> CliResult {
             };
             (name, plan.waypoints.len(), params, looser, loaded, motion)
         }
-        (None, Some(path)) => {
+        MotionFile::Trajectory(path) => {
             let (file, name, params) = read_trajectory(path)?;
             let looser = (!file.map.unknown_is_occupied && !a.map.unknown_free).then(|| {
                 "the trajectory was made with unknown space free; fly it with --unknown-free"
@@ -193,7 +184,6 @@ pub fn run(a: SimArgs) -> CliResult {
                 Motion::Timed(r),
             )
         }
-        _ => return Err(CliError::input("give --plan or --trajectory")),
     };
     let obstacles = MapClearance::new(&loaded.grid, &params);
     let flight = with_progress(|progress| match &motion {

@@ -1,11 +1,11 @@
 //! `arc verify`: the exact check of docs/model.md, independent of the planner.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use clap::Args;
 
 use super::checks;
-use super::common::{looser_assumption, parse_point, MapArgs};
+use super::common::{looser_assumption, parse_point, MapArgs, MotionArgs, MotionFile};
 use super::trajectory::{read_trajectory, LimitArgs};
 use super::{CliError, CliResult};
 use aerial_chain::collision::{verify_plan, VerifyOptions};
@@ -17,17 +17,8 @@ use aerial_chain::trajectory::check_samples;
 pub struct VerifyArgs {
     #[command(flatten)]
     map: MapArgs,
-    /// The plan (JSON, arc-plan/1); `-` reads it from standard input.
-    #[arg(
-        long,
-        required_unless_present = "trajectory",
-        conflicts_with = "trajectory"
-    )]
-    plan: Option<PathBuf>,
-    /// A trajectory instead of a plan (JSON, arc-trajectory/1); `-` reads it from
-    /// standard input. Checked against the limits below, not the ones it records.
-    #[arg(long)]
-    trajectory: Option<PathBuf>,
+    #[command(flatten)]
+    motion: MotionArgs,
     #[command(flatten)]
     limits: LimitArgs,
     /// Where the plan must start (head x,y,z); a scenario has its own.
@@ -54,10 +45,9 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// every edge is valid, and the plan starts and ends where asked.
 pub fn run(a: VerifyArgs) -> CliResult {
     checks::length("--goal-tol", a.goal_tol, false)?;
-    let path = match (&a.plan, &a.trajectory) {
-        (Some(p), None) => p,
-        (None, Some(t)) => return run_trajectory(&a, t),
-        _ => return Err(CliError::input("give --plan or --trajectory")),
+    let path = match a.motion.file()? {
+        MotionFile::Plan(p) => p,
+        MotionFile::Trajectory(t) => return run_trajectory(&a, t),
     };
     let plan = Plan::read(path).map_err(|e| CliError::input(e.to_string()))?;
     // What unknown space is comes from the command line only, never from the plan

@@ -1,6 +1,8 @@
 //! What a loaded [`OcTree`] answers: the state of the space at a point, its leaves, its
 //! bounds and its counts, each as OctoMap answers it for the same file.
 
+use nalgebra::Point3;
+
 use super::tree::{
     cell_center, child_cell, child_code, node_size, OcTree, CHILD_FREE, CHILD_INNER, CHILD_NONE,
     CHILD_OCCUPIED, TREE_DEPTH, TREE_MAX_VAL,
@@ -54,7 +56,8 @@ impl OcTree {
     /// followed by `isNodeOccupied`: the key along each axis is
     /// `floor((1 / resolution) * p) + 32768`, and points whose key falls outside 0..65536
     /// (or that are not finite) are outside.
-    pub fn query(&self, p: [f64; 3]) -> Option<bool> {
+    pub fn query(&self, p: impl Into<Point3<f64>>) -> Option<bool> {
+        let p = p.into();
         let factor = 1.0 / self.resolution;
         let mut key = [0u32; 3];
         for (k, &c) in key.iter_mut().zip(p.iter()) {

@@ -80,13 +80,8 @@ fn start_and_goal_are_free() {
         let f = Arc::new(DistanceField::new(s.grid.clone()));
         let ctx = CollisionContext::new(f, p, DEFAULT_CLEARANCE).unwrap();
         let shape = s.start_shape(s.default_units).unwrap();
-        assert_eq!(
-            ctx.check_config(s.start.into(), &shape),
-            Ok(()),
-            "{}",
-            s.name
-        );
-        assert!(ctx.is_head_free(s.goal.into()), "{}", s.name);
+        assert_eq!(ctx.check_config(s.start, &shape), Ok(()), "{}", s.name);
+        assert!(ctx.is_head_free(s.goal), "{}", s.name);
     }
 }
 

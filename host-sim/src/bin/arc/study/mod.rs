@@ -596,7 +596,7 @@ mod tests {
         for n in [3u8, 12, 16] {
             let ctx = context(&env, n).unwrap();
             let q = fitting_query(&env.scenario, &ctx).unwrap();
-            assert!(ctx.check_config(q.start.into(), &q.start_shape).is_ok());
+            assert!(ctx.check_config(q.start, &q.start_shape).is_ok());
         }
         // A short chain keeps the scenario's own start.
         let ctx = context(&env, 4).unwrap();

@@ -253,7 +253,7 @@ pub fn boxes(grid: &Grid, region: &Region<'_>, max_boxes: usize) -> Boxes {
                 }
                 if let Some((set, d)) = &near_buckets {
                     let c = grid.voxel_center(v);
-                    if !set.contains(&bucket(c, *d)) {
+                    if !set.contains(&bucket(c.into(), *d)) {
                         continue;
                     }
                 }
@@ -281,7 +281,7 @@ pub fn boxes(grid: &Grid, region: &Region<'_>, max_boxes: usize) -> Boxes {
     Boxes {
         size: res * f64::from(scale),
         scale,
-        origin: grid.voxel_center([0, 0, 0]).map(|c| c + half),
+        origin: grid.voxel_center([0, 0, 0]).map(|c| c + half).into(),
         occupied,
         unknown,
     }
