@@ -43,11 +43,7 @@ fn differing(a: &[u8], b: &[u8]) -> usize {
 #[test]
 fn a_plan_animates_one_frame_per_step_of_its_trajectory() {
     let dir = tempfile::tempdir().unwrap();
-    let (plan, traj, gif) = (
-        dir.path().join("p.json"),
-        dir.path().join("t.json"),
-        dir.path().join("p.gif"),
-    );
+    let [plan, traj, gif] = ["p.json", "t.json", "p.gif"].map(|n| dir.path().join(n));
     plan_scenario(
         "window",
         4,
@@ -88,11 +84,7 @@ fn a_plan_animates_one_frame_per_step_of_its_trajectory() {
 #[test]
 fn a_flight_animates_one_frame_per_step_of_flight() {
     let dir = tempfile::tempdir().unwrap();
-    let (plan, out, gif) = (
-        dir.path().join("p.json"),
-        dir.path().join("f.json"),
-        dir.path().join("f.gif"),
-    );
+    let [plan, out, gif] = ["p.json", "f.json", "f.gif"].map(|n| dir.path().join(n));
     plan_scenario("window", 4, &[], &plan).expect("plan");
     arc_ok(&[
         "sim",
@@ -124,17 +116,12 @@ fn a_flight_animates_one_frame_per_step_of_flight() {
 fn bad_steps_and_outputs_are_refused_and_leave_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let plan = [
-        "plan",
-        "--scenario",
-        "window",
-        "--units",
-        "4",
-        "--out",
-        "p.json",
-    ];
     let with = |extra: &[&str]| -> Vec<String> {
-        plan.iter().chain(extra).map(|x| x.to_string()).collect()
+        "plan --scenario window --units 4 --out p.json"
+            .split(' ')
+            .chain(extra.iter().copied())
+            .map(String::from)
+            .collect()
     };
     for (extra, says) in [
         (

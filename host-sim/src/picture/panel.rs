@@ -165,16 +165,22 @@ impl Panel {
 
     /// A circle of data radius `r` (in units of the x axis).
     pub fn circle(&mut self, c: (f64, f64), r: f64, fill: &str, stroke: &str, opacity: f64) {
+        self.disc(c, r, (fill, opacity), (stroke, stroke::HAIR));
+    }
+
+    /// A circle of data radius `r` with its fill (colour, opacity) and its rim
+    /// (colour, width in pixels).
+    fn disc(&mut self, c: (f64, f64), r: f64, fill: (&str, f64), rim: (&str, f64)) {
         let (x, y) = self.map(c.0, c.1);
         self.add(
             Circle::new()
                 .set("cx", x)
                 .set("cy", y)
                 .set("r", (r * self.scale.0).max(1.0))
-                .set("fill", fill)
-                .set("fill-opacity", opacity)
-                .set("stroke", stroke)
-                .set("stroke-width", stroke::HAIR),
+                .set("fill", fill.0)
+                .set("fill-opacity", fill.1)
+                .set("stroke", rim.0)
+                .set("stroke-width", rim.1),
         );
     }
 
@@ -262,18 +268,12 @@ impl Panel {
             self.line(w[0], w[1], palette::INK, stroke::THIN);
         }
         for (i, &q) in body.iter().enumerate() {
-            let (x, y) = self.map(q.0, q.1);
-            let edge = if i == 0 { palette::INK } else { rim };
-            self.add(
-                Circle::new()
-                    .set("cx", x)
-                    .set("cy", y)
-                    .set("r", (r * self.scale.0).max(1.0))
-                    .set("fill", fill)
-                    .set("fill-opacity", 0.6)
-                    .set("stroke", edge)
-                    .set("stroke-width", if i == 0 { 1.6 } else { 1.4 }),
-            );
+            let edge = if i == 0 {
+                (palette::INK, 1.6)
+            } else {
+                (rim, 1.4)
+            };
+            self.disc(q, r, (fill, 0.6), edge);
         }
     }
 

@@ -181,24 +181,27 @@ fn priority(sources: &[Option<(Colour, &str)>]) -> Vec<usize> {
 }
 
 /// The waypoints whose chains are drawn, in time order: the first two of `order` (the
-/// start and the end) always, every other if its units and link midpoints keep `gap`
-/// from those of every chain already taken.
+/// start and the end) always, every other if none of its units comes within `gap` of
+/// a unit or a link's midpoint of a chain already taken, nor any of its links'
+/// midpoints within `gap` of such a unit.
 pub(crate) fn thinned(seen: &[Vec<(f64, f64)>], order: &[usize], gap: f64) -> Vec<usize> {
-    let points = |b: &[(f64, f64)]| -> Vec<(f64, f64)> {
-        let mids = b
-            .windows(2)
-            .map(|w| ((w[0].0 + w[1].0) / 2.0, (w[0].1 + w[1].1) / 2.0));
-        b.iter().copied().chain(mids).collect()
+    let mids = |b: &[(f64, f64)]| -> Vec<(f64, f64)> {
+        b.windows(2)
+            .map(|w| ((w[0].0 + w[1].0) / 2.0, (w[0].1 + w[1].1) / 2.0))
+            .collect()
     };
-    let mut taken: Vec<(f64, f64)> = Vec::new();
+    let near = |ps: &[(f64, f64)], qs: &[(f64, f64)]| {
+        ps.iter()
+            .any(|p| qs.iter().any(|q| (p.0 - q.0).hypot(p.1 - q.1) < gap))
+    };
+    let (mut units, mut links): (Vec<(f64, f64)>, Vec<(f64, f64)>) = (Vec::new(), Vec::new());
     let mut chosen = Vec::new();
     for &i in order {
-        let pts = points(&seen[i]);
-        let clear = pts
-            .iter()
-            .all(|p| taken.iter().all(|q| (p.0 - q.0).hypot(p.1 - q.1) >= gap));
+        let (u, m) = (&seen[i], mids(&seen[i]));
+        let clear = !near(u, &units) && !near(u, &links) && !near(&m, &units);
         if clear || chosen.len() < 2 {
-            taken.extend(pts);
+            units.extend_from_slice(u);
+            links.extend(m);
             chosen.push(i);
         }
     }
