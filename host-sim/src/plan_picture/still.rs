@@ -194,7 +194,8 @@ pub(crate) fn thinned(seen: &[Vec<(f64, f64)>], order: &[usize], gap: f64) -> Ve
         ps.iter()
             .any(|p| qs.iter().any(|q| (p.0 - q.0).hypot(p.1 - q.1) < gap))
     };
-    let (mut units, mut links): (Vec<(f64, f64)>, Vec<(f64, f64)>) = (Vec::new(), Vec::new());
+    let mut units: Vec<(f64, f64)> = Vec::new();
+    let mut links: Vec<(f64, f64)> = Vec::new();
     let mut chosen = Vec::new();
     for &i in order {
         let (u, m) = (&seen[i], mids(&seen[i]));
