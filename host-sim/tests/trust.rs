@@ -162,7 +162,7 @@ fn unsupported_pictures_are_refused_before_any_work() {
             "--plan",
             "hover.json",
             "--picture",
-            "x.gif",
+            "x.bmp",
         ],
         &["shapes", "--units", "3", "--out", "x.jpg"],
         &["map", "picture", "--scenario", "window", "--out", "x"],
@@ -173,7 +173,7 @@ fn unsupported_pictures_are_refused_before_any_work() {
     }
     // Nothing was planned or written.
     assert!(!d.join("p.json").exists());
-    assert!(!d.join("x.gif").exists());
+    assert!(!d.join("x.bmp").exists());
 }
 
 #[test]

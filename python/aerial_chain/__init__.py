@@ -17,6 +17,7 @@ subclasses of ``ArcError`` (a ``ValueError``), with a message naming the file, f
 or argument and the value.
 """
 
+from . import _native
 from ._native import (
     DEFAULT_CLEARANCE,
     SCENARIOS,
@@ -34,19 +35,7 @@ from ._native import (
     verify,
 )
 
-__all__ = [
-    "DEFAULT_CLEARANCE",
-    "SCENARIOS",
-    "ArcError",
-    "Flight",
-    "Map",
-    "MapError",
-    "Plan",
-    "PlanError",
-    "SimError",
-    "VerifyError",
-    "VerifyReport",
-    "plan",
-    "simulate",
-    "verify",
-]
+# The compiled module lists its names; the stub (_native.pyi) lists the same ones, and
+# type checkers follow this form of re-export.
+__all__: list = []
+__all__ += _native.__all__

@@ -84,10 +84,10 @@ impl Axis {
         if self.log {
             return decades(self.min, self.max);
         }
-        let wanted = (pixels / 70.0).clamp(2.0, 10.0);
+        let wanted = (pixels / TICK_SPACING).clamp(MIN_TICKS as f64, 10.0);
         let step = nice_step((self.max - self.min) / wanted);
-        let step = if self.whole { step.max(1.0) } else { step };
-        labelled(self.min, self.max, step)
+        let floor = if self.whole { 1.0 } else { 0.0 };
+        at_least(self.min, self.max, step.max(floor), floor)
     }
 
     /// Unlabelled ticks between the labelled ones: 2..9 times each power of ten on a
@@ -115,6 +115,41 @@ pub fn finite_range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
             (a.min(v), b.max(v))
         });
     lo.is_finite().then_some((lo, hi))
+}
+
+/// Pixels wanted between labelled ticks.
+pub(crate) const TICK_SPACING: f64 = 70.0;
+
+/// Fewest labelled ticks on a linear axis, however short or long its range, unless
+/// whole-number ticks cannot give that many.
+pub(crate) const MIN_TICKS: usize = 4;
+
+/// Ticks at multiples of `step` within `lo..=hi`, the step made finer (1, 2, 5 times
+/// a power of ten, and never below `floor`) until there are [`MIN_TICKS`]: a short axis
+/// beside a long one on a map still reads.
+pub(crate) fn at_least(lo: f64, hi: f64, step: f64, floor: f64) -> Ticks {
+    let mut step = step;
+    loop {
+        let finer = finer_step(step);
+        let count = ((hi / step).floor() - (lo / step).ceil() + 1.0).max(0.0) as usize;
+        if count >= MIN_TICKS || finer < floor || finer < (hi - lo).abs() * 1e-6 {
+            return labelled(lo, hi, step);
+        }
+        step = finer;
+    }
+}
+
+/// The next nice step below `step` (itself 1, 2 or 5 times a power of ten).
+fn finer_step(step: f64) -> f64 {
+    let p = 10f64.powf(step.log10().floor());
+    let m = (step / p).round();
+    if m >= 5.0 {
+        2.0 * p
+    } else if m >= 2.0 {
+        p
+    } else {
+        0.5 * p
+    }
 }
 
 /// 1, 2 or 5 times a power of ten, at least `raw`.
@@ -187,7 +222,26 @@ mod tests {
         assert_eq!(labels, ["3", "4", "5"]);
         let b = Axis::linear("m", (-0.13, 0.42));
         let labels: Vec<String> = b.ticks(300.0).into_iter().map(|t| t.1).collect();
-        assert_eq!(labels, ["0.0", "0.2", "0.4"]);
+        assert_eq!(labels, ["-0.1", "0.0", "0.1", "0.2", "0.3", "0.4"]);
+    }
+
+    #[test]
+    fn every_linear_axis_gets_enough_ticks() {
+        // Short axes beside long ones (a corridor's y and z), long and tiny ranges.
+        for (lo, hi, px) in [
+            (0.0, 100.0, 1000.0),
+            (-0.7, 2.3, 60.0),
+            (3.1, 3.4, 400.0),
+            (-2500.0, 12.0, 90.0),
+            (0.0, 1e-3, 200.0),
+        ] {
+            let t = Axis::linear("m", (lo, hi)).ticks(px);
+            assert!(t.len() >= MIN_TICKS, "{lo}..{hi}: {t:?}");
+            assert!(t.len() <= 40, "{lo}..{hi}: {} ticks", t.len());
+            let labels: std::collections::HashSet<&String> = t.iter().map(|x| &x.1).collect();
+            assert_eq!(labels.len(), t.len(), "{lo}..{hi}: labels repeat: {t:?}");
+        }
+        assert_eq!(at_least(0.0, 10.0, 10.0, 0.0).len(), 6, "10 -> 5 -> 2");
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! there is one. Drawn with the project's [`crate::picture`] module (SVG, or PNG
 //! rasterised from it).
 
-use crate::picture::{palette, Figure, Panel};
+use crate::picture::{palette, Figure, Mark, Panel};
 
 use crate::map::grid::{Cell, Grid};
 use crate::problem::scenarios::Scenario;
@@ -201,8 +201,8 @@ pub fn map_figure(grid: &Grid, scenario: Option<&Scenario>, opts: &MapPictureOpt
     fig.legend(palette::UNKNOWN, "unknown");
     if scenario.is_some() {
         fig.legend(palette::START, "start chain");
-        fig.legend(palette::GOAL, "goal");
-        fig.legend(palette::PATH, "a route");
+        fig.legend_mark(Mark::Dot, palette::GOAL, "goal");
+        fig.legend_mark(Mark::Dashed, palette::PATH, "a route");
     }
     fig
 }

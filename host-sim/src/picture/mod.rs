@@ -13,15 +13,17 @@ use std::path::{Path, PathBuf};
 use svg::node::element::Rectangle;
 use svg::Document;
 
+mod animation;
 pub(crate) mod axis;
 mod map;
 pub(crate) mod panel;
 pub(crate) mod style;
 
+pub use animation::Animation;
 pub use axis::{finite_range, Axis};
 pub use map::{map_figure, MapPictureOptions};
 pub use panel::Panel;
-pub use style::{palette, stroke, Colour};
+pub use style::{palette, ramp, stroke, Colour, Mark};
 
 use panel::{swatch, LEGEND_ROW};
 use style::{size, text};
@@ -44,6 +46,12 @@ pub enum DrawError {
     /// The PNG encoder failed.
     #[error("picture: {0}")]
     Png(String),
+    /// The GIF encoder failed.
+    #[error("animation: {0}")]
+    Gif(String),
+    /// The picture is larger than a GIF can hold (65535 pixels a side).
+    #[error("animation: {0} x {1} pixels is larger than a GIF can hold")]
+    TooLarge(u32, u32),
     /// The file could not be written.
     #[error("{}: {source}", path.display())]
     Write {
@@ -60,7 +68,9 @@ pub struct Figure {
     height: f64,
     title: String,
     panels: Vec<svg::node::element::Group>,
-    legend: Vec<(Colour, String)>,
+    legend: Vec<(Mark, String, String)>,
+    /// Only the panels' data, on a transparent ground: a layer over a full figure.
+    overlay: bool,
 }
 
 impl Figure {
@@ -72,13 +82,35 @@ impl Figure {
             title: title.to_string(),
             panels: Vec::new(),
             legend: Vec::new(),
+            overlay: false,
         }
+    }
+
+    /// An empty layer of `width` x `height` pixels to draw over a figure of that size
+    /// whose panels it repeats: only the data drawn in its panels shows, on a
+    /// transparent ground (no title, frames, ticks or legend).
+    pub fn overlay(width: f64, height: f64) -> Self {
+        Self {
+            overlay: true,
+            ..Self::new(width, height, "")
+        }
+    }
+
+    /// Width and height in pixels, extra legend rows counted.
+    pub fn size(&self) -> (f64, f64) {
+        let extra_rows = self.legend_layout().last().map_or(0, |l| l.1);
+        (self.width, self.height + LEGEND_ROW * extra_rows as f64)
     }
 
     /// Adds a finished panel.
     pub fn add(&mut self, mut panel: Panel) {
         panel.id = self.panels.len();
-        self.panels.push(panel.finish());
+        let group = if self.overlay {
+            panel.finish_overlay()
+        } else {
+            panel.finish()
+        };
+        self.panels.push(group);
     }
 
     /// Pixel rectangles `(x, y, w, h)` of a `rows` x `cols` grid of panels (row by
@@ -98,9 +130,21 @@ impl Figure {
             .collect()
     }
 
-    /// Adds a legend entry.
+    /// Adds a line of text whose right end is at pixel `(x, y)`, over the panels.
+    pub fn note(&mut self, x: f64, y: f64, s: &str) {
+        let t = text(x, y, s, size::PANEL_TITLE, palette::INK, "end");
+        self.panels.push(svg::node::element::Group::new().add(t));
+    }
+
+    /// Adds a legend entry marked with a filled square.
     pub fn legend(&mut self, colour: Colour, label: &str) {
-        self.legend.push((colour, label.to_string()));
+        self.legend_mark(Mark::Fill, colour, label);
+    }
+
+    /// Adds a legend entry marked as its data is drawn (a line, a ring, the ramp).
+    pub fn legend_mark(&mut self, mark: Mark, colour: &str, label: &str) {
+        self.legend
+            .push((mark, colour.to_string(), label.to_string()));
     }
 
     /// Where each legend entry goes: `(x, row)`, wrapping onto a new row where an
@@ -108,8 +152,8 @@ impl Figure {
     fn legend_layout(&self) -> Vec<(f64, usize)> {
         let (mut x, mut row) = (10.0, 0);
         let mut out = Vec::with_capacity(self.legend.len());
-        for (_, label) in &self.legend {
-            let w = 24.0 + style::text_width(label, size::LABEL);
+        for (mark, _, label) in &self.legend {
+            let w = mark.width() + 12.0 + style::text_width(label, size::LABEL);
             if x > 10.0 && x + w > self.width - 10.0 {
                 (x, row) = (10.0, row + 1);
             }
@@ -122,18 +166,23 @@ impl Figure {
     /// The SVG document. Extra legend rows add to the figure's height.
     pub fn to_svg(&self) -> String {
         let layout = self.legend_layout();
-        let extra_rows = layout.last().map_or(0, |l| l.1);
-        let height = self.height + LEGEND_ROW * extra_rows as f64;
+        let (_, height) = self.size();
         let mut doc = Document::new()
             .set("viewBox", (0.0, 0.0, self.width, height))
             .set("width", self.width)
-            .set("height", height)
-            .add(
-                Rectangle::new()
-                    .set("width", "100%")
-                    .set("height", "100%")
-                    .set("fill", palette::PAPER),
-            );
+            .set("height", height);
+        if self.overlay {
+            for g in &self.panels {
+                doc = doc.add(g.clone());
+            }
+            return doc.to_string();
+        }
+        doc = doc.add(
+            Rectangle::new()
+                .set("width", "100%")
+                .set("height", "100%")
+                .set("fill", palette::PAPER),
+        );
         if !self.title.is_empty() {
             doc = doc.add(
                 text(
@@ -150,9 +199,9 @@ impl Figure {
         for g in &self.panels {
             doc = doc.add(g.clone());
         }
-        for ((c, label), &(x, row)) in self.legend.iter().zip(&layout) {
+        for ((mark, c, label), &(x, row)) in self.legend.iter().zip(&layout) {
             let y = self.height + LEGEND_ROW * row as f64;
-            doc = doc.add(swatch(x, y, c, label));
+            doc = doc.add(swatch(x, y, mark, c, label));
         }
         doc.to_string()
     }
@@ -209,16 +258,30 @@ pub fn save_svg(svg: &str, path: &Path) -> Result<(), DrawError> {
 
 /// SVG text to PNG bytes.
 pub fn rasterise(svg: &str) -> Result<Vec<u8>, DrawError> {
+    render(svg, None)?
+        .encode_png()
+        .map_err(|e| DrawError::Png(e.to_string()))
+}
+
+/// SVG text drawn into pixels: onto a copy of `base` when given (its size kept), else
+/// onto a transparent pixmap of the SVG's size.
+pub(crate) fn render(
+    svg: &str,
+    base: Option<&resvg::tiny_skia::Pixmap>,
+) -> Result<resvg::tiny_skia::Pixmap, DrawError> {
     use resvg::{tiny_skia, usvg};
     let mut opt = usvg::Options::default();
     opt.fontdb_mut().load_system_fonts();
     let tree = usvg::Tree::from_str(svg, &opt)?;
-    let size = tree.size().to_int_size();
-    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height()).ok_or(DrawError::Empty)?;
+    let mut pixmap = match base {
+        Some(b) => b.clone(),
+        None => {
+            let size = tree.size().to_int_size();
+            tiny_skia::Pixmap::new(size.width(), size.height()).ok_or(DrawError::Empty)?
+        }
+    };
     resvg::render(&tree, tiny_skia::Transform::default(), &mut pixmap.as_mut());
-    pixmap
-        .encode_png()
-        .map_err(|e| DrawError::Png(e.to_string()))
+    Ok(pixmap)
 }
 
 #[cfg(test)]

@@ -7,11 +7,11 @@
 //! draws light grid lines to read values off.
 
 use svg::node::element::{
-    Circle, ClipPath, Definitions, Group, Line, Polygon, Polyline, Rectangle,
+    Circle, ClipPath, Definitions, Group, Line, LinearGradient, Polygon, Polyline, Rectangle, Stop,
 };
 
 use super::axis::{Axis, Ticks};
-use super::style::{palette, size, stroke, text, text_width, Colour};
+use super::style::{palette, size, stroke, text, text_width, Colour, Mark, RAMP_STOPS};
 
 /// Room around the plot area for the title, tick labels and axis names (px).
 #[derive(Clone, Copy, Debug)]
@@ -54,7 +54,7 @@ pub struct Panel {
     equal: bool,
     title: String,
     body: Group,
-    keys: Vec<(Colour, String)>,
+    keys: Vec<(Mark, String, String)>,
     /// Pixel positions of the data drawn, to keep the legend off it.
     inked: Vec<(f64, f64)>,
 }
@@ -138,11 +138,17 @@ impl Panel {
     /// Adds an entry to the panel's legend, drawn in the corner of the plot area
     /// where it hides the least data.
     pub fn key(&mut self, colour: Colour, label: &str) {
-        self.keys.push((colour, label.to_string()));
+        self.key_mark(Mark::Fill, colour, label);
+    }
+
+    /// Adds a legend entry marked as its data is drawn (a line, a ring, a dot).
+    pub fn key_mark(&mut self, mark: Mark, colour: &str, label: &str) {
+        self.keys
+            .push((mark, colour.to_string(), label.to_string()));
     }
 
     /// A filled axis-aligned rectangle in data coordinates.
-    pub fn rect(&mut self, min: (f64, f64), max: (f64, f64), fill: Colour, opacity: f64) {
+    pub fn rect(&mut self, min: (f64, f64), max: (f64, f64), fill: &str, opacity: f64) {
         let (x0, y1) = self.map(min.0, min.1);
         let (x1, y0) = self.map(max.0, max.1);
         self.add(
@@ -158,22 +164,28 @@ impl Panel {
     }
 
     /// A circle of data radius `r` (in units of the x axis).
-    pub fn circle(&mut self, c: (f64, f64), r: f64, fill: Colour, stroke: Colour, opacity: f64) {
+    pub fn circle(&mut self, c: (f64, f64), r: f64, fill: &str, stroke: &str, opacity: f64) {
+        self.disc(c, r, (fill, opacity), (stroke, stroke::HAIR));
+    }
+
+    /// A circle of data radius `r` with its fill (colour, opacity) and its rim
+    /// (colour, width in pixels).
+    fn disc(&mut self, c: (f64, f64), r: f64, fill: (&str, f64), rim: (&str, f64)) {
         let (x, y) = self.map(c.0, c.1);
         self.add(
             Circle::new()
                 .set("cx", x)
                 .set("cy", y)
                 .set("r", (r * self.scale.0).max(1.0))
-                .set("fill", fill)
-                .set("fill-opacity", opacity)
-                .set("stroke", stroke)
-                .set("stroke-width", stroke::HAIR),
+                .set("fill", fill.0)
+                .set("fill-opacity", fill.1)
+                .set("stroke", rim.0)
+                .set("stroke-width", rim.1),
         );
     }
 
     /// A filled dot of `radius` pixels: a data point's marker.
-    pub fn marker(&mut self, c: (f64, f64), radius: f64, colour: Colour) {
+    pub fn marker(&mut self, c: (f64, f64), radius: f64, colour: &str) {
         let (x, y) = self.map(c.0, c.1);
         self.ink((x, y));
         self.add(
@@ -186,7 +198,7 @@ impl Panel {
     }
 
     /// A straight segment, `width` in pixels.
-    pub fn line(&mut self, a: (f64, f64), b: (f64, f64), colour: Colour, width: f64) {
+    pub fn line(&mut self, a: (f64, f64), b: (f64, f64), colour: &str, width: f64) {
         let (x1, y1) = self.map(a.0, a.1);
         let (x2, y2) = self.map(b.0, b.1);
         self.ink((x1, y1));
@@ -204,7 +216,7 @@ impl Panel {
     }
 
     /// A polyline through data points, `width` in pixels; `dashed` for references.
-    pub fn polyline(&mut self, pts: &[(f64, f64)], colour: Colour, width: f64, dashed: bool) {
+    pub fn polyline(&mut self, pts: &[(f64, f64)], colour: &str, width: f64, dashed: bool) {
         let mapped: Vec<(f64, f64)> = pts.iter().map(|&(x, y)| self.map(x, y)).collect();
         let points: Vec<String> = mapped
             .iter()
@@ -224,7 +236,7 @@ impl Panel {
     }
 
     /// An arrow from `a` of data length `len` at angle `dir` (rad, from +x).
-    pub fn arrow(&mut self, a: (f64, f64), dir: f64, len: f64, colour: Colour) {
+    pub fn arrow(&mut self, a: (f64, f64), dir: f64, len: f64, colour: &str) {
         let b = (a.0 + len * dir.cos(), a.1 + len * dir.sin());
         self.line(a, b, colour, 1.5);
         let head = 0.35 * len;
@@ -249,20 +261,47 @@ impl Panel {
     }
 
     /// A chain seen along one axis: its units (projected centres `body`, head first)
-    /// as circles of data radius `r` in `colour` joined by its links; the head has
-    /// a dark rim so the chain's direction shows.
-    pub fn chain(&mut self, body: &[(f64, f64)], r: f64, colour: Colour) {
+    /// as circles of data radius `r` filled with `fill` and rimmed with `rim`, joined
+    /// by its links; the head's rim is dark so the chain's direction shows.
+    pub fn chain(&mut self, body: &[(f64, f64)], r: f64, fill: &str, rim: &str) {
         for w in body.windows(2) {
             self.line(w[0], w[1], palette::INK, stroke::THIN);
         }
         for (i, &q) in body.iter().enumerate() {
-            let rim = if i == 0 { palette::INK } else { colour };
-            self.circle(q, r, colour, rim, 0.45);
+            let edge = if i == 0 {
+                (palette::INK, 1.6)
+            } else {
+                (rim, 1.4)
+            };
+            self.disc(q, r, (fill, 0.6), edge);
         }
     }
 
+    /// A circle of data radius `r` drawn as its rim only: a region.
+    pub fn ring(&mut self, c: (f64, f64), r: f64, colour: &str, dashed: bool) {
+        let (x, y) = self.map(c.0, c.1);
+        let mut ring = Circle::new()
+            .set("cx", x)
+            .set("cy", y)
+            .set("r", (r * self.scale.0).max(2.0))
+            .set("fill", "none")
+            .set("stroke", colour)
+            .set("stroke-width", 1.8);
+        if dashed {
+            ring = ring.set("stroke-dasharray", "5 3");
+        }
+        self.add(ring);
+    }
+
+    /// A square marker of half side `half` pixels centred at a data point.
+    pub fn square(&mut self, c: (f64, f64), half: f64, colour: &str) {
+        let (x, y) = self.map(c.0, c.1);
+        self.ink((x, y));
+        self.add(square(x, y, half, colour));
+    }
+
     /// Text at a data point, `size` in pixels.
-    pub fn text(&mut self, at: (f64, f64), s: &str, size: f64, colour: Colour) {
+    pub fn text(&mut self, at: (f64, f64), s: &str, size: f64, colour: &str) {
         let (x, y) = self.map(at.0, at.1);
         self.add(text(x, y, s, size, colour, "middle"));
     }
@@ -310,6 +349,26 @@ impl Panel {
         g
     }
 
+    /// The panel's drawn data only, clipped to its plot area: a layer over the full
+    /// panel drawn once (the frames of an animation).
+    pub(crate) fn finish_overlay(self) -> Group {
+        let (ix, iy, iw, ih) = self.inner();
+        let clip_id = format!("overlay{}", self.id);
+        Group::new()
+            .add(
+                Definitions::new().add(
+                    ClipPath::new().set("id", clip_id.clone()).add(
+                        Rectangle::new()
+                            .set("x", ix)
+                            .set("y", iy)
+                            .set("width", iw)
+                            .set("height", ih),
+                    ),
+                ),
+            )
+            .add(self.body.set("clip-path", format!("url(#{clip_id})")))
+    }
+
     /// Title above the plot area, axis names below and to the left of it.
     fn names(&self) -> Group {
         let (x, y, _, h) = self.px;
@@ -341,11 +400,13 @@ impl Panel {
     /// Labelled ticks on both axes: a map panel uses one step for both.
     fn tick_lists(&self) -> (Ticks, Ticks) {
         if self.equal {
-            let extent = (self.x.max - self.x.min).max(self.y.max - self.y.min);
-            let step = super::axis::nice_step(extent / 6.0);
+            // One step on both axes where it gives each enough ticks; a short axis
+            // (a corridor's width) gets a finer one of its own.
+            use super::axis::{at_least, nice_step, TICK_SPACING};
+            let step = nice_step(TICK_SPACING / self.scale.0);
             (
-                super::axis::labelled(self.x.min, self.x.max, step),
-                super::axis::labelled(self.y.min, self.y.max, step),
+                at_least(self.x.min, self.x.max, step, 0.0),
+                at_least(self.y.min, self.y.max, step, 0.0),
             )
         } else {
             let (_, _, iw, ih) = self.inner();
@@ -415,9 +476,9 @@ impl Panel {
         let widest = self
             .keys
             .iter()
-            .map(|(_, l)| text_width(l, size::LABEL))
+            .map(|(m, _, l)| m.width() + 10.0 + text_width(l, size::LABEL))
             .fold(0.0, f64::max);
-        let column_w = 24.0 + widest;
+        let column_w = widest;
         let (w, h) = (
             8.0 + column_w * columns as f64,
             6.0 + LEGEND_ROW * rows as f64,
@@ -451,39 +512,131 @@ impl Panel {
                 .set("stroke", palette::INK)
                 .set("stroke-width", 0.6),
         );
-        for (k, (colour, label)) in self.keys.iter().enumerate() {
+        for (k, (mark, colour, label)) in self.keys.iter().enumerate() {
             let x = bx + 6.0 + column_w * (k / per_column) as f64;
             let y = by + 3.0 + LEGEND_ROW * (k % per_column + 1) as f64;
-            g = g.add(swatch(x, y, colour, label));
+            g = g.add(swatch(x, y, mark, colour, label));
         }
         g
     }
 }
 
-/// One legend entry whose baseline row ends at pixel `y`: a square of `colour` and
+/// One legend entry whose baseline row ends at pixel `y`: its mark in `colour` and
 /// its label; the figure's legend and the panels' look the same.
-pub(crate) fn swatch(x: f64, y: f64, colour: Colour, label: &str) -> Group {
-    Group::new()
-        .add(
+pub(crate) fn swatch(x: f64, y: f64, mark: &Mark, colour: &str, label: &str) -> Group {
+    let cy = y - 9.0;
+    let ring = |dashed: bool| {
+        let c = Circle::new()
+            .set("cx", x + 5.0)
+            .set("cy", cy)
+            .set("r", 4.5)
+            .set("fill", "none")
+            .set("stroke", colour)
+            .set("stroke-width", 1.8);
+        if dashed {
+            c.set("stroke-dasharray", "2.5 1.5")
+        } else {
+            c
+        }
+    };
+    let line = |dashed: bool| {
+        let l = hairline((x, cy), (x + 18.0, cy), colour).set("stroke-width", stroke::DATA);
+        if dashed {
+            l.set("stroke-dasharray", "6 4")
+        } else {
+            l
+        }
+    };
+    let g = Group::new();
+    let g = match mark {
+        Mark::Fill => g.add(
             Rectangle::new()
                 .set("x", x)
                 .set("y", y - 14.0)
                 .set("width", 10)
                 .set("height", 10)
                 .set("fill", colour),
+        ),
+        Mark::Square => g.add(square(x + 5.0, cy, 4.0, colour)),
+        Mark::Line => g.add(line(false)),
+        Mark::Dashed => g.add(line(true)),
+        Mark::Ring => g.add(ring(false)),
+        Mark::DashedRing => g.add(ring(true)),
+        Mark::Dot => g.add(
+            Circle::new()
+                .set("cx", x + 5.0)
+                .set("cy", cy)
+                .set("r", 4.0)
+                .set("fill", colour),
+        ),
+        Mark::Ramp { from, to } => ramp_bar(g, x, y, *from, *to),
+    };
+    g.add(text(
+        x + mark.width(),
+        y - 5.0,
+        label,
+        size::LABEL,
+        palette::INK,
+        "start",
+    ))
+}
+
+/// The colour ramp as a bar with its two end values: the legend entry of colours
+/// that stand for time.
+fn ramp_bar(g: Group, x: f64, y: f64, from: f64, to: f64) -> Group {
+    let n = RAMP_STOPS.len() - 1;
+    let mut gradient = LinearGradient::new().set("id", "ramp");
+    for k in 0..=n {
+        let f = k as f64 / n as f64;
+        gradient = gradient.add(
+            Stop::new()
+                .set("offset", f)
+                .set("stop-color", super::style::ramp(f)),
+        );
+    }
+    let decimals = if (to - from).abs() >= 10.0 { 0 } else { 1 };
+    let (bx, bw) = (x + 26.0, 80.0);
+    g.add(Definitions::new().add(gradient))
+        .add(text(
+            bx - 3.0,
+            y - 5.0,
+            &format!("{from:.decimals$}"),
+            size::TICK,
+            palette::INK,
+            "end",
+        ))
+        .add(
+            Rectangle::new()
+                .set("x", bx)
+                .set("y", y - 14.0)
+                .set("width", bw)
+                .set("height", 10)
+                .set("fill", "url(#ramp)"),
         )
         .add(text(
-            x + 14.0,
+            bx + bw + 3.0,
             y - 5.0,
-            label,
-            size::LABEL,
+            &format!("{to:.decimals$}"),
+            size::TICK,
             palette::INK,
             "start",
         ))
 }
 
+/// A filled square of half side `h` pixels centred at pixel `(x, y)`.
+fn square(x: f64, y: f64, h: f64, colour: &str) -> Rectangle {
+    Rectangle::new()
+        .set("x", x - h)
+        .set("y", y - h)
+        .set("width", 2.0 * h)
+        .set("height", 2.0 * h)
+        .set("fill", colour)
+        .set("stroke", palette::INK)
+        .set("stroke-width", 0.8)
+}
+
 /// A hairline between pixel positions `a` and `b`: ticks and grid lines.
-fn hairline(a: (f64, f64), b: (f64, f64), colour: Colour) -> Line {
+fn hairline(a: (f64, f64), b: (f64, f64), colour: &str) -> Line {
     Line::new()
         .set("x1", a.0)
         .set("y1", a.1)

@@ -48,6 +48,73 @@ pub mod palette {
     }
 }
 
+/// Stops of the colour ramp for time (or any order): viridis, its light yellow end
+/// left out so that the last colour still shows on white.
+pub const RAMP_STOPS: [(u8, u8, u8); 5] = [
+    (0x44, 0x01, 0x54),
+    (0x3b, 0x52, 0x8b),
+    (0x21, 0x91, 0x8c),
+    (0x5e, 0xc9, 0x62),
+    (0xb5, 0xde, 0x2b),
+];
+
+/// The ramp's colour at `f` in `0..=1` (clamped), as `#rrggbb`.
+pub fn ramp(f: f64) -> String {
+    let f = if f.is_finite() {
+        f.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = f * (RAMP_STOPS.len() - 1) as f64;
+    let k = (x.floor() as usize).min(RAMP_STOPS.len() - 2);
+    let w = x - k as f64;
+    let (a, b) = (RAMP_STOPS[k], RAMP_STOPS[k + 1]);
+    let mix = |p: u8, q: u8| (p as f64 + (q as f64 - p as f64) * w).round() as u8;
+    format!(
+        "#{:02x}{:02x}{:02x}",
+        mix(a.0, b.0),
+        mix(a.1, b.1),
+        mix(a.2, b.2)
+    )
+}
+
+/// How a legend entry is marked: as the thing it stands for is drawn.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Mark {
+    /// A filled square: an area (obstacles) or a fill colour.
+    Fill,
+    /// A line: a path or a curve.
+    Line,
+    /// A dashed line: a reference.
+    Dashed,
+    /// A circle's rim: what a rim colour means.
+    Ring,
+    /// A dashed circle: a region (the goal's).
+    DashedRing,
+    /// A dot: a point marker.
+    Dot,
+    /// A small square: the start marker.
+    Square,
+    /// The colour ramp from `from` to `to` (with its unit in the label).
+    Ramp {
+        /// The value at the ramp's first colour.
+        from: f64,
+        /// The value at its last colour.
+        to: f64,
+    },
+}
+
+impl Mark {
+    /// Width (px) the mark takes before its label.
+    pub(crate) fn width(&self) -> f64 {
+        match self {
+            Mark::Ramp { .. } => 150.0,
+            Mark::Line | Mark::Dashed => 24.0,
+            _ => 14.0,
+        }
+    }
+}
+
 /// Font families of every label (resvg finds DejaVu on the machines we use).
 pub const FONT: &str = "DejaVu Sans, Arial, sans-serif";
 
@@ -75,7 +142,7 @@ pub mod stroke {
 
 /// A text element at pixel `(x, y)` in the project's font; `anchor` is the SVG
 /// `text-anchor` (`start`, `middle`, `end`).
-pub fn text(x: f64, y: f64, s: &str, size: f64, colour: Colour, anchor: &str) -> Text {
+pub fn text(x: f64, y: f64, s: &str, size: f64, colour: &str, anchor: &str) -> Text {
     Text::new(s)
         .set("x", x)
         .set("y", y)
@@ -88,4 +155,19 @@ pub fn text(x: f64, y: f64, s: &str, size: f64, colour: Colour, anchor: &str) ->
 /// Width (px) a label of `s` takes at `size`, roughly: for laying out legends.
 pub fn text_width(s: &str, size: f64) -> f64 {
     0.59 * size * s.chars().count() as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_ramp_runs_through_its_stops() {
+        assert_eq!(ramp(0.0), "#440154");
+        assert_eq!(ramp(1.0), "#b5de2b");
+        assert_eq!(ramp(0.5), "#21918c");
+        assert_eq!(ramp(-3.0), ramp(0.0));
+        assert_eq!(ramp(f64::NAN), ramp(0.0));
+        assert_ne!(ramp(0.3), ramp(0.31));
+    }
 }

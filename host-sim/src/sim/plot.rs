@@ -2,15 +2,15 @@
 //! head position against its reference over time, link pitch and yaw against
 //! their references, and the flown chain seen from above over the map's obstacles.
 
-use crate::picture::{palette, stroke, Axis, Figure, Panel};
+use crate::picture::{palette, ramp, stroke, Axis, Figure, Mark, Panel};
 
 use super::flight::{Flight, Sample};
 
 /// At most this many points per time series (the flight is decimated evenly).
 const MAX_POINTS: usize = 1500;
 
-/// How many snapshots of the chain the top view shows, besides the last.
-const SNAPSHOTS: usize = 12;
+/// Snapshots of the chain the top view may show (those that overlap none drawn).
+const CANDIDATES: usize = 60;
 
 /// Size of the flight picture (px).
 const WIDTH: f64 = 1200.0;
@@ -69,7 +69,7 @@ fn head_panel(cell: (f64, f64, f64, f64), samples: &[&Sample]) -> Panel {
             .map(|s| (s.t, s.units[0].p[i] as f64))
             .collect();
         p.polyline(&flown, AXIS_COLOURS[i], stroke::DATA, false);
-        p.key(AXIS_COLOURS[i], name);
+        p.key_mark(Mark::Line, AXIS_COLOURS[i], name);
     }
     // The reference goes over the flown curves: it stays visible where they agree.
     for i in 0..3 {
@@ -79,7 +79,7 @@ fn head_panel(cell: (f64, f64, f64, f64), samples: &[&Sample]) -> Panel {
             .collect();
         p.polyline(&reference, palette::INK, stroke::HAIR, true);
     }
-    p.key(palette::INK, "reference");
+    p.key_mark(Mark::Dashed, palette::INK, "reference");
     p
 }
 
@@ -115,7 +115,7 @@ fn link_panel(
     for k in 0..n_links {
         let colour = palette::series(k);
         p.polyline(&series(k, |s| &s.links_meas), colour, stroke::DATA, false);
-        p.key(colour, &format!("link {}", k + 1));
+        p.key_mark(Mark::Line, colour, &format!("link {}", k + 1));
     }
     for k in 0..n_links {
         p.polyline(
@@ -125,7 +125,7 @@ fn link_panel(
             true,
         );
     }
-    p.key(palette::INK, "reference");
+    p.key_mark(Mark::Dashed, palette::INK, "reference");
     p
 }
 
@@ -172,38 +172,41 @@ fn top_view(
     }
     let head: Vec<(f64, f64)> = samples.iter().map(|s| at(s, 0)).collect();
     p.polyline(&head, palette::PATH, stroke::DATA, false);
-    let every = (flight.samples.len() / SNAPSHOTS).max(1);
-    let snapshots: Vec<&Sample> = flight
-        .samples
-        .iter()
-        .step_by(every)
-        .chain(flight.samples.last())
-        .collect();
-    // The chain on the way as a thin line with small dots, so a dozen snapshots
-    // of a long chain stay readable; at the start and the end, units at full size.
-    let last = snapshots.len().saturating_sub(1);
-    for (k, s) in snapshots.iter().enumerate() {
-        let body: Vec<(f64, f64)> = (0..s.units.len()).map(|i| at(s, i)).collect();
-        if k == 0 || k == last {
-            let colour = if k == 0 {
-                palette::START
-            } else {
-                palette::GOAL
-            };
-            p.chain(&body, ru, colour);
-        } else {
-            p.polyline(&body, palette::FOLLOW, stroke::THIN, false);
-            for (i, &q) in body.iter().enumerate() {
-                p.marker(q, if i == 0 { 3.5 } else { 2.5 }, palette::FOLLOW);
-            }
+    // Snapshots as in the plan pictures: coloured by time, taken where they overlap
+    // no snapshot already drawn (the start and the end first).
+    let every = (flight.samples.len() / CANDIDATES).max(1);
+    let mut picks: Vec<&Sample> = flight.samples.iter().step_by(every).collect();
+    if let Some(last) = flight.samples.last() {
+        if !std::ptr::eq(*picks.last().unwrap_or(&last), last) {
+            picks.push(last);
         }
     }
-    p.key(palette::PATH, "head, flown");
-    p.key(TRAIL, "other units, flown");
-    p.key(palette::INK, "head reference");
-    p.key(palette::START, "chain at start");
-    p.key(palette::FOLLOW, "on the way");
-    p.key(palette::GOAL, "at the end");
+    let bodies: Vec<Vec<(f64, f64)>> = picks
+        .iter()
+        .map(|s| (0..s.units.len()).map(|i| at(s, i)).collect())
+        .collect();
+    let n = picks.len();
+    let order: Vec<usize> = [0, n.saturating_sub(1)]
+        .into_iter()
+        .chain(1..n.saturating_sub(1))
+        .filter(|&i| i < n)
+        .collect();
+    let t_end = picks.last().map_or(1.0, |s| s.t).max(1e-9);
+    for i in crate::plan_picture::thinned(&bodies, &order, 2.0 * ru) {
+        let fill = ramp(picks[i].t / t_end);
+        p.chain(&bodies[i], ru, &fill, &fill);
+    }
+    p.key_mark(Mark::Line, palette::PATH, "head, flown");
+    p.key_mark(Mark::Line, TRAIL, "other units, flown");
+    p.key_mark(Mark::Dashed, palette::INK, "head reference");
+    p.key_mark(
+        Mark::Ramp {
+            from: 0.0,
+            to: t_end,
+        },
+        palette::INK,
+        "chain at time (s)",
+    );
     p.key(palette::OBSTACLE, "obstacle");
     p
 }

@@ -2,7 +2,7 @@
 //! held to (docs/promises.md lists them). Each check runs before any work, and its
 //! error is one line naming the flag, the value and the limit.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
 use super::CliError;
@@ -116,11 +116,6 @@ pub fn picture(flag: &str, path: &Path) -> Result<PictureFormat, CliError> {
             &format!("a picture ending in {}", PictureFormat::extensions()),
         )
     })
-}
-
-/// [`picture`] for an optional flag.
-pub fn optional_picture(flag: &str, path: Option<&PathBuf>) -> Result<(), CliError> {
-    path.map_or(Ok(()), |p| picture(flag, p).map(|_| ()))
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@ mod common;
 #[path = "../../fsutil.rs"]
 mod fsutil;
 mod map;
+mod picture;
 mod plan;
 mod sim;
 mod study;

@@ -92,9 +92,14 @@ pub struct PlanArgs {
     /// Output plan (JSON, arc-plan/1); `-` writes it to standard output.
     #[arg(long)]
     out: PathBuf,
-    /// Picture of the plan (.svg or .png).
+    /// Picture of the plan (.svg or .png), or an animation of its timed trajectory
+    /// (.gif, one frame per --frame-step).
     #[arg(long)]
     picture: Option<PathBuf>,
+    /// Seconds of the trajectory between an animation's frames [default: 0.1 s or
+    /// more, for at most about 120 frames].
+    #[arg(long, allow_hyphen_values = true)]
+    frame_step: Option<f64>,
     /// Also write the plan's timed trajectory (CSV when the name ends in .csv, else
     /// JSON, arc-trajectory/1), checked exactly on the map.
     #[arg(long)]
@@ -164,7 +169,7 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
             "--out - and --trajectory - would both write to standard output: name a file for one",
         ));
     }
-    checks::optional_picture("--picture", a.picture.as_ref())
+    super::picture::check(a.picture.as_ref(), a.frame_step)
 }
 
 /// The tables: read from `--tables` (and checked against the chain) or generated.
@@ -298,8 +303,9 @@ pub fn run(a: PlanArgs) -> CliResult {
             s.lattice_s * 1e3
         ));
     }
+    let grid = planner.context().field().grid();
+    let mut timed = None;
     if let Some(path) = &a.trajectory {
-        let grid = planner.context().field().grid();
         let began = Instant::now();
         let tr = super::trajectory::make(&plan, "the plan", grid, &a.timing.settings()?)?;
         super::trajectory::write(&tr, &plan, path, &report)?;
@@ -307,20 +313,64 @@ pub fn run(a: PlanArgs) -> CliResult {
             "  trajectory made and checked in {:.1} ms",
             began.elapsed().as_secs_f64() * 1e3
         ));
+        timed = Some(tr);
     }
     if let Some(pic) = &a.picture {
-        let grid = planner.context().field().grid();
-        aerial_chain::plan_picture::draw(
-            grid,
-            &plan,
-            &format!("ARCplanner on {}", a.problem.map.name()),
-            Some(query.goal.into()),
-        )
-        .save(pic)
-        .map_err(|e| CliError::input(e.to_string()))?;
-        report.line(format_args!("  picture: {}", pic.display()));
+        let goal = Some((query.goal.into(), query.goal_tol));
+        match draw(&a, pic, grid, &plan, timed, goal)? {
+            Some((frames, step)) => report.line(format_args!(
+                "  animation: {} ({frames} frames, one per {step} s of the trajectory)",
+                pic.display()
+            )),
+            None => report.line(format_args!("  picture: {}", pic.display())),
+        }
     }
     Ok(())
+}
+
+/// Draws the plan's picture, or animates its trajectory (made here unless given) and
+/// says how many frames at what step; a still picture is coloured by the
+/// trajectory's time where there is one.
+fn draw(
+    a: &PlanArgs,
+    pic: &std::path::Path,
+    grid: &aerial_chain::map::Grid,
+    plan: &aerial_chain::plan_file::Plan,
+    timed: Option<aerial_chain::trajectory::Trajectory>,
+    goal: Option<([f64; 3], f64)>,
+) -> Result<Option<(usize, f64)>, CliError> {
+    use aerial_chain::plan_picture::{self as pp, AnimationOptions, Motion, PictureOptions};
+    let title = format!("ARCplanner on {}", a.problem.map.name());
+    if super::picture::is_animation(pic) {
+        let tr = match timed {
+            Some(t) => t,
+            None => super::trajectory::make(plan, "the plan", grid, &a.timing.settings()?)?,
+        };
+        let opts = AnimationOptions {
+            title,
+            goal,
+            step: a.frame_step,
+            planned_label: "head path (plan)".into(),
+        };
+        let made = super::picture::write_animation(pic, grid, &Motion::of_trajectory(&tr), &opts)?;
+        return Ok(Some(made));
+    }
+    // Without an admissible trajectory the picture still comes, its ramp in waypoint order.
+    let tr = timed.or_else(|| {
+        a.timing
+            .settings()
+            .ok()
+            .and_then(|s| aerial_chain::trajectory::build(plan, grid, &s).ok())
+    });
+    let opts = PictureOptions {
+        title,
+        goal,
+        times: tr.map(|t| pp::waypoint_times(plan, &t)),
+    };
+    pp::draw(grid, plan, &opts)
+        .save(pic)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    Ok(None)
 }
 
 /// Prints the plan's quality, and what refinement changed.

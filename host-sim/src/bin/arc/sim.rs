@@ -34,9 +34,14 @@ pub struct SimArgs {
     /// standard output.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Write plots of the flight (.svg or .png).
+    /// Write plots of the flight (.svg or .png), or an animation of it (.gif, one
+    /// frame per --frame-step).
     #[arg(long)]
     picture: Option<PathBuf>,
+    /// Seconds of flight between an animation's frames [default: 0.1 s or more, for
+    /// at most about 120 frames].
+    #[arg(long, allow_hyphen_values = true)]
+    frame_step: Option<f64>,
     /// Physics and control rate (Hz, at least 500).
     #[arg(long, default_value_t = 500.0)]
     rate: f64,
@@ -138,7 +143,7 @@ fn check(a: &SimArgs) -> Result<(), CliError> {
     if a.record_every == 0 {
         return Err(checks::bad("--record-every", 0, "at least 1"));
     }
-    checks::optional_picture("--picture", a.picture.as_ref())
+    super::picture::check(a.picture.as_ref(), a.frame_step)
 }
 
 /// Runs `arc sim`: exit 0 only when the chain reaches the plan's goal without touching
@@ -201,7 +206,27 @@ pub fn run(a: SimArgs) -> CliResult {
             say(format_args!("  wrote {}", path.display()));
         }
     }
-    if let Some(path) = &a.picture {
+    if let Some(path) = a
+        .picture
+        .as_ref()
+        .filter(|p| super::picture::is_animation(p))
+    {
+        let opts = aerial_chain::plan_picture::AnimationOptions {
+            title: format!("arc sim: {plan_name} on {}", a.map.name()),
+            goal: flight
+                .samples
+                .last()
+                .map(|s| (s.head_ref.map(f64::from), a.goal_tol)),
+            step: a.frame_step,
+            planned_label: "head reference".into(),
+        };
+        let motion = aerial_chain::plan_picture::Motion::of_flight(&flight);
+        let (frames, step) = super::picture::write_animation(path, &loaded.grid, &motion, &opts)?;
+        say(format_args!(
+            "  wrote {} ({frames} frames, one per {step} s of flight)",
+            path.display()
+        ));
+    } else if let Some(path) = &a.picture {
         draw_flight(
             path,
             &flight,

@@ -12,7 +12,7 @@ use clap::{Args, Subcommand};
 use super::checks;
 use super::common::ChainArgs;
 use super::{CliError, CliResult};
-use aerial_chain::picture::{palette, Figure, Panel};
+use aerial_chain::picture::{palette, Figure, Mark, Panel};
 use aerial_chain::tables::{ShapeTables, TableSettings};
 
 /// `arc tables ...`
@@ -244,7 +244,7 @@ pub fn run_shapes(a: ShapesArgs) -> CliResult {
     }
     fig.legend(palette::START, "head (unit 1)");
     fig.legend(palette::LSC, "units");
-    fig.legend(palette::SENSOR, "sensor heading");
+    fig.legend_mark(Mark::Line, palette::SENSOR, "sensor heading");
     for (kind, why) in &lib.excluded {
         fig.legend(
             palette::UNKNOWN,

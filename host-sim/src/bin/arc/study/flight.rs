@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use aerial_chain::map::DistanceField;
-use aerial_chain::picture::{palette, stroke, Axis, Figure, Panel};
+use aerial_chain::picture::{palette, stroke, Axis, Figure, Mark, Panel};
 use aerial_chain::planner::{to_plan, ArcPlanner, Planner, Query, Settings, Termination};
 use aerial_chain::problem::scenarios;
 use aerial_chain::sim::{
@@ -299,14 +299,14 @@ pub fn figure(runs: &[FlightRun], speed: f64) -> String {
         stroke::HAIR,
         true,
     );
-    p.key(palette::INK, "path / speed");
+    p.key_mark(Mark::Dashed, palette::INK, "path / speed");
     p.polyline(
         &[(0.0, 0.0), (xmax, 2.0 * xmax)],
         palette::GOAL,
         stroke::DATA,
         true,
     );
-    p.key(palette::GOAL, "target: 2 x path / speed");
+    p.key_mark(Mark::Dashed, palette::GOAL, "target: 2 x path / speed");
     for (pts, colour, label) in [
         (&before, palette::series(1), "stop at every waypoint"),
         (&after, palette::series(0), "blended trajectory"),
@@ -314,7 +314,7 @@ pub fn figure(runs: &[FlightRun], speed: f64) -> String {
         for &q in pts {
             p.marker(q, 3.0, colour);
         }
-        p.key(colour, label);
+        p.key_mark(Mark::Dot, colour, label);
     }
     fig.add(p);
     fig.to_svg()

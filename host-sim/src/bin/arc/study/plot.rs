@@ -1,7 +1,7 @@
 //! Charts of the benchmark studies (time and success against a size), drawn with
 //! the project's [`aerial_chain::picture`] figures so they look like the other pictures.
 
-use aerial_chain::picture::{stroke, Axis, Colour, Figure, Panel};
+use aerial_chain::picture::{stroke, Axis, Colour, Figure, Mark, Panel};
 
 use super::{Spread, Summary};
 
@@ -75,7 +75,7 @@ fn panel(cell: (f64, f64, f64, f64), chart: &Chart) -> Panel {
         for &m in &medians {
             p.marker(m, MARKER, curve.colour);
         }
-        p.key(curve.colour, &curve.label);
+        p.key_mark(Mark::Line, curve.colour, &curve.label);
     }
     p
 }

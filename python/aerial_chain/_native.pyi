@@ -1,0 +1,221 @@
+"""Type stubs of the extension module ``aerial_chain._native`` (PyO3), which the package
+``aerial_chain`` re-exports. Checked against the built module by
+``python/tests/test_stubs.py``: every name here exists there and the other way round,
+with the same parameters."""
+
+from os import PathLike
+from typing import Any, Final, Optional, Sequence, Tuple, Union, final
+
+import numpy as np
+from numpy.typing import NDArray
+
+_Path = Union[str, PathLike[str]]
+_Point = Union[Sequence[float], NDArray[np.float64]]
+
+__all__ = [
+    "ArcError",
+    "DEFAULT_CLEARANCE",
+    "Flight",
+    "Map",
+    "MapError",
+    "Plan",
+    "PlanError",
+    "SCENARIOS",
+    "SimError",
+    "VerifyError",
+    "VerifyReport",
+    "plan",
+    "simulate",
+    "verify",
+]
+
+DEFAULT_CLEARANCE: Final[float]
+"""The clearance margin (m) every plan keeps from the map by default."""
+
+SCENARIOS: Final[list[str]]
+"""Names of the built-in scenarios."""
+
+class ArcError(ValueError):
+    """Base of the errors of aerial_chain: bad input, or an answer that is no."""
+
+class MapError(ArcError):
+    """A map that cannot be loaded: a missing or malformed .bt file, an unknown scenario."""
+
+class PlanError(ArcError):
+    """Planning refused or failed: bad chain or query, no plan found; or a bad plan file."""
+
+class VerifyError(ArcError):
+    """The exact verifier found the plan INVALID on the map (the message says where)."""
+
+class SimError(ArcError):
+    """The simulation cannot fly the plan: settings outside their limits, a plan it cannot time."""
+
+@final
+class Map:
+    """A map to plan, verify and fly on: an occupancy grid (OctoMap ``.bt`` file or
+    built-in scenario) and whether unknown space counts as occupied."""
+
+    @staticmethod
+    def from_file(path: _Path, unknown_free: bool = False) -> Map:
+        """Reads an OctoMap binary tree (``.bt``); raises ``MapError`` naming the file."""
+    @staticmethod
+    def scenario(name: str, unknown_free: bool = False) -> Map:
+        """A built-in scenario (``SCENARIOS``, ``corridor:LENGTH``, ``passage:...``)."""
+    @property
+    def name(self) -> str:
+        """The map's name: the file or ``scenario NAME``."""
+    @property
+    def resolution(self) -> float:
+        """Voxel edge (m)."""
+    @property
+    def unknown_is_occupied(self) -> bool:
+        """Whether unknown space counts as occupied."""
+    @property
+    def bounds(self) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The grid's metric bounds ``(lo, hi)``, two arrays of 3 (m)."""
+    @property
+    def start(self) -> Optional[NDArray[np.float64]]:
+        """The scenario's head start (array of 3, m); ``None`` for a map file."""
+    @property
+    def goal(self) -> Optional[NDArray[np.float64]]:
+        """The scenario's head goal (array of 3, m); ``None`` for a map file."""
+    @property
+    def start_yaw(self) -> Optional[float]:
+        """The scenario's start yaw (rad); ``None`` for a map file."""
+    @property
+    def default_units(self) -> Optional[int]:
+        """The number of units the scenario is made for; ``None`` for a map file."""
+    def occupied_voxels(
+        self, z_range: Optional[Tuple[float, float]] = None
+    ) -> NDArray[np.float64]:
+        """Centres of the occupied voxels, ``(K, 3)`` (m), optionally in a height band."""
+
+@final
+class Plan:
+    """A plan (``arc-plan/1``): waypoints of the chain, the start first."""
+
+    @staticmethod
+    def read(path: _Path) -> Plan:
+        """Reads and checks a plan file; raises ``PlanError`` naming the file and field."""
+    @staticmethod
+    def from_json(text: str, name: str = "<plan>") -> Plan:
+        """Parses and checks a plan's JSON text."""
+    def write(self, path: _Path) -> None:
+        """Writes the plan file (pretty JSON, atomically)."""
+    def to_json(self) -> str:
+        """The plan as JSON text."""
+    @property
+    def units(self) -> int:
+        """Number of units N."""
+    @property
+    def chain(self) -> dict[str, Any]:
+        """The chain section (units, link_length, unit_radius, ...)."""
+    @property
+    def map(self) -> dict[str, Any]:
+        """The map section: resolution, unknown_is_occupied, the map's source."""
+    @property
+    def stats(self) -> dict[str, Any]:
+        """The planner's statistics (counts, timings in seconds, quality)."""
+    @property
+    def waypoints(self) -> NDArray[np.float64]:
+        """Every waypoint's configuration zeta, ``(W, 2N + 2)`` (m, rad)."""
+    @property
+    def heads(self) -> NDArray[np.float64]:
+        """The head position of every waypoint, ``(W, 3)`` (m)."""
+    def unit_positions(self) -> NDArray[np.float64]:
+        """Every unit's centre at every waypoint, ``(W, N, 3)`` (m, head first)."""
+    def __len__(self) -> int: ...
+
+@final
+class VerifyReport:
+    """What the exact verifier found (``arc verify``)."""
+
+    @property
+    def ok(self) -> bool:
+        """True when the plan is VALID and starts and ends where asked."""
+    @property
+    def violation(self) -> Optional[str]:
+        """Why the plan is INVALID (``None`` when valid)."""
+    @property
+    def samples(self) -> int:
+        """Configurations tested."""
+    @property
+    def min_clearance(self) -> float:
+        """Smallest clearance of any body to the map over the valid samples (m)."""
+    @property
+    def min_clearance_at(self) -> Optional[str]:
+        """Where that clearance was found."""
+    @property
+    def edges(self) -> list[str]:
+        """The kind of every edge: ``translation``, ``shape_change``, ``stay`` or ``both``."""
+    @property
+    def notes(self) -> list[str]:
+        """Remarks: another map than the plan's, a different unknown-space assumption."""
+
+@final
+class Flight:
+    """A flight: the chain's recorded states and its report; arrays are ``(T, ...)``."""
+
+    @property
+    def t(self) -> NDArray[np.float64]:
+        """Time of every sample, ``(T,)`` (s)."""
+    @property
+    def unit_positions(self) -> NDArray[np.float64]:
+        """Every unit's centre, ``(T, N, 3)`` (m, head first)."""
+    @property
+    def unit_states(self) -> NDArray[np.float64]:
+        """Every unit's rigid-body state, ``(T, N, 13)``: position, quaternion
+        ``[w, x, y, z]``, velocity, angular velocity (world frame)."""
+    @property
+    def head_reference(self) -> NDArray[np.float64]:
+        """The reference head position the controller tracked, ``(T, 3)`` (m)."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The summary (``arc sim --out``'s ``report``)."""
+    @property
+    def success(self) -> bool:
+        """True when the chain reached the plan's goal without touching anything."""
+    def __len__(self) -> int: ...
+
+def plan(
+    map: Map,
+    units: Optional[int] = None,
+    start: Optional[_Point] = None,
+    goal: Optional[_Point] = None,
+    start_yaw: Optional[float] = None,
+    start_shape: Optional[Sequence[float]] = None,
+    goal_tol: float = 0.3,
+    seed: int = 1,
+    srs: int = 500,
+    srs_seed: int = 1,
+    clearance: float = ...,
+    time_limit: Optional[float] = None,
+    smooth: bool = True,
+) -> Plan:
+    """Plans on ``map`` with the ARCplanner and the defaults of ``arc plan``; raises
+    ``PlanError`` for bad input and when no plan is found."""
+
+def verify(
+    map: Map,
+    plan: Plan,
+    start: Optional[_Point] = None,
+    goal: Optional[_Point] = None,
+    goal_tol: float = 0.3,
+    strict: bool = True,
+) -> VerifyReport:
+    """Checks ``plan`` on ``map`` with the exact verifier; raises ``VerifyError`` when
+    INVALID unless ``strict=False``."""
+
+def simulate(
+    map: Map,
+    plan: Plan,
+    rate: float = 500.0,
+    speed: float = 0.5,
+    accel: float = 0.5,
+    angular_rate: float = 0.4,
+    goal_tol: float = 0.1,
+    settle_time: float = 10.0,
+    record_every: int = 10,
+) -> Flight:
+    """Flies ``plan`` on ``map`` with the chain's dynamics and control stack (``arc
+    sim``); raises ``SimError`` for settings outside their limits."""
