@@ -96,7 +96,8 @@ fn differs(a: &Shape, b: &Shape) -> bool {
 }
 
 impl ArcPlanner {
-    /// Refines a solved query's plan (see the module docs). The result starts and
+    /// Refines a solved query's plan (see the module docs), then shortens its shape
+    /// motion (`super::shorten`), both within [`CHECK_BUDGET`]. The result starts and
     /// ends where the solution does and passes the same checks. Past `deadline` (the
     /// query's time limit) refinement stops and keeps what it has; only then can two
     /// runs differ.
