@@ -97,7 +97,7 @@ fn differs(a: &Shape, b: &Shape) -> bool {
 
 impl ArcPlanner {
     /// Refines a solved query's plan (see the module docs), then shortens its shape
-    /// motion (`super::shorten`), both within [`CHECK_BUDGET`]. The result starts and
+    /// motion (`super::shorten`), both within `CHECK_BUDGET` checks. The result starts and
     /// ends where the solution does and passes the same checks. Past `deadline` (the
     /// query's time limit) refinement stops and keeps what it has; only then can two
     /// runs differ.

@@ -57,6 +57,21 @@ fn step(x: f64, shape: Shape, shape_change: bool) -> Step {
     }
 }
 
+/// A plan through `shapes` from x = 0: each a change where the head is, then a
+/// translation 1 m along x (only the last one's when not `translate_between`).
+fn plan(shapes: &[Shape], translate_between: bool) -> Vec<Step> {
+    let mut x = 0.0;
+    let mut out = vec![step(x, shapes[0], false)];
+    for (k, &s) in shapes.iter().enumerate().skip(1) {
+        out.push(step(x, s, true));
+        if translate_between || k + 1 == shapes.len() {
+            x += 1.0;
+            out.push(step(x, s, false));
+        }
+    }
+    out
+}
+
 fn motion(steps: &[Step]) -> f64 {
     Quality::of(steps).shape_motion_rad
 }
@@ -79,7 +94,7 @@ fn well_formed(before: &[Step], after: &[Step]) {
 fn a_change_the_rest_of_the_plan_does_not_need_is_dropped() {
     let a = bent(0.0, 0.0);
     let b = bent(0.8, -0.8);
-    let steps = vec![step(0.0, a, false), step(0.0, b, true), step(2.0, b, false)];
+    let steps = plan(&[a, b], true);
     let mut checks = rule(|_, _| true, |_, _| true);
     let out = shorten(&mut checks, steps.clone());
     well_formed(&steps, &out);
@@ -91,12 +106,7 @@ fn a_change_the_rest_of_the_plan_does_not_need_is_dropped() {
 #[test]
 fn changes_at_one_point_merge_into_one_direct_change() {
     let (a, b, c) = (bent(0.0, 0.0), bent(1.0, 0.5), bent(0.3, 0.2));
-    let steps = vec![
-        step(0.0, a, false),
-        step(0.0, b, true),
-        step(0.0, c, true),
-        step(2.0, c, false),
-    ];
+    let steps = plan(&[a, b, c], false);
     // Only `c` flies the translation, and any change is admissible.
     let mut checks = rule(move |_, s| s.max_angle_diff(&c) < 1e-6, |_, _| true);
     let out = shorten(&mut checks, steps.clone());
@@ -112,13 +122,7 @@ fn a_back_and_forth_is_clamped_between_its_neighbours() {
     // flies only with link 1 yaw in [0.1, 0.3], so neither neighbour's shape will do;
     // the last run flies only its own shape.
     let (a, b, c) = (bent(0.0, 0.0), bent(0.6, 0.2), bent(0.3, 0.5));
-    let steps = vec![
-        step(0.0, a, false),
-        step(0.0, b, true),
-        step(1.0, b, false),
-        step(1.0, c, true),
-        step(2.0, c, false),
-    ];
+    let steps = plan(&[a, b, c], true);
     let mut checks = rule(
         move |x, s| match x < 0.5 {
             true => (0.1..=0.3).contains(&s.yaw(1)),
@@ -137,7 +141,7 @@ fn a_back_and_forth_is_clamped_between_its_neighbours() {
 #[test]
 fn the_last_shape_relaxes_back_as_far_as_the_passage_allows() {
     let (a, b) = (bent(0.0, 0.0), bent(1.0, 0.0));
-    let steps = vec![step(0.0, a, false), step(0.0, b, true), step(2.0, b, false)];
+    let steps = plan(&[a, b], true);
     // The translation needs link 0 turned by at least 0.4 rad.
     let mut checks = rule(|_, s| s.yaw(0) >= 0.4, |_, _| true);
     let out = shorten(&mut checks, steps.clone());
@@ -157,13 +161,7 @@ fn the_head_yaw_is_held_and_a_turn_of_it_alone_disappears() {
     b.set_head_yaw(1.2);
     let mut c = bent(0.5, 0.5);
     c.set_head_yaw(-0.7);
-    let steps = vec![
-        step(0.0, a, false),
-        step(0.0, b, true),
-        step(1.0, b, false),
-        step(1.0, c, true),
-        step(2.0, c, false),
-    ];
+    let steps = plan(&[a, b, c], true);
     // Every change rejected: only the hold, which needs no check, can act.
     let mut checks = rule(|_, s| s.yaw(0) > 0.25, |_, _| false);
     let out = shorten(&mut checks, steps.clone());
@@ -176,7 +174,7 @@ fn the_head_yaw_is_held_and_a_turn_of_it_alone_disappears() {
 #[test]
 fn nothing_changes_where_no_check_passes() {
     let (a, b) = (bent(0.0, 0.0), bent(1.0, 0.0));
-    let steps = vec![step(0.0, a, false), step(0.0, b, true), step(2.0, b, false)];
+    let steps = plan(&[a, b], true);
     let mut checks = rule(|_, _| false, |_, _| false);
     let out = shorten(&mut checks, steps.clone());
     let key = |s: &Step| (s.xi, s.shape, s.shape_change);

@@ -352,7 +352,7 @@ pub fn figure(runs: &[FlightRun], speed: f64) -> String {
     );
     p.key(palette::GOAL, "target: 2 x path / speed");
     for (pts, colour, label) in [
-        (&before, palette::series(1), "stop at every waypoint"),
+        (&before, palette::series(3), "stop at every waypoint"),
         (&after, palette::series(0), "blended trajectory"),
     ] {
         for &q in pts {
