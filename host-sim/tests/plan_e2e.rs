@@ -45,6 +45,12 @@ fn plan_and_verify(scenario: &str, units: u8, dir: &Path) -> Plan {
         changes > 0,
         "the scenarios are built so that the chain must change shape"
     );
+    // Post-processing (the default) moves the chain's angles no more than the raw plan.
+    let motion = |q: &serde_json::Value| q["shape_motion_rad"].as_f64().expect("shape motion");
+    assert!(
+        motion(&plan.stats["quality"]) <= motion(&plan.stats["refinement"]["before"]) + 1e-9,
+        "{scenario} N={units}: post-processing added shape motion"
+    );
     plan
 }
 

@@ -13,7 +13,7 @@
 //! - [`ArcPlanner`], the paper's ARCplanner (`arc`): a lazy head roadmap
 //!   (`roadmap`, `lattice`) and, per head edge, the cheapest shape that gets the
 //!   chain along it (`construction`, `connect`, `candidates`, `follow`,
-//!   `srs_connect`), then `refine`;
+//!   `srs_connect`), then `refine` and `shorten`;
 //! - the full-state PRM baseline, [`crate::baseline::FullStatePrm`].
 //!
 //! Both search their roadmaps with the one lazy graph search of `graph`.
@@ -31,6 +31,7 @@ pub(crate) mod motion;
 pub(crate) mod refine;
 pub(crate) mod roadmap;
 mod settings;
+mod shorten;
 pub(crate) mod srs_connect;
 
 use std::time::{Duration, Instant};

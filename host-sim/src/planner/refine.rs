@@ -96,7 +96,8 @@ fn differs(a: &Shape, b: &Shape) -> bool {
 }
 
 impl ArcPlanner {
-    /// Refines a solved query's plan (see the module docs). The result starts and
+    /// Refines a solved query's plan (see the module docs), then shortens its shape
+    /// motion (`super::shorten`), both within `CHECK_BUDGET` checks. The result starts and
     /// ends where the solution does and passes the same checks. Past `deadline` (the
     /// query's time limit) refinement stops and keeps what it has; only then can two
     /// runs differ.
@@ -113,6 +114,7 @@ impl ArcPlanner {
         };
         let steps = pass.run();
         let steps = pass.shrink_changes(steps);
+        let steps = super::shorten::shorten(&mut pass, steps);
         let mut stats = solution.stats.clone();
         super::construction::count_sources(&steps, &mut stats);
         let report = Refinement {
@@ -305,6 +307,20 @@ impl Pass<'_> {
     fn shape_change(&mut self, xi: [f64; 3], s: &Shape, t: &Shape) -> bool {
         self.checks += 1;
         self.checker.shape_change(xi, s, t)
+    }
+}
+
+impl super::shorten::Checks for Pass<'_> {
+    fn translation(&mut self, a: [f64; 3], b: [f64; 3], s: &Shape) -> bool {
+        Pass::translation(self, a, b, s)
+    }
+
+    fn shape_change(&mut self, xi: [f64; 3], s: &Shape, t: &Shape) -> bool {
+        Pass::shape_change(self, xi, s, t)
+    }
+
+    fn exhausted(&self) -> bool {
+        Pass::exhausted(self)
     }
 }
 

@@ -29,8 +29,8 @@ pub enum BenchCommand {
     /// Robustness on the hard-case family (`passage:`): random instances with
     /// witnesses, N = 4..8, `arc plan`'s defaults; CSV, markdown and a plot.
     Robust(RobustArgs),
-    /// Flight time of the planner's plans (window, maze, silos, corridor; N = 4..6):
-    /// stopping at every waypoint against the blended trajectory, simulated; CSV,
+    /// Flight time of the planner's plans (window, maze, silos, corridor; N = 4..6;
+    /// a sample of the robust family): stopping at every waypoint against the blended trajectory, simulated; CSV,
     /// markdown and a plot of flight time against head path / speed.
     #[command(after_help = "Example:\n  arc bench flight --seeds 2 --out-dir out/flight")]
     Flight(FlightArgs),
@@ -140,6 +140,10 @@ pub struct FlightArgs {
     /// Seeds per scenario and size (1, 2, ...).
     #[arg(long, default_value_t = 2)]
     seeds: u64,
+    /// Also fly this many instances of `arc bench robust`'s family (its first ones,
+    /// each with its own N and planner seed); 0: none.
+    #[arg(long, default_value_t = 20)]
+    robust: usize,
     /// Where CSV, markdown and the plot go.
     #[arg(long, default_value = "bench-out")]
     out_dir: PathBuf,
@@ -490,30 +494,35 @@ fn run_flight(a: FlightArgs) -> CliResult {
     }
     let speed = aerial_chain::trajectory::Limits::default().speed;
     let t = Instant::now();
-    let mut runs = Vec::new();
+    checks::count("--robust", a.robust, 0, 200, "instances")?;
+    let mut jobs = Vec::new();
     for sc in &a.scenarios {
         for &n in &a.units {
-            for seed in 1..=a.seeds {
-                let r = study::flight::run_one(sc, n, seed);
-                eprintln!(
-                    "{sc} N = {n} seed {seed}: path {:.1} m, stop-go {:.1} s, trajectory {:.1} s ({} of {} corners blended, {} merged, made in {:.0} ms){}",
-                    r.head_path_m,
-                    r.before.map_or(f64::NAN, |f| f.time_s),
-                    r.after.map_or(f64::NAN, |f| f.time_s),
-                    r.blended,
-                    r.corners,
-                    r.merged,
-                    r.trajectory_s * 1e3,
-                    if r.error.is_empty() { String::new() } else { format!(": {}", r.error) }
-                );
-                runs.push(r);
-            }
+            jobs.extend((1..=a.seeds).map(|seed| (sc.clone(), n, seed)));
         }
     }
+    jobs.extend(study::flight::robust_sample(a.robust));
+    let mut runs = Vec::new();
+    for (sc, n, seed) in jobs {
+        let r = study::flight::run_one(&sc, n, seed);
+        eprintln!(
+            "{sc} N = {n} seed {seed}: path {:.1} m, stop-go {:.1} s, trajectory {:.1} s ({} of {} corners blended, {} merged, made in {:.0} ms){}",
+            r.head_path_m,
+            r.before.map_or(f64::NAN, |f| f.time_s),
+            r.after.map_or(f64::NAN, |f| f.time_s),
+            r.blended,
+            r.corners,
+            r.merged,
+            r.trajectory_s * 1e3,
+            if r.error.is_empty() { String::new() } else { format!(": {}", r.error) }
+        );
+        runs.push(r);
+    }
     let md = format!(
-        "{}\nMedians over seeds 1..={}; flight time from the start of the flight (1 s hold included) to arrival; {} build; whole study {:.0} s.\n",
+        "{}\nMedians over seeds 1..={} (the robust family: over its first {} instances, N = 4..8 as drawn); flight time from the start of the flight (1 s hold included) to arrival; {} build; whole study {:.0} s.\n",
         study::flight::markdown(&runs, speed),
         a.seeds,
+        a.robust,
         if cfg!(debug_assertions) { "debug" } else { "release" },
         t.elapsed().as_secs_f64()
     );

@@ -44,6 +44,10 @@ pub struct FlightRun {
     pub blended: usize,
     /// Translations and shape changes merged.
     pub merged: usize,
+    /// Time to post-process the plan (refinement and shortening, s).
+    pub refine_s: f64,
+    /// Shape motion of the plan before and after post-processing (rad).
+    pub shape_motion_rad: (f64, f64),
     /// Time to make and check the trajectory (s).
     pub trajectory_s: f64,
     /// Trajectory duration (s).
@@ -97,6 +101,8 @@ pub fn run_one(scenario: &str, units: u8, seed: u64) -> FlightRun {
         corners: 0,
         blended: 0,
         merged: 0,
+        refine_s: f64::NAN,
+        shape_motion_rad: (f64::NAN, f64::NAN),
         trajectory_s: f64::NAN,
         trajectory_duration_s: f64::NAN,
         before: None,
@@ -134,7 +140,12 @@ fn fly_both(run: &mut FlightRun) -> Result<(), String> {
     let solution = planner
         .solve(&query, Termination::default())
         .map_err(|e| format!("no plan: {e}"))?;
-    let (solution, _) = planner.refine(&solution, None);
+    let (solution, refinement) = planner.refine(&solution, None);
+    run.refine_s = refinement.time_s;
+    run.shape_motion_rad = (
+        refinement.before.shape_motion_rad,
+        refinement.after.shape_motion_rad,
+    );
     let grid = &sc.grid;
     let plan = to_plan(
         &solution,
@@ -187,7 +198,7 @@ fn fly_both(run: &mut FlightRun) -> Result<(), String> {
 /// The runs as CSV, one row each.
 pub fn csv(runs: &[FlightRun], speed: f64) -> String {
     let mut s = String::from(
-        "scenario,units,seed,head_path_m,path_over_speed_s,shape_changes,corners,blended,merged,trajectory_ms,trajectory_s,\
+        "scenario,units,seed,head_path_m,path_over_speed_s,shape_changes,shape_motion_before_rad,shape_motion_rad,corners,blended,merged,refine_ms,trajectory_ms,trajectory_s,\
          before_s,before_ratio,before_ok,before_head_max_m,before_min_clearance_m,\
          after_s,after_ratio,after_ok,after_head_max_m,after_min_clearance_m,error\n",
     );
@@ -205,16 +216,19 @@ pub fn csv(runs: &[FlightRun], speed: f64) -> String {
         };
         let _ = writeln!(
             s,
-            "{},{},{},{:.3},{:.2},{},{},{},{},{:.1},{:.2},{},{},{:?}",
+            "{},{},{},{:.3},{:.2},{},{:.3},{:.3},{},{},{},{:.1},{:.1},{:.2},{},{},{:?}",
             r.scenario,
             r.units,
             r.seed,
             r.head_path_m,
             r.head_path_m / speed,
             r.shape_changes,
+            r.shape_motion_rad.0,
+            r.shape_motion_rad.1,
             r.corners,
             r.blended,
             r.merged,
+            r.refine_s * 1e3,
             r.trajectory_s * 1e3,
             r.trajectory_duration_s,
             f(r.before),
@@ -225,17 +239,44 @@ pub fn csv(runs: &[FlightRun], speed: f64) -> String {
     s
 }
 
+/// A run's row of the table: its scenario and N, or for an instance of the passages
+/// family (`passage:...`) the family's one row, every N together.
+fn group_of(r: &FlightRun) -> (String, String) {
+    if r.scenario.starts_with("passage:") {
+        (ROBUST.into(), "4-8".into())
+    } else {
+        (r.scenario.clone(), r.units.to_string())
+    }
+}
+
+/// The table's name for the passages family.
+const ROBUST: &str = "robust family";
+
+/// The first `count` instances of `arc bench robust`'s family (its generator and
+/// seed), as (scenario, N, planner seed).
+pub fn robust_sample(count: usize) -> Vec<(String, u8, u64)> {
+    let o = super::robust::RobustOptions {
+        instances: count,
+        ..super::robust::RobustOptions::full()
+    };
+    super::robust::draw(&o)
+        .0
+        .into_iter()
+        .map(|s| (s.key.scenario.clone(), s.key.units, s.seed))
+        .collect()
+}
+
 /// A markdown table: per scenario and N, the median over seeds of both ratios.
 pub fn markdown(runs: &[FlightRun], speed: f64) -> String {
     let mut s = String::from(
-        "| scenario | N | runs | head path (m) | path / speed (s) | stop at every waypoint (s) | ratio | trajectory (s) | ratio | all flights without contact |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        "| scenario | N | runs | head path (m) | path / speed (s) | shape motion raw -> post-processed (rad) | stop at every waypoint (s) | ratio | trajectory (s) | ratio | post-processing + trajectory (ms) | all flights without contact |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    let mut keys: Vec<(String, u8)> = runs.iter().map(|r| (r.scenario.clone(), r.units)).collect();
+    let mut keys: Vec<(String, String)> = runs.iter().map(group_of).collect();
     keys.dedup();
     for (sc, n) in keys {
         let group: Vec<&FlightRun> = runs
             .iter()
-            .filter(|r| r.scenario == sc && r.units == n && r.error.is_empty())
+            .filter(|r| group_of(r) == (sc.clone(), n.clone()) && r.error.is_empty())
             .collect();
         let med = |f: &dyn Fn(&FlightRun) -> f64| median(group.iter().map(|r| f(r)).collect());
         let ok = group
@@ -243,14 +284,17 @@ pub fn markdown(runs: &[FlightRun], speed: f64) -> String {
             .all(|r| r.before.is_some_and(|f| f.success) && r.after.is_some_and(|f| f.success));
         let _ = writeln!(
             s,
-            "| {sc} | {n} | {} | {:.1} | {:.1} | {:.1} | {:.2} | {:.1} | {:.2} | {} |",
+            "| {sc} | {n} | {} | {:.1} | {:.1} | {:.1} -> {:.1} | {:.1} | {:.2} | {:.1} | {:.2} | {:.0} | {} |",
             group.len(),
             med(&|r| r.head_path_m),
             med(&|r| r.head_path_m / speed),
+            med(&|r| r.shape_motion_rad.0),
+            med(&|r| r.shape_motion_rad.1),
             med(&|r| r.before.map_or(f64::NAN, |f| f.time_s)),
             med(&|r| r.ratio(r.before, speed)),
             med(&|r| r.after.map_or(f64::NAN, |f| f.time_s)),
             med(&|r| r.ratio(r.after, speed)),
+            med(&|r| (r.refine_s + r.trajectory_s) * 1e3),
             if ok { "yes" } else { "no" }
         );
     }
@@ -308,7 +352,7 @@ pub fn figure(runs: &[FlightRun], speed: f64) -> String {
     );
     p.key_mark(Mark::Dashed, palette::GOAL, "target: 2 x path / speed");
     for (pts, colour, label) in [
-        (&before, palette::series(1), "stop at every waypoint"),
+        (&before, palette::series(3), "stop at every waypoint"),
         (&after, palette::series(0), "blended trajectory"),
     ] {
         for &q in pts {
@@ -341,6 +385,8 @@ mod tests {
             corners: 6,
             blended: 4,
             merged: 2,
+            refine_s: 0.004,
+            shape_motion_rad: (20.0, 12.0),
             trajectory_s: 0.01,
             trajectory_duration_s: after - 1.0,
             before: Some(flown(before)),
@@ -350,15 +396,27 @@ mod tests {
 
     #[test]
     fn table_csv_and_plot_of_the_runs() {
-        let runs = vec![run("maze", 1, 60.0, 30.0), run("maze", 2, 80.0, 50.0)];
+        let mut runs = vec![run("maze", 1, 60.0, 30.0), run("maze", 2, 80.0, 50.0)];
+        runs.extend([
+            run("passage:a", 1, 30.0, 20.0),
+            run("passage:b", 2, 40.0, 30.0),
+        ]);
+        runs[3].units = 7;
         let md = markdown(&runs, 0.5);
         // Medians over the two seeds: 70 s and 40 s against 20 s of path.
         assert!(
-            md.contains("| maze | 5 | 2 | 10.0 | 20.0 | 70.0 | 3.50 | 40.0 | 2.00 | yes |"),
+            md.contains(
+                "| maze | 5 | 2 | 10.0 | 20.0 | 20.0 -> 12.0 | 70.0 | 3.50 | 40.0 | 2.00 | 14 | yes |"
+            ),
+            "{md}"
+        );
+        // The family's instances make one row, whatever their N.
+        assert!(
+            md.contains("| robust family | 4-8 | 2 | 10.0 | 20.0 | 20.0 -> 12.0 | 35.0 | 1.75 | 25.0 | 1.25 |"),
             "{md}"
         );
         let csv = csv(&runs, 0.5);
-        assert_eq!(csv.lines().count(), 3);
+        assert_eq!(csv.lines().count(), 5);
         let cols = csv.lines().next().unwrap().split(',').count();
         assert!(csv.lines().all(|l| l.split(',').count() == cols), "{csv}");
         let svg = figure(&runs, 0.5);
