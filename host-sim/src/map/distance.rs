@@ -234,17 +234,17 @@ impl Scratch {
         }
     }
 
+    /// The 1D transform of `row[..n]` into `out[..n]`.
+    fn run(&mut self, n: usize, walls: bool) {
+        let (row, out) = (&self.row[..n], &mut self.out[..n]);
+        edt_1d(row, walls, out, &mut self.v, &mut self.z);
+    }
+
     /// The 1D transform of the contiguous line `line`, in place.
     fn transform(&mut self, line: &mut [u32], walls: bool) {
         let n = line.len();
         self.row[..n].copy_from_slice(line);
-        edt_1d(
-            &self.row[..n],
-            walls,
-            &mut self.out[..n],
-            &mut self.v,
-            &mut self.z,
-        );
+        self.run(n, walls);
         line.copy_from_slice(&self.out[..n]);
     }
 
@@ -260,13 +260,7 @@ impl Scratch {
         for k in 0..n {
             self.row[k] = cells[first + k * stride];
         }
-        edt_1d(
-            &self.row[..n],
-            walls,
-            &mut self.out[..n],
-            &mut self.v,
-            &mut self.z,
-        );
+        self.run(n, walls);
         for k in 0..n {
             cells[first + k * stride] = self.out[k];
         }
@@ -312,7 +306,7 @@ impl Columns {
             for k in 0..n {
                 s.row[k] = block[k * BLOCK + j];
             }
-            edt_1d(&s.row[..n], walls, &mut s.out[..n], &mut s.v, &mut s.z);
+            s.run(n, walls);
             for k in 0..n {
                 block[k * BLOCK + j] = s.out[k];
             }

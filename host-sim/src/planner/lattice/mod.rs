@@ -289,22 +289,9 @@ impl HeadLattice {
         start: [f64; 3],
         goal: [f64; 3],
     ) -> LatticeOutcome {
-        self.route_within(ctx_min, start, goal, self.budget, None)
-    }
-
-    /// [`Self::route`], giving up ([`LatticeOutcome::Budget`]) once `budget` lattice
-    /// points have been touched or `deadline` has passed (the query's time limit).
-    pub fn route_within(
-        &self,
-        ctx_min: &CollisionContext,
-        start: [f64; 3],
-        goal: [f64; 3],
-        budget: usize,
-        deadline: Option<std::time::Instant>,
-    ) -> LatticeOutcome {
-        match self.quick_route(ctx_min, start, goal, deadline) {
+        match self.quick_route(ctx_min, start, goal, None) {
             Some(route) => LatticeOutcome::Found(route),
-            None => self.guided_route(ctx_min, start, goal, budget, deadline),
+            None => self.guided_route(ctx_min, start, goal, self.budget, None),
         }
     }
 
