@@ -295,6 +295,12 @@ impl ArcPlanner {
                 .quick_route(&self.ctx_min, start, goal, deadline);
             built.lattice_s += t.elapsed().as_secs_f64();
             on_route = self.solve_on_route(query, stop, began, &built)?;
+            // Where the chain could not fly it alone, the roadmap is tried on its own
+            // first: a long chain replans better over samples than along the route's
+            // free edges. The route joins the roadmap after that fails.
+            if on_route.is_none() {
+                built.quick = built.route.take();
+            }
         }
         let (steps, mut stats) = match on_route {
             Some(solved) => solved,
@@ -308,9 +314,10 @@ impl ArcPlanner {
             (stats.roadmap_vertices, stats.roadmap_edges) = (r.vertex_count(), r.edge_count());
         }
         stats.collision_checks = self.check_count() - checks_before;
-        stats.lattice_expanded = built.route.as_ref().map_or(0, |r| r.expanded);
+        let route = built.route.as_ref().or(built.quick.as_ref());
+        stats.lattice_expanded = route.map_or(0, |r| r.expanded);
         stats.lattice_s = built.lattice_s;
-        stats.route_points = built.route.as_ref().map_or(0, |r| r.points.len());
+        stats.route_points = route.map_or(0, |r| r.points.len());
         stats.regions_s = built.regions_s;
         stats.timings.roadmap_s = built.regions_s + built.roadmap_s;
         stats.timings.planning_s =
@@ -335,7 +342,8 @@ impl ArcPlanner {
         };
         let mut roadmap = self.sampled_roadmap(0, stop.deadline(began));
         let inner = &route.points[1..route.points.len() - 1];
-        match Construction::new(self, &mut roadmap, query, Some(inner), stop, began).run() {
+        let construction = Construction::new(self, &mut roadmap, query, Some(inner), stop, began);
+        match construction.without_replans().run() {
             Ok((_, stats))
                 if stats.min_margin < self.ctx.clearance_margin() - 1e-9
                     && route.narrowest_margin >= self.ctx.clearance_margin() =>
@@ -364,8 +372,9 @@ impl ArcPlanner {
         if let Some(sep) = self.lattice.separation(self.ctx.field(), start, goal) {
             return Err(self.separated(sep));
         }
-        if built.route.is_some() {
-            return Ok(None); // the quick route was tried alone before
+        if let Some(quick) = built.quick.take() {
+            built.route = Some(quick);
+            return Ok(None); // tried alone before: now it joins the roadmap
         }
         let (budget, deadline) = (self.lattice.budget, stop.deadline(began));
         built.route = self.head_route(start, goal, budget, deadline, &mut built.lattice_s)?;
@@ -442,8 +451,10 @@ impl ArcPlanner {
 /// What a query built and searched before its construction, timed apart.
 #[derive(Default)]
 struct Built {
-    /// The lattice's head route, if one was found.
+    /// The lattice's head route that joins the roadmap, if one was found.
     route: Option<lattice::HeadRoute>,
+    /// The quick route, flown alone without success, kept for the roadmap's second try.
+    quick: Option<lattice::HeadRoute>,
     /// Time (s) the lattice searches took.
     lattice_s: f64,
     /// Time (s) spent labelling the free regions in this query.

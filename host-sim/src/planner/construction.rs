@@ -51,6 +51,8 @@ pub(super) struct Construction<'p> {
     goal_tol: f64,
     /// Edges flown below the preferred clearance: steps before, margin, where.
     pub(super) relaxed: Vec<(usize, f64, [f64; 3])>,
+    /// Replans allowed without progress (`Settings::max_replans` unless set).
+    max_replans: usize,
 }
 
 impl<'p> Construction<'p> {
@@ -102,7 +104,16 @@ impl<'p> Construction<'p> {
             began,
             goal_tol: tol,
             relaxed: Vec::new(),
+            max_replans: planner.settings.max_replans,
         }
+    }
+
+    /// The same construction giving up at the first edge no shape flies: over a lone
+    /// head route there is no other way to replan onto, and backing up along it only
+    /// retries the same shapes.
+    pub(super) fn without_replans(mut self) -> Self {
+        self.max_replans = 0;
+        self
     }
 
     fn route(&self, from: VertexId) -> Result<Vec<VertexId>, PlanError> {
@@ -158,7 +169,7 @@ impl<'p> Construction<'p> {
                 self.banned.insert((bad.0.min(bad.1), bad.0.max(bad.1)));
                 self.stats.replans += 1;
                 stuck_replans += 1;
-                if stuck_replans > self.planner.settings.max_replans {
+                if stuck_replans > self.max_replans {
                     return Err(PlanError::NoShape {
                         from,
                         to,
