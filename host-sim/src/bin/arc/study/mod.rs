@@ -67,7 +67,8 @@ pub struct RunResult {
     pub message: String,
     /// Shape tables build (offline, not part of `t_G`) (s).
     pub tables_s: f64,
-    /// Roadmap build `t_G` (s).
+    /// The planner's setup before the query, `t_G` (s): the roadmap build for the
+    /// planners that build one up front.
     pub roadmap_s: f64,
     /// Query `t_P` (s).
     pub planning_s: f64,
