@@ -404,12 +404,11 @@ impl ArcPlanner {
             let mut roadmap = self.roadmap.take().expect("the query built the roadmap");
             let result = Construction::new(self, &mut roadmap, query, inner, stop, began).run();
             roadmap.clear_query();
-            let size = (roadmap.vertex_count(), roadmap.edge_count());
             self.roadmap = Some(roadmap);
             match result {
                 Ok((steps, mut stats)) => {
+                    // The roadmap's size is filled in by `solve_query`.
                     stats.roadmap_growths = growths;
-                    (stats.roadmap_vertices, stats.roadmap_edges) = size;
                     return Ok((steps, stats));
                 }
                 Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. })

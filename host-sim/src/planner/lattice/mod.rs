@@ -59,7 +59,7 @@ pub use regions::Regions;
 
 use crate::collision::{CollisionContext, FK_TOLERANCE};
 use crate::map::distance::DistanceField;
-use nodes::{KeyMap, Nodes};
+use nodes::Nodes;
 use search::{Limit, Search};
 
 /// Bits per axis in a packed lattice key.
@@ -194,11 +194,7 @@ impl HeadLattice {
         goal: [f64; 3],
     ) -> Option<LatticeOutcome> {
         let regions = self.regions(field);
-        let mut nodes = Nodes {
-            lat: self,
-            field,
-            map: KeyMap::default(),
-        };
+        let mut nodes = Nodes::new(self, field);
         let mut sides = [("start", start), ("goal", goal)].map(|(side, p)| {
             let mut found: Vec<u32> = self
                 .anchors(&mut nodes, p, 1)
@@ -307,11 +303,7 @@ impl HeadLattice {
         goal: [f64; 3],
         deadline: Option<std::time::Instant>,
     ) -> Option<HeadRoute> {
-        let mut nodes = Nodes {
-            lat: self,
-            field: ctx_min.field(),
-            map: KeyMap::default(),
-        };
+        let mut nodes = Nodes::new(self, ctx_min.field());
         let quick = Limit {
             budget: QUICK_BUDGET.min(self.budget),
             deadline,
@@ -343,11 +335,7 @@ impl HeadLattice {
     ) -> LatticeOutcome {
         let limit = Limit { budget, deadline };
         let field = ctx_min.field();
-        let mut nodes = Nodes {
-            lat: self,
-            field,
-            map: KeyMap::default(),
-        };
+        let mut nodes = Nodes::new(self, field);
         let regions = self.regions(field);
         let starts = self.anchors(&mut nodes, start, 1);
         let goals = self.anchors(&mut nodes, goal, 1);

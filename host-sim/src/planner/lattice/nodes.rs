@@ -51,7 +51,16 @@ pub(super) struct Nodes<'a> {
     pub(super) map: KeyMap<Node>,
 }
 
-impl Nodes<'_> {
+impl<'a> Nodes<'a> {
+    /// No point touched yet on `lat` over `field`.
+    pub(super) fn new(lat: &'a HeadLattice, field: &'a DistanceField) -> Self {
+        Self {
+            lat,
+            field,
+            map: KeyMap::default(),
+        }
+    }
+
     /// The point's record, its clearance computed on first touch.
     pub(super) fn get(&mut self, k: u64) -> &mut Node {
         let (lat, field) = (self.lat, self.field);

@@ -153,11 +153,7 @@ fn the_coarse_guide_leads_through_the_door_not_the_wall() {
     // goal 2 m apart on either side of the wall, 2.5 m from the door.
     let (c, lat) = walled(0.1, [40, 40, 20], 20..22, [30..36, 1..15]);
     let (a, b) = ([1.0, 1.0, 1.0], [3.2, 1.0, 1.0]);
-    let mut nodes = Nodes {
-        lat: &lat,
-        field: c.field(),
-        map: KeyMap::default(),
-    };
+    let mut nodes = Nodes::new(&lat, c.field());
     let starts = lat.anchors(&mut nodes, a, 1);
     let goals = lat.anchors(&mut nodes, b, 1);
     let guide = super::guide::Guide::new(&lat, lat.regions(c.field()), &starts, &goals, b);
@@ -184,11 +180,7 @@ fn flood_connects(
     a: [f64; 3],
     b: [f64; 3],
 ) -> Option<bool> {
-    let mut nodes = Nodes {
-        lat,
-        field: c.field(),
-        map: KeyMap::default(),
-    };
+    let mut nodes = Nodes::new(lat, c.field());
     let starts = lat.anchors(&mut nodes, a, 1);
     let goals: KeySet = lat.anchors(&mut nodes, b, 1).into_iter().collect();
     if starts.is_empty() || goals.is_empty() {
