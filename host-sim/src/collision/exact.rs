@@ -344,6 +344,7 @@ pub fn exact_clearance(
     let r = g.resolution();
     let c0 = g.lattice_index(p);
     let rings = (cap / r).ceil() as i32 + 1;
+    let half = Vector3::repeat(r / 2.0);
     let mut best = cap;
     for k in 0..=rings {
         // Every cube of ring k is at least (k - 1) r away.
@@ -362,7 +363,6 @@ pub fn exact_clearance(
                         continue;
                     }
                     let c = g.voxel_center(i);
-                    let half = Vector3::repeat(r / 2.0);
                     let d = point_box_distance(p, c - half, c + half);
                     if d < best {
                         best = d;
