@@ -13,7 +13,7 @@
 //! - [`ArcPlanner`], the paper's ARCplanner (`arc`): a lazy head roadmap
 //!   (`roadmap`, `lattice`) and, per head edge, the cheapest shape that gets the
 //!   chain along it (`construction`, `connect`, `candidates`, `follow`,
-//!   `srs_connect`), then `refine` and `shorten`;
+//!   `srs_connect`), then `refine`, `shorten` and `widen`;
 //! - the full-state PRM baseline, [`crate::baseline::FullStatePrm`].
 //!
 //! Both search their roadmaps with the one lazy graph search of `graph`.
@@ -33,6 +33,7 @@ pub(crate) mod roadmap;
 mod settings;
 mod shorten;
 pub(crate) mod srs_connect;
+mod widen;
 
 use std::time::{Duration, Instant};
 
@@ -46,6 +47,7 @@ pub use error::PlanError;
 pub use motion::{annotate_quality, source_label, to_plan};
 pub use refine::{Quality, Refinement};
 pub use settings::{Mode, Preference, Settings};
+pub use widen::{Widening, CAP as WIDEN_CAP};
 
 use crate::collision::CollisionContext;
 use crate::plan_file::{Plan, Timings};

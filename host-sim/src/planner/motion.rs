@@ -59,6 +59,15 @@ pub fn annotate_quality(plan: &mut Plan, quality: &Quality, refinement: Option<&
     let mut m = serde_json::Map::new();
     m.insert("before".into(), quality_json(&r.before));
     m.insert("checks".into(), r.checks.into());
+    let w = &r.widening;
+    m.insert(
+        "widening".into(),
+        serde_json::json!({
+            "narrowest_before_m": w.before,
+            "narrowest_after_m": w.after,
+            "moves": w.moves,
+        }),
+    );
     plan.stats.insert("refinement".into(), Value::Object(m));
     if let Some(Value::Object(t)) = plan.stats.get_mut("timing") {
         t.insert("refine_s".into(), r.time_s.into());

@@ -28,12 +28,23 @@ use aerial_chain_core::cost::transition_cost;
 use aerial_chain_core::Shape;
 
 use super::candidates::Source;
+use super::widen::Widening;
 use super::{ArcPlanner, Checker, Solution, Stats, Step};
+use crate::collision::CollisionContext;
 
 /// Collision checks refinement may spend on one plan. At a few microseconds each
 /// this bounds the pass to tens of milliseconds; what is left unrefined when it
 /// runs out stays as the search made it.
 pub const CHECK_BUDGET: u64 = 20_000;
+
+/// How much of the widened plan's clearance post-processing may give back (m): the
+/// checks are conservative, so a margin exactly at the plan's clearance could refuse
+/// the plan's own edges.
+const KEEP_SLACK: f64 = 0.005;
+
+/// A margin less than this (m) above the search's is not worth keeping: it would
+/// refuse shortcuts for next to no clearance.
+const KEEP_GAIN: f64 = 0.025;
 
 /// Angles closer than this (rad) are the same shape: no shape change is needed.
 const SAME_SHAPE: f32 = 1e-6;
@@ -76,8 +87,10 @@ pub struct Refinement {
     pub before: Quality,
     /// The refined plan.
     pub after: Quality,
-    /// Collision checks spent.
+    /// Collision checks spent (before widening).
     pub checks: u64,
+    /// What widening did (`super::widen`), the last stage.
+    pub widening: Widening,
     /// Time spent (s).
     pub time_s: f64,
 }
@@ -97,7 +110,8 @@ fn differs(a: &Shape, b: &Shape) -> bool {
 
 impl ArcPlanner {
     /// Refines a solved query's plan (see the module docs), then shortens its shape
-    /// motion (`super::shorten`), both within `CHECK_BUDGET` checks. The result starts and
+    /// motion (`super::shorten`), both within `CHECK_BUDGET` checks, then widens its
+    /// narrow passages (`super::widen`). The result starts and
     /// ends where the solution does and passes the same checks. Past `deadline` (the
     /// query's time limit) refinement stops and keeps what it has; only then can two
     /// runs differ.
@@ -107,23 +121,54 @@ impl ArcPlanner {
         deadline: Option<Instant>,
     ) -> (Solution<Stats>, Refinement) {
         let began = Instant::now();
+        // Widen the search's plan first, where it has the most stations to move; then
+        // refine and shorten without giving back what that won (`keep_margin`).
+        let (widened, first) =
+            super::widen::widen(&self.ctx, &self.ctx_min, solution.steps.clone());
+        // Where there is nothing to keep, refine what the search found, as before.
+        let (ctx, raw) = match self.keep_margin(first.in_passages) {
+            Some(ctx) => (ctx, widened),
+            None => (self.ctx.clone(), solution.steps.clone()),
+        };
         let mut pass = Pass {
-            checker: Checker::new(self.ctx.clone(), deadline),
-            poses: &solution.steps,
+            checker: Checker::new(ctx.clone(), deadline),
+            poses: &raw,
             checks: 0,
         };
         let steps = pass.run();
         let steps = pass.shrink_changes(steps);
         let steps = super::shorten::shorten(&mut pass, steps);
+        let (steps, last) = super::widen::widen(&ctx, &self.ctx_min, steps);
         let mut stats = solution.stats.clone();
         super::construction::count_sources(&steps, &mut stats);
         let report = Refinement {
             before: Quality::of(&solution.steps),
             after: Quality::of(&steps),
             checks: pass.checks,
+            widening: Widening {
+                before: first.before,
+                moves: first.moves + last.moves,
+                ..last
+            },
             time_s: began.elapsed().as_secs_f64(),
         };
         (Solution { steps, stats }, report)
+    }
+
+    /// The context post-processing checks in after the search's plan was widened to
+    /// keep `narrowest` (m) through every passage (`None`: it passes none): where
+    /// that is more than the preferred clearance (by [`KEEP_GAIN`]), a context at that
+    /// margin less [`KEEP_SLACK`], so that a shortcut never passes an opening closer
+    /// than the plan already does; else `None`, the search's own.
+    fn keep_margin(&self, narrowest: Option<f64>) -> Option<CollisionContext> {
+        let keep = narrowest? - KEEP_SLACK;
+        if keep < self.ctx.clearance_margin() + KEEP_GAIN {
+            return None;
+        }
+        let mut c =
+            CollisionContext::new(self.ctx.field_arc().clone(), *self.ctx.params(), keep).ok()?;
+        c.set_min_step(self.ctx.min_step());
+        Some(c)
     }
 }
 

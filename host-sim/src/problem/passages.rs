@@ -23,8 +23,9 @@
 
 use aerial_chain_core::ChainParams;
 
+use super::scenarios::fill;
 use super::ProblemError;
-use crate::collision::verify_plan;
+use crate::collision::{verify_plan, verify_plan_with, VerifyOptions};
 use crate::map::grid::{Cell, Grid};
 use crate::plan_file::Plan;
 use crate::problem::scenarios::Scenario;
@@ -175,9 +176,8 @@ impl PassageSpec {
         }
     }
 
-    /// The scenario.
-    pub fn build(&self) -> Result<Scenario, ProblemError> {
-        self.check()?;
+    /// Where the walls and their openings lie, on the map's lattice.
+    fn layout(&self) -> Layout {
         let r = self.res;
         let snap = |v: f64| (v / r).round() * r;
         // Openings: faces on the lattice, outward (at least as wide as asked).
@@ -185,56 +185,53 @@ impl PassageSpec {
         let up = |v: f64| (v / r - 1e-6).ceil() * r;
         let t = snap(self.wall).max(2.0 * r);
         let yc = ROOM_Y / 2.0 + self.offset;
-        let wall2 = self.door.map(|_| WALL_X + t + WALL_GAP);
-        let sx = snap(match wall2 {
-            Some(x2) => x2 + 0.2 + 3.0,
+        let hw = self.w / 2.0;
+        let door = self.door.map(|(dw, doff)| Door {
+            x: WALL_X + t + WALL_GAP,
+            y: (
+                down(ROOM_Y / 2.0 + doff - dw / 2.0),
+                up(ROOM_Y / 2.0 + doff + dw / 2.0),
+            ),
+        });
+        let sx = snap(match door {
+            Some(d) => d.x + 0.2 + 3.0,
             None => WALL_X + t + 3.5,
         });
-        let dims = [sx, ROOM_Y, ROOM_Z].map(|v| (v / r).round() as usize);
-        let mut g = Grid::new(r, [0; 3], dims, Cell::Occupied, true)?;
-        let fill = super::scenarios::fill;
-        let size = [dims[0] as f64 * r, dims[1] as f64 * r, dims[2] as f64 * r];
+        Layout {
+            dims: [sx, ROOM_Y, ROOM_Z].map(|v| (v / r).round() as usize),
+            t,
+            window_y: (down(yc - hw), up(yc + hw)),
+            window_z: (down(Z_C - hw), up(Z_C + hw)),
+            door,
+        }
+    }
+
+    /// The scenario.
+    pub fn build(&self) -> Result<Scenario, ProblemError> {
+        self.check()?;
+        let r = self.res;
+        let lay = self.layout();
+        let mut g = Grid::new(r, [0; 3], lay.dims, Cell::Occupied, true)?;
+        let size = lay.size(r);
         fill(
             &mut g,
             [SHELL; 3],
             [size[0] - SHELL, size[1] - SHELL, size[2] - SHELL],
             Cell::Free,
         );
-        fill(
-            &mut g,
-            [WALL_X, 0.0, 0.0],
-            [WALL_X + t, size[1], size[2]],
-            Cell::Occupied,
-        );
-        // The window's faces on the lattice, as near the asked ones as it allows; the
-        // route goes through the centre of what is built.
-        let hw = self.w / 2.0;
-        let (y0, y1) = (down(yc - hw), up(yc + hw));
-        let (z0, z1) = (down(Z_C - hw), up(Z_C + hw));
-        let (yc, zc) = ((y0 + y1) / 2.0, (z0 + z1) / 2.0);
-        if !self.sealed {
-            fill(&mut g, [WALL_X, y0, z0], [WALL_X + t, y1, z1], Cell::Free);
-        }
-        let mut goal = [WALL_X + t + 1.5, yc, zc];
+        lay.first_wall(&mut g, self.sealed);
+        // The route goes through the centre of the openings as built.
+        let (yc, zc) = lay.window_centre();
+        let mut goal = [WALL_X + lay.t + 1.5, yc, zc];
         let a = self.angle_deg.to_radians();
         let turn = [WALL_X - 1.0, yc, zc];
         let start = [turn[0] - a.cos(), turn[1] - a.sin(), zc];
-        let mut route = vec![start, turn, [WALL_X + t + 0.8, yc, zc]];
-        if let (Some(x2), Some((dw, doff))) = (wall2, self.door) {
-            let (d0, d1) = (
-                down(ROOM_Y / 2.0 + doff - dw / 2.0),
-                up(ROOM_Y / 2.0 + doff + dw / 2.0),
-            );
-            let yd = (d0 + d1) / 2.0;
-            fill(
-                &mut g,
-                [x2, 0.0, 0.0],
-                [x2 + 0.2, size[1], size[2]],
-                Cell::Occupied,
-            );
-            fill(&mut g, [x2, d0, SHELL], [x2 + 0.2, d1, 2.0], Cell::Free);
-            route.push([x2 - 0.8, yd, zc]);
-            goal = [x2 + 0.2 + 1.5, yd, zc];
+        let mut route = vec![start, turn, [WALL_X + lay.t + 0.8, yc, zc]];
+        if let Some(d) = lay.door {
+            d.wall(&mut g, size);
+            let yd = (d.y.0 + d.y.1) / 2.0;
+            route.push([d.x - 0.8, yd, zc]);
+            goal = [d.x + 0.2 + 1.5, yd, zc];
         }
         route.push(goal);
         let door_text = match self.door {
@@ -248,6 +245,7 @@ impl PassageSpec {
             description: format!(
                 "A room at {r} m with a {t} m wall holding a {w} m x {w} m window (a tunnel when the wall is thick) {off:+} m off the \
                  axis, approached at {ang} degrees off its normal{door_text}.",
+                t = lay.t,
                 w = self.w,
                 off = self.offset,
                 ang = self.angle_deg
@@ -259,6 +257,127 @@ impl PassageSpec {
             default_units: 5,
             route: super::scenarios::points(&route),
         })
+    }
+
+    /// How much clearance `plan` keeps through each opening, against what the
+    /// passages issue asks: `0.9 (w - 2 r_u) / 2` for an opening `w` wide (its narrower
+    /// side as built). Each opening's clearance is measured exactly, by the verifier,
+    /// against a map that holds only the wall around it, so the rest of the room does
+    /// not count. `Err` when the instance does not build.
+    pub fn opening_clearances(
+        &self,
+        plan: &Plan,
+        params: &ChainParams,
+    ) -> Result<Vec<OpeningClearance>, ProblemError> {
+        self.check()?;
+        let r = self.res;
+        let lay = self.layout();
+        let size = lay.size(r);
+        let empty = || Grid::new(r, [0; 3], lay.dims, Cell::Free, false);
+        let mut walls = Vec::new();
+        let mut g = empty()?;
+        lay.first_wall(&mut g, self.sealed);
+        let window = (lay.window_y.1 - lay.window_y.0).min(lay.window_z.1 - lay.window_z.0);
+        walls.push(("window", g, window));
+        if let Some(d) = lay.door {
+            let mut g = empty()?;
+            d.wall(&mut g, size);
+            walls.push(("door", g, d.y.1 - d.y.0));
+        }
+        let opts = VerifyOptions { horizon: 1.0 };
+        let r_u = params.unit_radius as f64;
+        Ok(walls
+            .into_iter()
+            .map(|(name, g, width)| OpeningClearance {
+                name,
+                width,
+                clearance: verify_plan_with(&g, plan, &opts).min_clearance,
+                target: 0.9 * (width - 2.0 * r_u) / 2.0,
+            })
+            .collect())
+    }
+}
+
+/// The clearance a plan keeps through one opening of an instance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OpeningClearance {
+    /// `window` or `door`.
+    pub name: &'static str,
+    /// The opening's width as built (m).
+    pub width: f64,
+    /// The smallest clearance the plan keeps from the wall holding it (m).
+    pub clearance: f64,
+    /// What the passages issue asks: `0.9 (width - 2 r_u) / 2` (m).
+    pub target: f64,
+}
+
+/// Walls and openings of an instance, their faces on the map's lattice.
+#[derive(Clone, Copy, Debug)]
+struct Layout {
+    /// Voxels per axis.
+    dims: [usize; 3],
+    /// First wall's thickness (m), from `WALL_X`.
+    t: f64,
+    /// Window faces across the room (y) and in height (z), m.
+    window_y: (f64, f64),
+    window_z: (f64, f64),
+    /// The second wall, when there is one.
+    door: Option<Door>,
+}
+
+impl Layout {
+    fn size(&self, r: f64) -> [f64; 3] {
+        self.dims.map(|d| d as f64 * r)
+    }
+
+    fn window_centre(&self) -> (f64, f64) {
+        (
+            (self.window_y.0 + self.window_y.1) / 2.0,
+            (self.window_z.0 + self.window_z.1) / 2.0,
+        )
+    }
+
+    /// Puts the first wall into `g`, with its window unless `sealed`.
+    fn first_wall(&self, g: &mut Grid, sealed: bool) {
+        let size = self.size(g.resolution());
+        let x1 = WALL_X + self.t;
+        fill(
+            g,
+            [WALL_X, 0.0, 0.0],
+            [x1, size[1], size[2]],
+            Cell::Occupied,
+        );
+        if !sealed {
+            let (y, z) = (self.window_y, self.window_z);
+            fill(g, [WALL_X, y.0, z.0], [x1, y.1, z.1], Cell::Free);
+        }
+    }
+}
+
+/// The second wall (0.2 m thick) and its door, from the floor's shell to 2 m.
+#[derive(Clone, Copy, Debug)]
+struct Door {
+    /// Where the wall begins (m).
+    x: f64,
+    /// Door faces across the room (m).
+    y: (f64, f64),
+}
+
+impl Door {
+    fn wall(&self, g: &mut Grid, size: [f64; 3]) {
+        let x1 = self.x + 0.2;
+        fill(
+            g,
+            [self.x, 0.0, 0.0],
+            [x1, size[1], size[2]],
+            Cell::Occupied,
+        );
+        fill(
+            g,
+            [self.x, self.y.0, SHELL],
+            [x1, self.y.1, 2.0],
+            Cell::Free,
+        );
     }
 }
 
@@ -305,5 +424,26 @@ mod tests {
         for n in [4u8, 6, 8] {
             witness(&sc, &ChainParams::new(n)).unwrap();
         }
+    }
+
+    #[test]
+    fn the_centred_witness_keeps_the_opening_target_and_a_plan_off_centre_does_not() {
+        let s = PassageSpec::parse("w=0.5,angle=30,door=0.7").unwrap();
+        let sc = s.build().unwrap();
+        let params = ChainParams::new(4);
+        let mut plan = witness(&sc, &params).unwrap();
+        let o = s.opening_clearances(&plan, &params).unwrap();
+        assert_eq!(o.len(), 2);
+        for c in &o {
+            // Centred: (w - 2 r_u) / 2 less a little for the turn onto the normal.
+            assert!(c.clearance >= c.target, "{c:?}");
+        }
+        assert!((o[0].width - 0.5).abs() < 1e-9 && (o[1].width - 0.7).abs() < 1e-9);
+        // The same plan 4 cm off centre in y keeps less than the target in the window.
+        for w in &mut plan.waypoints {
+            w.zeta[1] += 0.04;
+        }
+        let o = s.opening_clearances(&plan, &params).unwrap();
+        assert!(o[0].clearance < o[0].target, "{:?}", o[0]);
     }
 }

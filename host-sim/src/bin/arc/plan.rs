@@ -388,5 +388,12 @@ fn print_quality(report: &Report, q: &Quality, refinement: Option<&Refinement>) 
             r.before.shape_changes,
             r.before.shape_motion_rad
         ));
+        let w = &r.widening;
+        if w.before < aerial_chain::planner::WIDEN_CAP {
+            report.line(format_args!(
+                "  narrowest unit clearance {:.3} m as searched, {:.3} m post-processed ({} stations moved to widen passages)",
+                w.before, w.after, w.moves
+            ));
+        }
     }
 }

@@ -47,6 +47,7 @@ use aerial_chain::map::DistanceField;
 use aerial_chain::planner::{
     to_plan, ArcPlanner, Failure, Planner, Settings, Solution, SolutionStats, Termination,
 };
+use aerial_chain::problem::passages::{OpeningClearance, PassageSpec};
 use aerial_chain::problem::scenarios::{self, Scenario};
 use aerial_chain::tables::{ShapeTables, TableSettings};
 
@@ -100,6 +101,33 @@ pub struct RunResult {
     pub waypoints: Option<usize>,
     /// Exact verification of the plan (`None` without a plan).
     pub verified: Option<bool>,
+    /// For an instance of the hard-case family (`passage:`), what post-processing
+    /// made of the plan and the clearance it keeps through the openings.
+    pub passage: Option<PassageResult>,
+}
+
+/// The plan of a `passage:` instance after `arc plan`'s post-processing, and the
+/// clearance the raw and the post-processed plan keep through its openings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassageResult {
+    /// Post-processing time (s), not part of the planning time.
+    pub post_s: f64,
+    /// Exact verification of the post-processed plan.
+    pub verified: bool,
+    /// Per opening, the raw plan's and the post-processed plan's clearance.
+    pub openings: Vec<(OpeningClearance, OpeningClearance)>,
+}
+
+impl PassageResult {
+    /// The smallest ratio of clearance to target over the openings, raw and
+    /// post-processed.
+    pub fn worst_ratio(&self) -> (f64, f64) {
+        self.openings
+            .iter()
+            .fold((f64::INFINITY, f64::INFINITY), |(a, b), (r, p)| {
+                (a.min(r.clearance / r.target), b.min(p.clearance / p.target))
+            })
+    }
 }
 
 impl RunResult {
@@ -126,6 +154,7 @@ impl RunResult {
             build_capped: false,
             waypoints: None,
             verified: None,
+            passage: None,
         }
     }
 
@@ -441,6 +470,9 @@ fn run_arc(
     r.tables_s = tables_s;
     r.roadmap_vertices = spec.key.vertices;
     if let Ok(sol) = res {
+        if let Some(p) = spec.key.scenario.strip_prefix("passage:") {
+            r.passage = passage_result(env, &planner, &sol, p);
+        }
         let s = &sol.stats;
         r.roadmap_vertices = s.roadmap_vertices;
         r.shape_changes = Some(s.shape_changes);
@@ -450,6 +482,31 @@ fn run_arc(
         r.collision_checks = Some(s.collision_checks);
     }
     r
+}
+
+/// Post-processes `sol` as `arc plan` does and measures the clearance through the
+/// openings of the `passage:` instance `name` (`None` when the name does not parse).
+fn passage_result(
+    env: &Env,
+    planner: &ArcPlanner,
+    sol: &Solution<aerial_chain::planner::Stats>,
+    name: &str,
+) -> Option<PassageResult> {
+    let spec = PassageSpec::parse(name).ok()?;
+    let params = *planner.context().params();
+    let g = &env.scenario.grid;
+    let as_plan = |s| to_plan(s, &params, g.resolution(), g.unknown_is_occupied());
+    let t = Instant::now();
+    let (post, _) = planner.refine(sol, None);
+    let post_s = t.elapsed().as_secs_f64();
+    let (raw, post) = (as_plan(sol), as_plan(&post));
+    let raw_o = spec.opening_clearances(&raw, &params).ok()?;
+    let post_o = spec.opening_clearances(&post, &params).ok()?;
+    Some(PassageResult {
+        post_s,
+        verified: verify_plan(g, &post).ok,
+        openings: raw_o.into_iter().zip(post_o).collect(),
+    })
 }
 
 fn run_prm(

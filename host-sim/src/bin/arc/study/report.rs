@@ -32,14 +32,14 @@ pub fn runs_csv(results: &[RunResult]) -> String {
     let mut s = String::from(
         "study,scenario,units,method,vertices,srs,seed,time_limit_s,start_x,start_y,start_z,success,outcome,\
          tables_s,roadmap_s,planning_s,roadmap_cpu_s,planning_cpu_s,collision_s,search_s,shape_changes,edges,replans,srs_connects,\
-         iterations,collision_checks,roadmap_vertices,build_capped,waypoints,verified,message\n",
+         iterations,collision_checks,roadmap_vertices,build_capped,waypoints,verified,post_s,openings,message\n",
     );
     for r in results {
         let p = &r.spec;
         let start = p.query.map(|q| q.start);
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             key_cells(&p.key),
             p.seed,
             opt(p.time_limit),
@@ -65,10 +65,27 @@ pub fn runs_csv(results: &[RunResult]) -> String {
             r.build_capped,
             opt(r.waypoints),
             opt(r.verified),
+            opt(r.passage.as_ref().map(|p| format!("{:.6}", p.post_s))),
+            r.passage.as_ref().map_or(String::new(), openings_cell),
             csv_field(&r.message)
         );
     }
     s
+}
+
+/// Per opening of a `passage:` instance: `name:width:target:raw:post` (m), joined by
+/// spaces.
+fn openings_cell(p: &super::PassageResult) -> String {
+    p.openings
+        .iter()
+        .map(|(r, q)| {
+            format!(
+                "{}:{:.3}:{:.4}:{:.4}:{:.4}",
+                r.name, r.width, r.target, r.clearance, q.clearance
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 fn spread_cols(s: &Spread) -> String {

@@ -142,6 +142,7 @@ pub fn markdown(results: &[RunResult], redrawn: usize, meta: &str) -> String {
             Spread::of(ok.iter().copied()).median
         );
     }
+    s += &openings_markdown(&solved);
     let failed: Vec<&RunResult> = results.iter().filter(|r| !r.success).collect();
     if !failed.is_empty() {
         s += "\nFailures:\n\n";
@@ -153,6 +154,50 @@ pub fn markdown(results: &[RunResult], redrawn: usize, meta: &str) -> String {
         }
     }
     s += &format!("\n{meta}\n");
+    s
+}
+
+/// What the plans keep through the openings, raw and post-processed.
+fn openings_markdown(solved: &[&RunResult]) -> String {
+    let with: Vec<&super::PassageResult> =
+        solved.iter().filter_map(|r| r.passage.as_ref()).collect();
+    if with.is_empty() {
+        return String::new();
+    }
+    let post_ms: Vec<f64> = with.iter().map(|p| p.post_s * 1e3).collect();
+    let verified = with.iter().filter(|p| p.verified).count();
+    let ratios = |post: bool| -> Vec<f64> {
+        with.iter()
+            .map(|p| {
+                let (r, q) = p.worst_ratio();
+                if post {
+                    q
+                } else {
+                    r
+                }
+            })
+            .collect()
+    };
+    let mut s = format!(
+        "\nThrough the openings: the smallest clearance a plan keeps from each wall with an opening \
+         (window or door) against what the passages issue asks, 0.9 (w - 2 r_u) / 2 for an opening w wide; \
+         the worst opening of each instance counts. Post-processed as `arc plan` does: median {:.1} ms, \
+         p95 {:.1} ms; {verified} of {} post-processed plans verified.\n\n\
+         | plan | at or above the target | worst ratio | median ratio |\n|---|---|---|---|\n",
+        quantile(&post_ms, 0.5),
+        quantile(&post_ms, 0.95),
+        with.len()
+    );
+    for (name, post) in [("raw", false), ("post-processed", true)] {
+        let v = ratios(post);
+        let ok = v.iter().filter(|&&x| x >= 1.0 - 1e-9).count();
+        s += &format!(
+            "| {name} | {ok} of {} | {:.2} | {:.2} |\n",
+            v.len(),
+            v.iter().copied().fold(f64::INFINITY, f64::min),
+            quantile(&v, 0.5)
+        );
+    }
     s
 }
 

@@ -1,0 +1,654 @@
+//! Widening: the last stage of post-processing moves the plan's stations (the head
+//! positions where it stops, with every shape change made there) towards the middle of
+//! narrow passages, so that a plan keeps as much clearance through an opening as the
+//! opening allows, not just the margin the search checked at.
+//!
+//! The search checks at the preferred clearance (`--clearance`, 0.05 m); through a
+//! 0.5 m window the chain's units could keep 0.1 m, and a plan that passes 1 cm from
+//! the preferred margin's edge is valid but needlessly close. Widening looks at the
+//! edges whose units come within [`CAP`] of the map, narrowest first, and moves a
+//! station next to the narrowest one (or both ends of a translation together) a small
+//! step at a time, in the direction that most increases that unit's clearance, while
+//! the narrowest clearance of every edge the move touches grows. Each move is checked
+//! as the search checks (the same margin), so the plan stays as admissible as before;
+//! clearance is measured exactly (sphere against voxel cube) at the verifier's samples.
+//!
+//! The start and the goal stay where they are. Work is counted in edge measurements
+//! ([`BUDGET`]), not time, so the result is deterministic.
+
+use nalgebra::{Point3, Vector3};
+
+use super::{Checker, Step};
+use crate::collision::exact::{exact_clearance, positions_f64};
+use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
+use crate::collision::CollisionContext;
+
+/// Clearances at or above this (m) are wide enough: widening leaves them alone.
+pub const CAP: f64 = 0.25;
+
+/// Edge measurements widening may spend on one plan.
+pub const BUDGET: usize = 300;
+
+/// Step lengths tried, as fractions of the map's resolution, largest first.
+const STEPS: [f64; 3] = [0.4, 0.15, 0.05];
+
+/// Directions tried per step: the clearance's gradient, then the nearest lattice
+/// directions (axes and face diagonals) that also widen.
+const DIRECTIONS: usize = 3;
+
+/// Samples of an edge are measured at the verifier's spacing times this: no unit
+/// moves more than `SAMPLE_SPACING r_v / 4` between two, so a narrowest missed in
+/// between is at most that much narrower (the clearance changes no faster than the
+/// unit moves); `arc verify` reports the exact figure.
+const SAMPLE_SPACING: f64 = 2.0;
+
+/// Translations widening may split into three (per plan).
+const MAX_SPLITS: usize = 2;
+
+/// An edge whose narrowest unit keeps this share of what the middle of its passage
+/// would keep is wide enough.
+const CENTRED: f64 = 0.97;
+
+/// Smallest gain (m) that counts as widening.
+const GAIN: f64 = 1e-4;
+
+/// A run of steps at one head position: the translation into it, its shape changes,
+/// and the translation out of it move with it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Station {
+    first: usize,
+    last: usize,
+}
+
+/// The narrowest sample of an edge: its clearance and where (unit centre).
+#[derive(Clone, Copy, Debug)]
+struct Narrowest {
+    clearance: f64,
+    at: Point3<f64>,
+}
+
+/// What widening did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Widening {
+    /// The plan's narrowest unit clearance before and after (m, at most [`CAP`]).
+    pub before: f64,
+    /// After.
+    pub after: f64,
+    /// After, over the edges whose narrowest unit is in a passage (obstacles on both
+    /// sides, see `Widener::passage`); `None` when there is none.
+    pub in_passages: Option<f64>,
+    /// Stations moved (accepted moves).
+    pub moves: usize,
+}
+
+/// Moves the stations of `steps` towards the middle of narrow passages (see the module
+/// docs). `ctx` is the context the plan was checked in; moves must pass its checks,
+/// or, for an edge that did not pass them before (where the search gave way), those of
+/// `ctx_min`.
+pub(super) fn widen(
+    ctx: &CollisionContext,
+    ctx_min: &CollisionContext,
+    steps: Vec<Step>,
+) -> (Vec<Step>, Widening) {
+    let mut w = Widener {
+        ctx,
+        check: Checker::new(ctx.clone(), None),
+        check_min: Checker::new(ctx_min.clone(), None),
+        narrow: Vec::new(),
+        steps,
+        spent: 0,
+        splits: 0,
+        stuck: Vec::new(),
+    };
+    let start = w.steps.clone();
+    w.narrow = (0..start.len().saturating_sub(1))
+        .map(|e| w.measure(e, &start))
+        .collect();
+    w.stuck = vec![false; w.narrow.len()];
+    let before = w.narrowest();
+    let mut moves = 0;
+    while w.spent < BUDGET {
+        let Some(e) = w.worst() else { break };
+        if w.improve(e) {
+            moves += 1;
+        } else {
+            w.stuck[e] = true;
+        }
+    }
+    let after = w.narrowest();
+    let in_passages = w.narrowest_in_passages();
+    (
+        w.steps,
+        Widening {
+            before,
+            after,
+            in_passages,
+            moves,
+        },
+    )
+}
+
+struct Widener<'a> {
+    ctx: &'a CollisionContext,
+    check: Checker,
+    check_min: Checker,
+    steps: Vec<Step>,
+    /// Per edge `e` (steps `e` to `e + 1`), its narrowest sample.
+    narrow: Vec<Narrowest>,
+    /// Edges no move widens any more.
+    stuck: Vec<bool>,
+    spent: usize,
+    /// Translations split so far.
+    splits: usize,
+}
+
+impl Widener<'_> {
+    fn narrowest(&self) -> f64 {
+        self.narrow.iter().map(|n| n.clearance).fold(CAP, f64::min)
+    }
+
+    /// The narrowest clearance over the edges whose narrowest unit is in a passage.
+    fn narrowest_in_passages(&self) -> Option<f64> {
+        (0..self.narrow.len())
+            .filter(|&e| self.narrow[e].clearance < CAP)
+            .filter(|&e| {
+                self.passage(
+                    self.narrow[e].at,
+                    self.gradient(self.narrow[e].at),
+                    self.along(e),
+                )
+                .is_some()
+            })
+            .map(|e| self.narrow[e].clearance)
+            .min_by(f64::total_cmp)
+    }
+
+    /// The direction of edge `e` when it is a translation.
+    fn along(&self, e: usize) -> Option<Vector3<f64>> {
+        let (xa, xb) = (self.steps[e].xi, self.steps[e + 1].xi);
+        Vector3::new(xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]).try_normalize(1e-9)
+    }
+
+    /// The narrowest edge below [`CAP`] that may still widen.
+    fn worst(&self) -> Option<usize> {
+        (0..self.narrow.len())
+            .filter(|&e| !self.stuck[e] && self.narrow[e].clearance < CAP)
+            .min_by(|&a, &b| {
+                self.narrow[a]
+                    .clearance
+                    .total_cmp(&self.narrow[b].clearance)
+            })
+    }
+
+    /// The station holding step `i`.
+    fn station(&self, i: usize) -> Station {
+        let xi = self.steps[i].xi;
+        let mut s = Station { first: i, last: i };
+        while s.first > 0 && self.steps[s.first - 1].xi == xi {
+            s.first -= 1;
+        }
+        while s.last + 1 < self.steps.len() && self.steps[s.last + 1].xi == xi {
+            s.last += 1;
+        }
+        s
+    }
+
+    /// Whether `s` may move: the start's and the goal's stations stay.
+    fn movable(&self, s: Station) -> bool {
+        s.first > 0 && s.last + 1 < self.steps.len()
+    }
+
+    /// Tries to widen edge `e`: moves of the stations at its ends, in the directions
+    /// that widen its narrowest sample, largest step first. Returns whether a move was
+    /// taken.
+    fn improve(&mut self, e: usize) -> bool {
+        let (a, b) = (self.station(e), self.station(e + 1));
+        let mut groups: Vec<Vec<Station>> = Vec::new();
+        if a == b {
+            groups.push(vec![a]);
+        } else {
+            groups.push(vec![a, b]);
+            groups.push(vec![a]);
+            groups.push(vec![b]);
+        }
+        groups.retain(|g| g.iter().all(|&s| self.movable(s)));
+        // Along a translation, moving its stations along it changes little: only the
+        // part of a move across it widens.
+        let along = self.along(e);
+        let narrow = self.narrow[e];
+        let grad = self.gradient(narrow.at);
+        match self.passage(narrow.at, grad, along) {
+            Some(best) if narrow.clearance < CENTRED * best => {}
+            // Open on one side, or as wide as the passage allows.
+            _ => return false,
+        }
+        if !groups.is_empty() && self.try_groups(e, &groups, grad, along) {
+            return true;
+        }
+        self.splits < MAX_SPLITS && self.split(e)
+    }
+
+    /// Tries the moves of `groups` along `grad` (then other directions); whether one
+    /// was taken.
+    fn try_groups(
+        &mut self,
+        e: usize,
+        groups: &[Vec<Station>],
+        grad: Vector3<f64>,
+        along: Option<Vector3<f64>>,
+    ) -> bool {
+        let dirs = self.directions(grad, along);
+        let r_v = self.ctx.field().grid().resolution();
+        // Along the gradient at every step length; the other directions only at the
+        // smallest, where the gradient's own step has failed.
+        let mut tries: Vec<(f64, &Vector3<f64>)> = STEPS
+            .iter()
+            .flat_map(|&f| dirs.first().map(|d| (f, d)))
+            .collect();
+        let last = STEPS[STEPS.len() - 1];
+        tries.extend(dirs.iter().skip(1).map(|d| (last, d)));
+        for (f, d) in tries {
+            for g in groups {
+                if self.spent >= BUDGET {
+                    return false;
+                }
+                if self.try_move(g, d * (f * r_v), e) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// Splits translation `e` around the stretch where the chain passes near the map
+    /// (any unit within [`CAP`] of it, by the distance field's bound): two stations on
+    /// the segment, so that the stretch can move across as one. The plan flies the
+    /// same path. Whether it split.
+    fn split(&mut self, e: usize) -> bool {
+        let Some(_) = self.along(e) else {
+            return false;
+        };
+        let params = self.ctx.params();
+        let (l, r_u) = (params.link_length as f64, params.unit_radius as f64);
+        let (a, b) = (zeta(&self.steps[e]), zeta(&self.steps[e + 1]));
+        let kind = classify_edge(&a, &b);
+        let field = self.ctx.field();
+        let r_v = field.grid().resolution();
+        let n = edge_intervals(kind, l, &a, &b, r_v).max(1);
+        let near: Vec<f64> = (0..=n)
+            .map(|j| j as f64 / n as f64)
+            .filter(|&t| {
+                let z = edge_sample(kind, &a, &b, t);
+                positions_f64(l, [z[0], z[1], z[2]], &z[3..])
+                    .into_iter()
+                    .any(|p| field.clearance_above(p, CAP + r_u) < CAP + r_u)
+            })
+            .collect();
+        let (Some(&lo), Some(&hi)) = (near.first(), near.last()) else {
+            return false;
+        };
+        let len = (0..3).map(|i| (b[i] - a[i]).powi(2)).sum::<f64>().sqrt();
+        let margin = (2.0 * r_v / len).min(0.25);
+        let (lo, hi) = ((lo - margin).max(margin), (hi + margin).min(1.0 - margin));
+        if hi - lo < margin {
+            return false;
+        }
+        let at = |t: f64| {
+            let mut s = self.steps[e + 1];
+            s.xi = [0, 1, 2].map(|i| a[i] + t * (b[i] - a[i]));
+            s.shape_change = false;
+            s
+        };
+        let (p, q) = (at(lo), at(hi));
+        self.steps.splice(e + 1..e + 1, [p, q]);
+        let steps = self.steps.clone();
+        let fresh: Vec<Narrowest> = (e..e + 3).map(|k| self.measure(k, &steps)).collect();
+        self.narrow.splice(e..=e, fresh);
+        self.stuck.splice(e..=e, [false; 3]);
+        self.splits += 1;
+        true
+    }
+
+    /// Candidate directions at `p`: the exact clearance's gradient there, then the
+    /// axis and face-diagonal directions that increase it most ([`DIRECTIONS`] in all).
+    fn directions(&self, grad: Vector3<f64>, along: Option<Vector3<f64>>) -> Vec<Vector3<f64>> {
+        let across = |v: Vector3<f64>| match along {
+            Some(u) => v - u * u.dot(&v),
+            None => v,
+        };
+        let mut dirs: Vec<(f64, Vector3<f64>)> = Vec::new();
+        for x in -1i32..=1 {
+            for y in -1i32..=1 {
+                for z in -1i32..=1 {
+                    let n = x.abs() + y.abs() + z.abs();
+                    if n == 0 || n == 3 {
+                        continue;
+                    }
+                    let Some(d) =
+                        across(Vector3::new(x as f64, y as f64, z as f64)).try_normalize(1e-9)
+                    else {
+                        continue;
+                    };
+                    let gain = d.dot(&grad);
+                    if gain > 0.0 {
+                        dirs.push((gain, d));
+                    }
+                }
+            }
+        }
+        dirs.sort_by(|a, b| b.0.total_cmp(&a.0));
+        across(grad)
+            .try_normalize(1e-12)
+            .into_iter()
+            .chain(dirs.into_iter().map(|(_, d)| d))
+            .take(DIRECTIONS)
+            .collect()
+    }
+
+    /// The gradient of the distance to the map at `p` (central differences).
+    fn gradient(&self, p: Point3<f64>) -> Vector3<f64> {
+        let h = self.ctx.field().grid().resolution() / 8.0;
+        Vector3::from_fn(|i, _| {
+            let mut e = Vector3::zeros();
+            e[i] = h;
+            (self.distance(p + e) - self.distance(p - e)) / (2.0 * h)
+        })
+    }
+
+    /// The clearance a unit would keep in the middle of the passage at `p`: over the
+    /// lines through `p` across `along` (the projected gradient `across` and the axes),
+    /// the shortest free chord with obstacles on both sides, halved, less the unit's
+    /// radius. `None` when no line meets obstacles on both sides within reach: open
+    /// space, or a passage wider than [`CAP`] allows to matter.
+    fn passage(
+        &self,
+        p: Point3<f64>,
+        across: Vector3<f64>,
+        along: Option<Vector3<f64>>,
+    ) -> Option<f64> {
+        let flat = |v: Vector3<f64>| match along {
+            Some(u) => v - u * u.dot(&v),
+            None => v,
+        };
+        let r_u = self.ctx.params().unit_radius as f64;
+        let lines: Vec<Vector3<f64>> = [across, Vector3::x(), Vector3::y(), Vector3::z()]
+            .iter()
+            .filter_map(|&v| flat(v).try_normalize(1e-6))
+            .collect();
+        // A unit about to enter an opening is narrowest in front of it: the passage's
+        // cross-section lies a little further along.
+        let shifts: &[f64] = match along {
+            Some(_) => &[0.0, 0.05, -0.05, 0.1, -0.1, 0.2, -0.2],
+            None => &[0.0],
+        };
+        let u_along = along.unwrap_or_else(Vector3::zeros);
+        shifts
+            .iter()
+            .map(|&s| p + u_along * s)
+            .flat_map(|q| lines.iter().map(move |&u| (q, u)))
+            .filter_map(|(q, u)| Some(self.free_run(q, u)? + self.free_run(q, -u)?))
+            .map(|chord| chord / 2.0 - r_u)
+            .min_by(f64::total_cmp)
+    }
+
+    /// How far from `p` along `u` the first obstacle lies, within `2 (CAP + r_u)`:
+    /// sphere tracing, with the distance field's lower bound while it is large and the
+    /// exact distance near the obstacle.
+    fn free_run(&self, p: Point3<f64>, u: Vector3<f64>) -> Option<f64> {
+        let f = self.ctx.field();
+        let r_v = f.grid().resolution();
+        let reach = 2.0 * (CAP + self.ctx.params().unit_radius as f64);
+        let mut t = 0.0;
+        while t < reach {
+            let q = p + u * t;
+            let mut d = f.clearance(q);
+            if d < r_v {
+                d = self.distance(q);
+                if d < 1e-3 {
+                    return Some(t);
+                }
+            }
+            t += d.max(1e-3);
+        }
+        None
+    }
+
+    /// Distance from `p` to the nearest obstacle cube, capped at `CAP + r_u`.
+    fn distance(&self, p: Point3<f64>) -> f64 {
+        let cap = CAP + self.ctx.params().unit_radius as f64;
+        let f = self.ctx.field();
+        if f.clearance_above(p, cap) >= cap {
+            return cap;
+        }
+        exact_clearance(f, p, 0.0, cap).min(cap)
+    }
+
+    /// Moves the stations of `group` by `delta` when that widens every edge it touches
+    /// whose narrowest sample is below the old narrowest of them, and the moved edges
+    /// pass the checks. Returns whether the move was taken.
+    fn try_move(&mut self, group: &[Station], delta: Vector3<f64>, first: usize) -> bool {
+        let mut moved = self.steps.clone();
+        for s in group {
+            for st in &mut moved[s.first..=s.last] {
+                st.xi = [st.xi[0] + delta.x, st.xi[1] + delta.y, st.xi[2] + delta.z];
+            }
+        }
+        let lo = group
+            .iter()
+            .map(|s| s.first)
+            .min()
+            .unwrap_or(0)
+            .saturating_sub(1);
+        let hi = group
+            .iter()
+            .map(|s| s.last)
+            .max()
+            .unwrap_or(0)
+            .min(self.narrow.len() - 1);
+        let old = (lo..=hi)
+            .map(|e| self.narrow[e].clearance)
+            .fold(f64::INFINITY, f64::min);
+        // The edge being widened first: most moves that fail, fail there.
+        let mut order: Vec<usize> = (lo..=hi).collect();
+        order.sort_by_key(|&k| k != first);
+        let mut new = Vec::with_capacity(order.len());
+        for &k in &order {
+            match self.measure_above(k, &moved, old + GAIN) {
+                Some(n) => new.push((k, n)),
+                None => return false,
+            }
+        }
+        if !(lo..=hi).all(|k| self.admissible(k, &moved)) {
+            return false;
+        }
+        for (k, n) in new {
+            self.narrow[k] = n;
+            self.stuck[k] = false;
+        }
+        self.steps = moved;
+        true
+    }
+
+    /// Whether edge `e` of `moved` passes the search's checks, or, where the current
+    /// edge `e` does not (the search gave way there), the smallest clearance's checks.
+    fn admissible(&mut self, e: usize, moved: &[Step]) -> bool {
+        if edge_passes(&mut self.check, &moved[e], &moved[e + 1]) {
+            return true;
+        }
+        !edge_passes(&mut self.check, &self.steps[e], &self.steps[e + 1])
+            && edge_passes(&mut self.check_min, &moved[e], &moved[e + 1])
+    }
+
+    /// The narrowest unit clearance of edge `e` of `steps`, exactly, at the verifier's
+    /// samples (capped at [`CAP`]). The distance field's proven lower bound picks the
+    /// samples that can hold the minimum (the exact distance exceeds the bound by at
+    /// most `r_v sqrt(3)`); only those are measured exactly, lowest bound first.
+    fn measure(&mut self, e: usize, steps: &[Step]) -> Narrowest {
+        self.measure_above(e, steps, f64::NEG_INFINITY)
+            .expect("no clearance is at or below minus infinity")
+    }
+
+    /// [`Self::measure`], giving up (`None`) at the first sample at or below `floor`.
+    fn measure_above(&mut self, e: usize, steps: &[Step], floor: f64) -> Option<Narrowest> {
+        self.spent += 1;
+        let params = self.ctx.params();
+        let (l, r_u) = (params.link_length as f64, params.unit_radius as f64);
+        let (a, b) = (zeta(&steps[e]), zeta(&steps[e + 1]));
+        let kind = classify_edge(&a, &b);
+        let field = self.ctx.field();
+        let r_v = field.grid().resolution();
+        let cap = CAP + r_u;
+        let n = edge_intervals(kind, l, &a, &b, SAMPLE_SPACING * r_v).max(1);
+        let mut bounds: Vec<(f64, Point3<f64>)> = Vec::new();
+        for j in 0..=n {
+            let z = edge_sample(kind, &a, &b, j as f64 / n as f64);
+            for p in positions_f64(l, [z[0], z[1], z[2]], &z[3..]) {
+                let lb = field.clearance_above(p, cap);
+                if lb < cap {
+                    bounds.push((lb, p));
+                }
+            }
+        }
+        bounds.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let mut best = Narrowest {
+            clearance: CAP,
+            at: Point3::from(steps[e].xi),
+        };
+        let within = bounds.first().map_or(0.0, |f| f.0 + r_v * 3f64.sqrt());
+        for (lb, p) in bounds {
+            // A bound within a micrometre of the best is as good as equal: the samples
+            // along a flat face all share it.
+            if lb - r_u + 1e-6 >= best.clearance || lb > within {
+                break;
+            }
+            // Near the cap the bound is close enough: the exact measure there costs
+            // the most (the farthest rings) and matters the least.
+            let c = if lb - r_u >= CAP - r_v {
+                lb - r_u
+            } else {
+                self.distance(p) - r_u
+            };
+            if c <= floor {
+                return None;
+            }
+            if c < best.clearance {
+                best = Narrowest {
+                    clearance: c,
+                    at: p,
+                };
+            }
+        }
+        Some(best)
+    }
+}
+
+/// Whether the edge from `a` to `b` passes `check` (a translation or a shape change).
+fn edge_passes(check: &mut Checker, a: &Step, b: &Step) -> bool {
+    if a.xi != b.xi {
+        check.translation(a.xi, b.xi, &b.shape)
+    } else {
+        check.shape_change(a.xi, &a.shape, &b.shape)
+    }
+}
+
+/// A step's configuration `zeta` in `f64`.
+fn zeta(s: &Step) -> Vec<f64> {
+    s.xi.iter()
+        .copied()
+        .chain(s.shape.as_slice().iter().map(|&v| v as f64))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::map::grid::{Cell, Grid};
+    use crate::map::DistanceField;
+    use crate::planner::Source;
+    use aerial_chain_core::{ChainParams, Shape};
+    use std::sync::Arc;
+
+    /// A 0.1 m wall at x = 2 with a 0.5 m square window centred at y = z = 1.
+    fn window() -> CollisionContext {
+        let mut g = Grid::new(0.05, [-20, 0, 0], [100, 40, 40], Cell::Free, false).unwrap();
+        g.fill_box([2.01, 0.0, 0.0], [2.09, 2.0, 2.0], Cell::Occupied);
+        g.fill_box([2.01, 0.76, 0.76], [2.09, 1.24, 1.24], Cell::Free);
+        let field = Arc::new(DistanceField::new(g));
+        CollisionContext::new(field, ChainParams::new(3), 0.05).unwrap()
+    }
+
+    fn step(xi: [f64; 3], shape: &Shape) -> Step {
+        Step {
+            xi,
+            shape: *shape,
+            source: Source::Follow,
+            shape_change: false,
+        }
+    }
+
+    #[test]
+    fn an_off_centre_passage_moves_to_the_middle_and_stays_admissible() {
+        let ctx = window();
+        let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
+        // Through the window 4 cm off its centre line in y and 3 cm in z.
+        let (y, z) = (1.04, 0.97);
+        let steps = vec![
+            step([0.4, 1.0, 1.0], &straight),
+            step([1.2, y, z], &straight),
+            step([3.6, y, z], &straight),
+            step([3.8, 1.0, 1.0], &straight),
+        ];
+        let mut check = Checker::new(ctx.clone(), None);
+        for w in steps.windows(2) {
+            assert!(edge_passes(&mut check, &w[0], &w[1]));
+        }
+        let (out, report) = widen(&ctx, &ctx, steps.clone());
+        // The start and the goal stay; stations may be added (splits), shapes stay.
+        assert!(out.len() >= steps.len());
+        assert_eq!(out[0].xi, steps[0].xi);
+        assert_eq!(out[out.len() - 1].xi, steps[3].xi);
+        assert!(out.iter().all(|s| s.shape == straight));
+        // The unit sphere (0.15 m) in a 0.5 m window keeps at most 0.1 m.
+        assert!(report.before < 0.065, "{report:?}");
+        assert!(report.after > 0.09, "{report:?}");
+        for w in out.windows(2) {
+            assert!(edge_passes(&mut check, &w[0], &w[1]));
+        }
+    }
+
+    #[test]
+    fn a_passage_between_start_and_goal_is_split_and_centred() {
+        let ctx = window();
+        let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
+        // One translation from the start to the goal, both of which stay, 4 cm off the
+        // window's centre line.
+        let steps = vec![
+            step([1.2, 1.04, 1.0], &straight),
+            step([3.6, 1.04, 1.0], &straight),
+        ];
+        let (out, report) = widen(&ctx, &ctx, steps.clone());
+        assert_eq!(out.len(), 4, "{out:?}");
+        assert_eq!((out[0].xi, out[3].xi), (steps[0].xi, steps[1].xi));
+        assert!(out.iter().all(|s| s.shape == straight && !s.shape_change));
+        assert!(report.before < 0.065 && report.after > 0.09, "{report:?}");
+        let mut check = Checker::new(ctx.clone(), None);
+        for w in out.windows(2) {
+            assert!(edge_passes(&mut check, &w[0], &w[1]));
+        }
+    }
+
+    #[test]
+    fn wide_plans_are_left_alone() {
+        let ctx = window();
+        let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
+        let steps = vec![
+            step([0.4, 1.0, 1.0], &straight),
+            step([1.0, 1.0, 1.0], &straight),
+            step([1.4, 1.0, 1.0], &straight),
+        ];
+        let (out, report) = widen(&ctx, &ctx, steps.clone());
+        assert_eq!(out, steps);
+        assert_eq!(report.moves, 0);
+        assert_eq!(report.before, CAP);
+    }
+}
