@@ -586,55 +586,51 @@ mod tests {
         }
     }
 
+    /// Widens `steps` in the window and checks what every widened plan must be: the
+    /// start and the goal where they were, the shapes kept, every edge admissible, and
+    /// the unit sphere (0.15 m) in the 0.5 m window from below 0.065 m to above 0.09 m
+    /// (0.1 m is the most it can keep). Returns the plan.
+    fn widened_in_the_window(steps: &[Step]) -> Vec<Step> {
+        let ctx = window();
+        let mut check = Checker::new(ctx.clone(), None);
+        assert!(steps
+            .windows(2)
+            .all(|w| edge_passes(&mut check, &w[0], &w[1])));
+        let (out, report) = widen(&ctx, &ctx, steps.to_vec());
+        let (first, last) = (&steps[0], &steps[steps.len() - 1]);
+        assert_eq!((out[0].xi, out[out.len() - 1].xi), (first.xi, last.xi));
+        assert!(out.iter().all(|s| s.shape == first.shape));
+        assert!(report.before < 0.065 && report.after > 0.09, "{report:?}");
+        assert!(out
+            .windows(2)
+            .all(|w| edge_passes(&mut check, &w[0], &w[1])));
+        out
+    }
+
     #[test]
     fn an_off_centre_passage_moves_to_the_middle_and_stays_admissible() {
-        let ctx = window();
         let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
         // Through the window 4 cm off its centre line in y and 3 cm in z.
         let (y, z) = (1.04, 0.97);
-        let steps = vec![
+        let out = widened_in_the_window(&[
             step([0.4, 1.0, 1.0], &straight),
             step([1.2, y, z], &straight),
             step([3.6, y, z], &straight),
             step([3.8, 1.0, 1.0], &straight),
-        ];
-        let mut check = Checker::new(ctx.clone(), None);
-        for w in steps.windows(2) {
-            assert!(edge_passes(&mut check, &w[0], &w[1]));
-        }
-        let (out, report) = widen(&ctx, &ctx, steps.clone());
-        // The start and the goal stay; stations may be added (splits), shapes stay.
-        assert!(out.len() >= steps.len());
-        assert_eq!(out[0].xi, steps[0].xi);
-        assert_eq!(out[out.len() - 1].xi, steps[3].xi);
-        assert!(out.iter().all(|s| s.shape == straight));
-        // The unit sphere (0.15 m) in a 0.5 m window keeps at most 0.1 m.
-        assert!(report.before < 0.065, "{report:?}");
-        assert!(report.after > 0.09, "{report:?}");
-        for w in out.windows(2) {
-            assert!(edge_passes(&mut check, &w[0], &w[1]));
-        }
+        ]);
+        assert!(out.len() >= 4);
     }
 
     #[test]
     fn a_passage_between_start_and_goal_is_split_and_centred() {
-        let ctx = window();
         let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
-        // One translation from the start to the goal, both of which stay, 4 cm off the
-        // window's centre line.
-        let steps = vec![
+        // One translation from the start to the goal, both of which stay.
+        let out = widened_in_the_window(&[
             step([1.2, 1.04, 1.0], &straight),
             step([3.6, 1.04, 1.0], &straight),
-        ];
-        let (out, report) = widen(&ctx, &ctx, steps.clone());
+        ]);
         assert_eq!(out.len(), 4, "{out:?}");
-        assert_eq!((out[0].xi, out[3].xi), (steps[0].xi, steps[1].xi));
-        assert!(out.iter().all(|s| s.shape == straight && !s.shape_change));
-        assert!(report.before < 0.065 && report.after > 0.09, "{report:?}");
-        let mut check = Checker::new(ctx.clone(), None);
-        for w in out.windows(2) {
-            assert!(edge_passes(&mut check, &w[0], &w[1]));
-        }
+        assert!(out.iter().all(|s| !s.shape_change));
     }
 
     #[test]
