@@ -46,6 +46,10 @@ const KEEP_SLACK: f64 = 0.005;
 /// refuse shortcuts for next to no clearance.
 const KEEP_GAIN: f64 = 0.025;
 
+/// Post-processing that keeps a widened passage's margin is taken unless it asks for
+/// more than this share of the shape motion of post-processing that does not.
+const KEEP_MOTION: f64 = 1.02;
+
 /// Angles closer than this (rad) are the same shape: no shape change is needed.
 const SAME_SHAPE: f32 = 1e-6;
 
@@ -121,38 +125,59 @@ impl ArcPlanner {
         deadline: Option<Instant>,
     ) -> (Solution<Stats>, Refinement) {
         let began = Instant::now();
+        // As before widening existed: shortcuts and smaller shape changes at the
+        // search's margin.
+        let (steps, mut checks) = self.shortcut(&self.ctx, &solution.steps, deadline);
+        let mut chosen = (steps, self.ctx.clone(), 0);
         // Widen the search's plan first, where it has the most stations to move; then
-        // refine and shorten without giving back what that won (`keep_margin`).
+        // refine and shorten without giving back what that won (`keep_margin`). The
+        // result is taken unless it asks for more shape motion (where a narrow door
+        // keeps the margin up, fewer shortcuts may pass).
         let (widened, first) =
             super::widen::widen(&self.ctx, &self.ctx_min, solution.steps.clone());
-        // Where there is nothing to keep, refine what the search found, as before.
-        let (ctx, raw) = match self.keep_margin(first.in_passages) {
-            Some(ctx) => (ctx, widened),
-            None => (self.ctx.clone(), solution.steps.clone()),
-        };
-        let mut pass = Pass {
-            checker: Checker::new(ctx.clone(), deadline),
-            poses: &raw,
-            checks: 0,
-        };
-        let steps = pass.run();
-        let steps = pass.shrink_changes(steps);
-        let steps = super::shorten::shorten(&mut pass, steps);
+        if let Some(ctx) = self.keep_margin(first.in_passages) {
+            let (kept, spent) = self.shortcut(&ctx, &widened, deadline);
+            checks += spent;
+            let motion = |s: &[Step]| Quality::of(s).shape_motion_rad;
+            if motion(&kept) <= motion(&chosen.0) * KEEP_MOTION + 1e-9 {
+                chosen = (kept, ctx, first.moves);
+            }
+        }
+        let (steps, ctx, first_moves) = chosen;
         let (steps, last) = super::widen::widen(&ctx, &self.ctx_min, steps);
         let mut stats = solution.stats.clone();
         super::construction::count_sources(&steps, &mut stats);
         let report = Refinement {
             before: Quality::of(&solution.steps),
             after: Quality::of(&steps),
-            checks: pass.checks,
+            checks,
             widening: Widening {
                 before: first.before,
-                moves: first.moves + last.moves,
+                moves: first_moves + last.moves,
                 ..last
             },
             time_s: began.elapsed().as_secs_f64(),
         };
         (Solution { steps, stats }, report)
+    }
+
+    /// Refinement's shortcuts and smaller changes, then shortening, over `poses`, with
+    /// the checks of `ctx`; the steps and the checks spent.
+    fn shortcut(
+        &self,
+        ctx: &CollisionContext,
+        poses: &[Step],
+        deadline: Option<Instant>,
+    ) -> (Vec<Step>, u64) {
+        let mut pass = Pass {
+            checker: Checker::new(ctx.clone(), deadline),
+            poses,
+            checks: 0,
+        };
+        let steps = pass.run();
+        let steps = pass.shrink_changes(steps);
+        let steps = super::shorten::shorten(&mut pass, steps);
+        (steps, pass.checks)
     }
 
     /// The context post-processing checks in after the search's plan was widened to
