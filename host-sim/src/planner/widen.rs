@@ -1,17 +1,21 @@
-//! Widening: the last stage of post-processing moves the plan's stations (the head
-//! positions where it stops, with every shape change made there) towards the middle of
-//! narrow passages, so that a plan keeps as much clearance through an opening as the
-//! opening allows, not just the margin the search checked at.
+//! Widening: post-processing moves the plan's stations (the head positions where it
+//! stops, with every shape change made there) towards the middle of narrow passages,
+//! so that a plan keeps as much clearance through an opening as the opening allows,
+//! not just the margin the search checked at (docs/postprocessing.md, stage 3; it runs
+//! on the search's plan and again after refinement and shortening).
 //!
 //! The search checks at the preferred clearance (`--clearance`, 0.05 m); through a
 //! 0.5 m window the chain's units could keep 0.1 m, and a plan that passes 1 cm from
 //! the preferred margin's edge is valid but needlessly close. Widening looks at the
-//! edges whose units come within [`CAP`] of the map, narrowest first, and moves a
-//! station next to the narrowest one (or both ends of a translation together) a small
-//! step at a time, in the direction that most increases that unit's clearance, while
-//! the narrowest clearance of every edge the move touches grows. Each move is checked
-//! as the search checks (the same margin), so the plan stays as admissible as before;
-//! clearance is measured exactly (sphere against voxel cube) at the verifier's samples.
+//! edges whose units come within [`CAP`] of the map, narrowest first, and, where the
+//! unit keeps less than [`CENTRED`] of what the middle of its passage would, moves a
+//! station next to it (or both ends of a translation together) a small step at a
+//! time, in the direction that most increases that unit's clearance, while the
+//! narrowest clearance of every edge the move touches grows. A translation whose ends
+//! cannot move is split. Each move passes the checks of the context it is given, so
+//! the plan stays as admissible as before. Clearance is measured exactly (sphere
+//! against voxel cube) at twice the verifier's sample spacing; within `r_v` of the cap
+//! the distance field's bound stands in for it.
 //!
 //! The start and the goal stay where they are. Work is counted in edge measurements
 //! ([`BUDGET`]), not time, so the result is deterministic.
@@ -77,7 +81,7 @@ pub struct Widening {
     /// After, over the edges whose narrowest unit is in a passage (obstacles on both
     /// sides, see `Widener::passage`); `None` when there is none.
     pub in_passages: Option<f64>,
-    /// Stations moved (accepted moves).
+    /// Moves taken: stations moved, and translations split.
     pub moves: usize,
 }
 

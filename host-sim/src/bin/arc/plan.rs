@@ -391,7 +391,7 @@ fn print_quality(report: &Report, q: &Quality, refinement: Option<&Refinement>) 
         let w = &r.widening;
         if w.before < aerial_chain::planner::WIDEN_CAP {
             report.line(format_args!(
-                "  narrowest unit clearance {:.3} m as searched, {:.3} m post-processed ({} stations moved to widen passages)",
+                "  narrowest unit clearance {:.3} m as searched, {:.3} m post-processed ({} widening moves)",
                 w.before, w.after, w.moves
             ));
         }
