@@ -31,7 +31,7 @@ use crate::collision::CollisionContext;
 pub const CAP: f64 = 0.25;
 
 /// Edge measurements widening may spend on one plan.
-pub const BUDGET: usize = 300;
+pub const BUDGET: usize = 150;
 
 /// Step lengths tried, as fractions of the map's resolution, largest first.
 const STEPS: [f64; 3] = [0.4, 0.15, 0.05];
