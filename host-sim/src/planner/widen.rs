@@ -316,10 +316,7 @@ impl Widener<'_> {
     /// Candidate directions at `p`: the exact clearance's gradient there, then the
     /// axis and face-diagonal directions that increase it most ([`DIRECTIONS`] in all).
     fn directions(&self, grad: Vector3<f64>, along: Option<Vector3<f64>>) -> Vec<Vector3<f64>> {
-        let across = |v: Vector3<f64>| match along {
-            Some(u) => v - u * u.dot(&v),
-            None => v,
-        };
+        let flat = |v| across(v, along);
         let mut dirs: Vec<(f64, Vector3<f64>)> = Vec::new();
         for x in -1i32..=1 {
             for y in -1i32..=1 {
@@ -329,7 +326,7 @@ impl Widener<'_> {
                         continue;
                     }
                     let Some(d) =
-                        across(Vector3::new(x as f64, y as f64, z as f64)).try_normalize(1e-9)
+                        flat(Vector3::new(x as f64, y as f64, z as f64)).try_normalize(1e-9)
                     else {
                         continue;
                     };
@@ -341,7 +338,7 @@ impl Widener<'_> {
             }
         }
         dirs.sort_by(|a, b| b.0.total_cmp(&a.0));
-        across(grad)
+        flat(grad)
             .try_normalize(1e-12)
             .into_iter()
             .chain(dirs.into_iter().map(|(_, d)| d))
@@ -360,24 +357,20 @@ impl Widener<'_> {
     }
 
     /// The clearance a unit would keep in the middle of the passage at `p`: over the
-    /// lines through `p` across `along` (the projected gradient `across` and the axes),
+    /// lines through `p` across `along` (the projected gradient `grad` and the axes),
     /// the shortest free chord with obstacles on both sides, halved, less the unit's
     /// radius. `None` when no line meets obstacles on both sides within reach: open
     /// space, or a passage wider than [`CAP`] allows to matter.
     fn passage(
         &self,
         p: Point3<f64>,
-        across: Vector3<f64>,
+        grad: Vector3<f64>,
         along: Option<Vector3<f64>>,
     ) -> Option<f64> {
-        let flat = |v: Vector3<f64>| match along {
-            Some(u) => v - u * u.dot(&v),
-            None => v,
-        };
         let r_u = self.ctx.params().unit_radius as f64;
-        let lines: Vec<Vector3<f64>> = [across, Vector3::x(), Vector3::y(), Vector3::z()]
+        let lines: Vec<Vector3<f64>> = [grad, Vector3::x(), Vector3::y(), Vector3::z()]
             .iter()
-            .filter_map(|&v| flat(v).try_normalize(1e-6))
+            .filter_map(|&v| across(v, along).try_normalize(1e-6))
             .collect();
         // A unit about to enter an opening is narrowest in front of it: the passage's
         // cross-section lies a little further along.
@@ -543,6 +536,14 @@ impl Widener<'_> {
             }
         }
         Some(best)
+    }
+}
+
+/// The part of `v` across the unit direction `along` (all of it without one).
+fn across(v: Vector3<f64>, along: Option<Vector3<f64>>) -> Vector3<f64> {
+    match along {
+        Some(u) => v - u * u.dot(&v),
+        None => v,
     }
 }
 
