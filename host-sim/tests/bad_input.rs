@@ -13,37 +13,29 @@ use support::{hover_plan, run, Outcome};
 /// The values every numeric flag is tried with.
 const VALUES: [&str; 5] = ["0", "-1", "nan", "inf", "1e20"];
 
-/// Largest value of each flag type, as a user would type it.
-const F64_MAX: &str = "1.7976931348623157e308";
-const F32_MAX: &str = "3.4028235e38";
-const USIZE_MAX: &str = "18446744073709551615";
-const U8_MAX: &str = "255";
+/// The flag table: subcommands, their numeric flags and the verdicts (see its header).
+const TABLE: &str = include_str!("bad_input_flags.txt");
+
+/// Largest value of a flag type, as a user would type it.
+fn type_max(ty: &str) -> &'static str {
+    match ty {
+        "f64" => "1.7976931348623157e308",
+        "f32" => "3.4028235e38",
+        "usize" | "u64" => "18446744073709551615",
+        "u8" => "255",
+        _ => panic!("bad_input_flags.txt: unknown flag type {ty:?}"),
+    }
+}
 
 /// One flag and what it does with `VALUES` then its type's maximum: `o` accepted
 /// (the run ends normally), `x` refused with exit 2, `-` accepted but too costly to
 /// run here (a whole study).
+#[derive(Clone)]
 struct Flag {
     name: &'static str,
     max: &'static str,
     verdicts: &'static str,
 }
-
-const fn flag(name: &'static str, max: &'static str, verdicts: &'static str) -> Flag {
-    Flag {
-        name,
-        max,
-        verdicts,
-    }
-}
-
-/// The chain flags every chain-making subcommand shares (`--units` is set apart).
-const CHAIN: [Flag; 5] = [
-    flag("--link-length", F32_MAX, "xxxxxx"),
-    flag("--unit-radius", F32_MAX, "xxxxxx"),
-    flag("--link-radius", F32_MAX, "xxxxxx"),
-    flag("--theta-max-deg", F32_MAX, "xxxxxx"),
-    flag("--beta-max-deg", F32_MAX, "xxxxxx"),
-];
 
 /// A subcommand: its small base command (arguments apart by spaces) and its numeric
 /// flags.
@@ -52,121 +44,62 @@ struct Case {
     flags: Vec<Flag>,
 }
 
+/// The table's commands, groups included where they are named.
 fn cases() -> Vec<Case> {
-    let mut plan = vec![
-        flag("--units", U8_MAX, "xxxxxx"),
-        flag("--goal-tol", F64_MAX, "oxxxxx"),
-        flag("--seed", "18446744073709551615", "oxxxxo"),
-        flag("--vertices", USIZE_MAX, "xxxxxx"),
-        flag("--r-t", F64_MAX, "xxxxxx"),
-        flag("--max-neighbours", USIZE_MAX, "xxxxxx"),
-        flag("--n-psi", USIZE_MAX, "xxxxxx"),
-        flag("--d-c", F32_MAX, "xxxxoo"),
-        flag("--srs", USIZE_MAX, "oxxxxx"),
-        flag("--srs-seed", "18446744073709551615", "oxxxxo"),
-        flag("--clearance", F64_MAX, "oxxxxx"),
-        flag("--follow-step", F64_MAX, "oxxxxx"),
-        flag("--max-replans", USIZE_MAX, "oxxxxx"),
-        flag("--clearance-weight", F64_MAX, "oxxxoo"),
-        flag("--max-growth", USIZE_MAX, "oxxxxx"),
-        flag("--time-limit", F64_MAX, "xxxxxx"),
-        flag("--start-yaw-deg", F64_MAX, "ooxxox"),
-    ];
-    plan.extend(CHAIN);
-    let mut prm = vec![
-        flag("--units", U8_MAX, "xxxxxx"),
-        flag("--goal-tol", F64_MAX, "oxxxxx"),
-        flag("--vertices", USIZE_MAX, "xxxxxx"),
-        flag("--k", USIZE_MAX, "xxxxxx"),
-        flag("--goal-samples", USIZE_MAX, "xxxxxx"),
-        flag("--seed", "18446744073709551615", "oxxxxo"),
-        flag("--clearance", F64_MAX, "oxxxxx"),
-        flag("--time-limit", F64_MAX, "xxxxxx"),
-    ];
-    prm.extend(CHAIN);
-    let mut build = vec![
-        flag("--units", U8_MAX, "xxxxxx"),
-        flag("--srs", USIZE_MAX, "oxxxxx"),
-        flag("--seed", "18446744073709551615", "oxxxxo"),
-        flag("--r-s", F32_MAX, "xxxxoo"),
-    ];
-    build.extend(CHAIN);
-    let mut shapes = vec![flag("--units", U8_MAX, "xxxxxx")];
-    shapes.extend(CHAIN);
-    let study = || {
-        vec![
-            flag("--seeds", "18446744073709551615", "xxxxxx"),
-            flag("--time-limit", F64_MAX, "-xxxxx"),
-            flag("--threads", USIZE_MAX, "xxxxxx"),
-            flag("--vertices", USIZE_MAX, "xxxxxx"),
-            flag("--srs", USIZE_MAX, "-xxxxx"),
-        ]
+    let mut groups: Vec<(&str, Vec<Flag>)> = Vec::new();
+    let mut cases: Vec<Case> = Vec::new();
+    // Where the lines below a header go: the last group or the last command.
+    let mut into_group = false;
+    for line in TABLE.lines().map(str::trim) {
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        if let Some(name) = line.strip_prefix("group ") {
+            groups.push((name, Vec::new()));
+            into_group = true;
+        } else if let Some(base) = line.strip_prefix("command ") {
+            cases.push(Case {
+                base,
+                flags: Vec::new(),
+            });
+            into_group = false;
+        } else {
+            let flags = match line.strip_prefix('+') {
+                Some(name) => {
+                    let group = groups.iter().find(|(g, _)| *g == name);
+                    group
+                        .unwrap_or_else(|| panic!("no group {name:?}"))
+                        .1
+                        .clone()
+                }
+                None => vec![parse_flag(line)],
+            };
+            let target = match into_group {
+                true => &mut groups.last_mut().expect("a group").1,
+                false => &mut cases.last_mut().expect("a command").flags,
+            };
+            target.extend(flags);
+        }
+    }
+    cases
+}
+
+/// One flag line: name, type, verdicts.
+fn parse_flag(line: &'static str) -> Flag {
+    let fields: Vec<&str> = line.split_whitespace().collect();
+    let [name, ty, verdicts] = fields[..] else {
+        panic!("bad_input_flags.txt: {line:?} is not `--flag type verdicts`");
     };
-    let mut paper = study();
-    paper.push(flag("--prm-vertices", USIZE_MAX, "xxxxxx"));
-    paper.push(flag("--prm-units", U8_MAX, "xxxxxx"));
-    paper.push(flag("--wide-window", F64_MAX, "-xxxxx"));
-    let mut scale = study();
-    scale.push(flag("--units", U8_MAX, "xxxxxx"));
-    scale.push(flag("--corridor-density", F64_MAX, "-xxxxx"));
-    vec![
-        Case {
-            base: "plan --scenario window --units 3 --vertices 600 --srs 50 --max-growth 0 --time-limit 20 --out p.json",
-            flags: plan,
-        },
-        Case {
-            base: "verify --scenario window --plan hover.json --goal 2,4.5,1.5",
-            flags: vec![flag("--goal-tol", F64_MAX, "oxxxxx")],
-        },
-        Case {
-            base: "sim --scenario window --plan hover.json --settle-time 2",
-            flags: vec![
-                flag("--rate", F64_MAX, "xxxxxx"),
-                flag("--speed", F64_MAX, "xxxxoo"),
-                flag("--accel", F64_MAX, "xxxxoo"),
-                flag("--angular-rate-deg", F64_MAX, "xxxxoo"),
-                flag("--goal-tol", F64_MAX, "xxxxoo"),
-                flag("--settle-time", F64_MAX, "xxxxxx"),
-                flag("--record-every", USIZE_MAX, "xxxxxo"),
-            ],
-        },
-        Case {
-            base: "view --scenario window --plan hover.json --out v.html",
-            flags: vec![
-                flag("--goal-tol", F64_MAX, "oxxxxx"),
-                flag("--near", F64_MAX, "xxxxxx"),
-                flag("--max-boxes", USIZE_MAX, "xxxxxx"),
-            ],
-        },
-        Case {
-            base: "bench prm --scenario window --units 3 --vertices 200 --start 2,4.5,1.5 --goal 2.6,4.5,1.5 --time-limit 20 --out q.json",
-            flags: prm,
-        },
-        Case {
-            base: "tables build --units 3 --srs 20 --out t.arct",
-            flags: build,
-        },
-        Case {
-            base: "shapes --units 3 --out s.svg",
-            flags: shapes,
-        },
-        Case {
-            base: "map picture --scenario window --out m.svg",
-            flags: vec![
-                flag("--band-min", F64_MAX, "ooxxxx"),
-                flag("--band-max", F64_MAX, "xxxxoo"),
-                flag("--slices", F64_MAX, "ooxxoo"),
-            ],
-        },
-        Case {
-            base: "bench paper --quick",
-            flags: paper,
-        },
-        Case {
-            base: "bench scale --quick",
-            flags: scale,
-        },
-    ]
+    assert_eq!(
+        verdicts.len(),
+        VALUES.len() + 1,
+        "{line:?}: one verdict per value"
+    );
+    Flag {
+        name,
+        max: type_max(ty),
+        verdicts,
+    }
 }
 
 /// The base command with `flag` set to `value` (replacing the base's own value).
