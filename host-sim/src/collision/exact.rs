@@ -8,6 +8,7 @@ use aerial_chain_core::{ChainParams, Shape};
 
 use nalgebra::{Point3, Vector3};
 
+use super::OutOfBounds;
 use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 
@@ -204,12 +205,7 @@ pub enum ExactViolation {
     /// Limits or self-collision (docs/model.md items 1-2), by the core's checks.
     Shape(Violation),
     /// A unit centre lies outside the map's bounding box (item 4).
-    OutOfBounds {
-        /// The unit.
-        body: Body,
-        /// Its centre (m).
-        point: Point3<f64>,
-    },
+    OutOfBounds(OutOfBounds),
     /// A body is within its radius of an obstacle cube (item 3).
     Map {
         /// The body.
@@ -227,11 +223,7 @@ impl std::fmt::Display for ExactViolation {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             ExactViolation::Shape(v) => write!(f, "{v}"),
-            ExactViolation::OutOfBounds { body, point } => write!(
-                f,
-                "{body} centre ({:.3}, {:.3}, {:.3}) is outside the map's bounds",
-                point[0], point[1], point[2]
-            ),
+            ExactViolation::OutOfBounds(o) => write!(f, "{o}"),
             ExactViolation::Map {
                 body,
                 clearance,
@@ -290,10 +282,7 @@ pub fn check_config_exact(
     let p = positions_f64(params.link_length as f64, head, eta);
     for (i, q) in p.iter().enumerate() {
         if !grid.in_bounds(*q) {
-            return Err(ExactViolation::OutOfBounds {
-                body: Body::Unit(i as u8),
-                point: *q,
-            });
+            return Err(ExactViolation::OutOfBounds(OutOfBounds::unit(i, *q)));
         }
     }
     let horizon = horizon.max(0.0);

@@ -68,18 +68,44 @@ fn smallest(horizons: &[f64]) -> f64 {
     horizons.iter().copied().fold(f64::INFINITY, f64::min)
 }
 
+/// A unit centre outside the map's bounding box (docs/model.md "Validity of one
+/// configuration", item 4): how both checkers report it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OutOfBounds {
+    /// The unit.
+    pub body: Body,
+    /// Its centre (m).
+    pub point: Point3<f64>,
+}
+
+impl OutOfBounds {
+    /// Unit `i` (0-based) with its centre at `point`.
+    pub fn unit(i: usize, point: Point3<f64>) -> Self {
+        Self {
+            body: Body::Unit(i as u8),
+            point,
+        }
+    }
+}
+
+impl fmt::Display for OutOfBounds {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let p = self.point;
+        write!(
+            f,
+            "{} centre ({:.3}, {:.3}, {:.3}) is outside the map's bounds",
+            self.body, p.x, p.y, p.z
+        )
+    }
+}
+
 /// Why the conservative checker rejected a configuration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Collision {
     /// Limits or self-collision (exact, from the core).
     Shape(Violation),
     /// A unit centre is outside the map's bounding box.
-    OutOfBounds {
-        /// The unit.
-        body: Body,
-        /// Its centre (m).
-        point: Point3<f64>,
-    },
+    OutOfBounds(OutOfBounds),
     /// A body may touch an obstacle (conservative: its proven free margin is not positive).
     Map {
         /// The body.
@@ -95,13 +121,7 @@ impl fmt::Display for Collision {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Collision::Shape(v) => write!(f, "{v}"),
-            Collision::OutOfBounds { body, point } => {
-                write!(
-                    f,
-                    "{body} at ({:.3}, {:.3}, {:.3}) is outside the map",
-                    point[0], point[1], point[2]
-                )
-            }
+            Collision::OutOfBounds(o) => write!(f, "{o}"),
             Collision::Map { body, point } => {
                 write!(
                     f,
@@ -435,10 +455,7 @@ impl CollisionContext {
         let mut c = [0.0f64; MAX_UNITS];
         for i in 0..n {
             if !self.inside(p[i]) {
-                return Err(Collision::OutOfBounds {
-                    body: Body::Unit(i as u8),
-                    point: p[i],
-                });
+                return Err(Collision::OutOfBounds(OutOfBounds::unit(i, p[i])));
             }
             c[i] = self.bound(p[i], self.unit_r);
             if c[i] <= self.unit_r {
@@ -564,10 +581,7 @@ impl CollisionContext {
                 if !self.inside(w) {
                     return Err(EdgeCollision {
                         t,
-                        collision: Collision::OutOfBounds {
-                            body: Body::Unit(i as u8),
-                            point: w,
-                        },
+                        collision: Collision::OutOfBounds(OutOfBounds::unit(i, w)),
                     });
                 }
             }
@@ -674,10 +688,7 @@ impl CollisionContext {
                         inside = inside.min(p[i][a] - lo[a]).min(hi[a] - p[i][a]);
                     }
                     if inside < FK_TOLERANCE {
-                        let collision = Collision::OutOfBounds {
-                            body: Body::Unit(i as u8),
-                            point: p[i],
-                        };
+                        let collision = Collision::OutOfBounds(OutOfBounds::unit(i, p[i]));
                         return Err(EdgeCollision { t, collision });
                     }
                     let m = c[i] - self.unit_r;
@@ -690,10 +701,7 @@ impl CollisionContext {
                     }
                     if speed[i] > 0.0 {
                         if inside < self.min_step {
-                            let collision = Collision::OutOfBounds {
-                                body: Body::Unit(i as u8),
-                                point: p[i],
-                            };
+                            let collision = Collision::OutOfBounds(OutOfBounds::unit(i, p[i]));
                             return Err(EdgeCollision { t, collision });
                         }
                         horizon[i] = t + m.min(inside) / speed[i];

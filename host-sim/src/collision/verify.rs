@@ -523,7 +523,7 @@ mod tests {
         let r = verify_plan(&g, &far);
         assert!(matches!(
             r.violation.unwrap().problem,
-            PlanProblem::Invalid(ExactViolation::OutOfBounds { .. })
+            PlanProblem::Invalid(ExactViolation::OutOfBounds(_))
         ));
         let mut broken = ok.clone();
         broken.waypoints[1].zeta.pop();

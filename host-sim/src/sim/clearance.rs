@@ -8,6 +8,7 @@ use nalgebra::Point3;
 use super::dynamics::V3;
 use super::flight::Obstacles;
 use crate::collision::exact::nearest_obstacle;
+use crate::collision::OutOfBounds;
 use crate::map::grid::Grid;
 
 /// How far beyond a body's radius obstacles are searched (m): the clearance reported is
@@ -37,16 +38,8 @@ impl Obstacles for MapClearance<'_> {
         let mut best = (HORIZON, String::from("nothing within the search horizon"));
         for (i, p) in units.iter().enumerate() {
             if !self.grid.in_bounds(Point3::from(*p)) {
-                return (
-                    -self.unit_radius,
-                    format!(
-                        "unit {} centre ({:.3}, {:.3}, {:.3}) is outside the map's bounds",
-                        i + 1,
-                        p.x,
-                        p.y,
-                        p.z
-                    ),
-                );
+                let outside = OutOfBounds::unit(i, Point3::from(*p));
+                return (-self.unit_radius, outside.to_string());
             }
         }
         let unit_bodies = units
