@@ -72,8 +72,8 @@ const SHELL: f64 = 0.2;
 const WALL_X: f64 = 6.0;
 /// Gap between the first wall and the second (m).
 const WALL_GAP: f64 = 2.5;
-/// Height of the window's centre (m).
-const Z_C: f64 = 1.3;
+/// Height of the window's centre (m): half way up the room.
+const Z_C: f64 = ROOM_Z / 2.0;
 
 impl PassageSpec {
     /// Parses `KEY=VALUE,...` (see the module docs).
