@@ -15,7 +15,7 @@ use std::sync::Arc;
 
 use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use aerial_chain::map::{DistanceField, Grid, OcTree};
-use aerial_chain::plan_file::{MapSource, Plan};
+use aerial_chain::plan_file::{MapSection, MapSource, Plan};
 use aerial_chain::planner::{to_plan, ArcPlanner, Planner, Query, Settings, Termination};
 use aerial_chain::tables::{ShapeTables, TableSettings};
 use aerial_chain_core::{ChainParams, Shape};
@@ -56,13 +56,8 @@ pub fn plan_on_map(p: &Problem) -> Result<(Grid, Plan), Box<dyn Error>> {
     let solution = planner.solve(&query, Termination::default())?;
     // Shortcuts and merged moves, as `arc plan` does unless --no-smooth.
     let (solution, _) = planner.refine(&solution, None);
-    let mut plan = to_plan(
-        &solution,
-        &params,
-        grid.resolution(),
-        grid.unknown_is_occupied(),
-    );
-    plan.map.source = MapSource::file(p.map, &bytes);
+    let map = MapSection::of(&grid).with_source(MapSource::file(p.map, &bytes));
+    let plan = to_plan(&solution, &params, map);
 
     // The planner's checks are conservative shortcuts; the verifier is the contract.
     let report = verify_plan(&grid, &plan);

@@ -26,6 +26,7 @@
 //!
 //! use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 //! use aerial_chain::map::DistanceField;
+//! use aerial_chain::plan_file::MapSection;
 //! use aerial_chain::planner::{to_plan, ArcPlanner, Planner, Query, Settings, Termination};
 //! use aerial_chain::problem::scenarios;
 //! use aerial_chain::tables::{ShapeTables, TableSettings};
@@ -41,7 +42,7 @@
 //! let query = Query::new(scenario.start, scenario.start_shape(5)?, scenario.goal);
 //! let solution = planner.solve(&query, Termination::default())?;
 //! let grid = &scenario.grid;
-//! let plan = to_plan(&solution, &params, grid.resolution(), grid.unknown_is_occupied());
+//! let plan = to_plan(&solution, &params, MapSection::of(grid));
 //! assert!(verify_plan(grid, &plan).ok);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

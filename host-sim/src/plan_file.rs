@@ -9,6 +9,7 @@
 use std::io::Read;
 use std::path::Path;
 
+use crate::map::grid::Grid;
 use aerial_chain_core::{ChainParams, Shape};
 use serde::{Deserialize, Serialize};
 
@@ -68,6 +69,16 @@ impl MapSection {
             unknown_is_occupied,
             source: MapSource::default(),
         }
+    }
+
+    /// The section of a plan made on `grid`, with no record of the map's source.
+    pub fn of(grid: &Grid) -> Self {
+        Self::new(grid.resolution(), grid.unknown_is_occupied())
+    }
+
+    /// This section, recording that the map came from `source`.
+    pub fn with_source(self, source: MapSource) -> Self {
+        Self { source, ..self }
     }
 }
 
@@ -302,24 +313,24 @@ impl Waypoint {
 
 impl Plan {
     /// A plan through `steps` (head position and shape, the start first) for chain
-    /// `params` on a map of `resolution` m, with `counts` and `timings` as its
+    /// `params` on the map `map` describes, with `counts` and `timings` as its
     /// statistics (the rest of the query named `rest`: `shape_search_s`, `search_s`).
     pub fn from_steps<'a>(
         params: &ChainParams,
-        (resolution, unknown_is_occupied): (f64, bool),
+        map: MapSection,
         steps: impl IntoIterator<Item = ([f64; 3], &'a Shape)>,
-        counts: &[(&str, u64)],
+        counts: Vec<(String, u64)>,
         (timings, rest): (&Timings, &str),
     ) -> Self {
         let mut stats: serde_json::Map<_, _> = counts
-            .iter()
-            .map(|&(k, v)| (k.to_string(), serde_json::Value::from(v)))
+            .into_iter()
+            .map(|(k, v)| (k, serde_json::Value::from(v)))
             .collect();
         stats.insert("timing".into(), timings.to_json(rest));
         Plan {
             format: FORMAT.into(),
             chain: ChainSection::from_params(params),
-            map: MapSection::new(resolution, unknown_is_occupied),
+            map,
             waypoints: steps
                 .into_iter()
                 .map(|(xi, shape)| Waypoint::new(xi, shape))

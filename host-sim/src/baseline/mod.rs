@@ -65,9 +65,10 @@ pub use settings::{prm_star_k, PrmSettings};
 pub type PrmSolution = Solution<PrmStats>;
 
 /// Counters and timings of a roadmap and one query.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct PrmStats {
     /// Roadmap build (sampling and neighbours), query and edge-check times.
+    #[serde(skip)]
     pub timings: Timings,
     /// Vertices in the roadmap (goal samples included).
     pub vertices: usize,
@@ -221,22 +222,6 @@ impl Planner for FullStatePrm {
 }
 
 impl SolutionStats for PrmStats {
-    fn counts(&self) -> Vec<(&'static str, u64)> {
-        vec![
-            ("vertices", self.vertices as u64),
-            ("goal_samples", self.goal_samples as u64),
-            ("sample_tries", self.sample_tries),
-            ("k", self.k as u64),
-            ("graph_edges", self.graph_edges as u64),
-            ("iterations", self.iterations as u64),
-            ("edges_checked", self.edges_checked as u64),
-            ("edges_blocked", self.edges_blocked as u64),
-            ("path_edges", self.path_edges as u64),
-            ("shape_changes", self.shape_changes as u64),
-            ("collision_checks", self.collision_checks),
-        ]
-    }
-
     fn timings(&self) -> Timings {
         self.timings
     }

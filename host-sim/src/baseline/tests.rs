@@ -11,6 +11,7 @@ use super::search::dist3;
 use super::*;
 use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use crate::map::distance::DistanceField;
+use crate::plan_file::MapSection;
 use crate::planner::motion::to_plan;
 use crate::problem::scenarios;
 
@@ -55,7 +56,7 @@ fn solves_an_easy_query_and_the_plan_verifies() {
     assert!(dist3(last, [2.5, 2.0, 1.5]) <= 0.3 + 1e-12);
     assert_eq!(sol.stats.vertices, 600);
     assert!(sol.stats.edges_checked >= sol.stats.path_edges);
-    let plan = to_plan(&sol, ctx.params(), 0.1, true);
+    let plan = to_plan(&sol, ctx.params(), MapSection::new(0.1, true));
     plan.check().unwrap();
     let report = verify_plan(&sc.grid, &plan);
     assert!(report.ok, "{:?}", report.violation);

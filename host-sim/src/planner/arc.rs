@@ -30,11 +30,12 @@ use crate::plan_file::{Plan, Timings};
 use crate::tables::ShapeTables;
 
 /// Counters and timings of one query.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Stats {
     /// Search structures built for this query (the labelled free regions and the
     /// uniform head roadmap, when it needed them and they were not built before),
     /// the query's other time, and its collision-check time.
+    #[serde(skip)]
     pub timings: Timings,
     /// Head edges flown.
     pub edges: usize,
@@ -516,26 +517,6 @@ impl Planner for ArcPlanner {
 }
 
 impl SolutionStats for Stats {
-    fn counts(&self) -> Vec<(&'static str, u64)> {
-        vec![
-            ("edges", self.edges as u64),
-            ("shape_changes", self.shape_changes as u64),
-            ("rotations", self.rotations as u64),
-            ("lsc_uses", self.lsc_uses as u64),
-            ("srs_uses", self.srs_uses as u64),
-            ("follow_uses", self.follow_uses as u64),
-            ("shrunk", self.shrunk as u64),
-            ("srs_connects", self.srs_connects as u64),
-            ("replans", self.replans as u64),
-            ("roadmap_growths", self.roadmap_growths as u64),
-            ("collision_checks", self.collision_checks),
-            ("roadmap_vertices", self.roadmap_vertices as u64),
-            ("roadmap_edges", self.roadmap_edges as u64),
-            ("lattice_expanded", self.lattice_expanded as u64),
-            ("route_points", self.route_points as u64),
-        ]
-    }
-
     fn timings(&self) -> Timings {
         self.timings
     }

@@ -130,9 +130,18 @@ pub struct Solution<S> {
 }
 
 /// A planner's counters and timings of one query, as a plan file holds them.
-pub trait SolutionStats {
-    /// The counters, in the order the plan file lists them.
-    fn counts(&self) -> Vec<(&'static str, u64)>;
+///
+/// Its counters are its fields that serialize as unsigned integers ([`Self::counts`]);
+/// timings and everything else go through [`Self::timings`] and [`Self::annotate`].
+pub trait SolutionStats: serde::Serialize {
+    /// The counters: every field that serializes as an unsigned integer, by name.
+    fn counts(&self) -> Vec<(String, u64)> {
+        let Ok(serde_json::Value::Object(fields)) = serde_json::to_value(self) else {
+            return Vec::new();
+        };
+        let counter = |(k, v): (String, serde_json::Value)| v.as_u64().map(|v| (k, v));
+        fields.into_iter().filter_map(counter).collect()
+    }
     /// Where the time went.
     fn timings(&self) -> Timings;
     /// The name of the query's time outside collision checks in the plan file.

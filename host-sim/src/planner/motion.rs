@@ -11,7 +11,7 @@ use serde_json::Value;
 use super::candidates::Source;
 use super::refine::{Quality, Refinement};
 use super::{Solution, SolutionStats};
-use crate::plan_file::Plan;
+use crate::plan_file::{MapSection, Plan};
 
 /// A short label of where a waypoint's shape came from.
 pub fn source_label(s: &Source, shape_change: bool) -> String {
@@ -28,20 +28,20 @@ pub fn source_label(s: &Source, shape_change: bool) -> String {
     }
 }
 
-/// The plan file for `solution`, of any planner.
+/// The plan file for `solution`, of any planner, made on the map `map` describes
+/// ([`MapSection::of`] a grid, with its source where it is known).
 pub fn to_plan<S: SolutionStats>(
     solution: &Solution<S>,
     params: &ChainParams,
-    resolution: f64,
-    unknown_is_occupied: bool,
+    map: MapSection,
 ) -> Plan {
     let st = &solution.stats;
     let steps = solution.steps.iter().map(|s| (s.xi, &s.shape));
     let mut plan = Plan::from_steps(
         params,
-        (resolution, unknown_is_occupied),
+        map,
         steps,
-        &st.counts(),
+        st.counts(),
         (&st.timings(), st.rest_name()),
     );
     st.annotate(&solution.steps, &mut plan);

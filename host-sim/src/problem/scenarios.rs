@@ -373,10 +373,7 @@ impl Scenario {
         let mut plan = Plan {
             format: crate::plan_file::FORMAT.into(),
             chain: ChainSection::from_params(&params),
-            map: MapSection {
-                source: MapSource::scenario(&self.name),
-                ..MapSection::new(self.grid.resolution(), self.grid.unknown_is_occupied())
-            },
+            map: MapSection::of(&self.grid).with_source(MapSource::scenario(&self.name)),
             waypoints: vec![Waypoint::new(start, &shape)],
             stats: Default::default(),
         };

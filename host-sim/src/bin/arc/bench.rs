@@ -548,7 +548,7 @@ fn run_flight(a: FlightArgs) -> CliResult {
 
 fn run_prm(a: PrmArgs) -> CliResult {
     let time_limit = check_prm(&a)?;
-    let (ctx, params, query, source) = a.problem.context(a.clearance)?;
+    let (ctx, params, query, map) = a.problem.context(a.clearance)?;
     let settings = PrmSettings {
         vertices: a.vertices,
         k: a.k,
@@ -577,20 +577,15 @@ fn run_prm(a: PrmArgs) -> CliResult {
         }
     })?;
     let grid = prm.context().field().grid();
-    let mut plan = to_plan(&sol, &params, grid.resolution(), grid.unknown_is_occupied());
-    plan.map.source = source;
+    let plan = to_plan(&sol, &params, map);
     let report = verify_plan(grid, &plan);
     let s = &sol.stats;
-    let lines = write_plan(
-        &plan,
-        &a.out,
-        "full-state PRM solved",
-        &a.problem.map,
-        format_args!(
-            "{} roadmap edges, {} shape changes",
-            s.path_edges, s.shape_changes
-        ),
-    )?;
+    let details = format!(
+        "{} roadmap edges, {} shape changes",
+        s.path_edges, s.shape_changes
+    );
+    let solved = "full-state PRM solved";
+    let lines = write_plan(&plan, &a.out, solved, &a.problem.map, &details)?;
     lines.line(format_args!(
         "  roadmap {:.1} ms ({} vertices, k = {}, {} edges), planning {:.1} ms ({} lazy searches, {} edges checked, {} blocked; {:.1} ms in checks)",
         s.timings.roadmap_s * 1e3,

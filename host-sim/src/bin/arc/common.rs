@@ -13,7 +13,7 @@ use aerial_chain::collision::CollisionContext;
 use aerial_chain::map::DistanceField;
 use aerial_chain::map::Grid;
 use aerial_chain::map::OcTree;
-use aerial_chain::plan_file::{MapSource, Plan};
+use aerial_chain::plan_file::{MapSection, MapSource, Plan};
 use aerial_chain::planner::Query;
 use aerial_chain::problem::scenarios::{self, Scenario};
 
@@ -253,11 +253,11 @@ impl ProblemArgs {
     pub fn context(
         &self,
         clearance: f64,
-    ) -> Result<(CollisionContext, ChainParams, Query, MapSource), CliError> {
+    ) -> Result<(CollisionContext, ChainParams, Query, MapSection), CliError> {
         let (loaded, params, query) = self.load()?;
-        let source = loaded.source.clone();
+        let map = MapSection::of(&loaded.grid).with_source(loaded.source.clone());
         let ctx = loaded.into_context(params, clearance)?;
-        Ok((ctx, params, query, source))
+        Ok((ctx, params, query, map))
     }
 }
 
@@ -269,7 +269,7 @@ pub fn write_plan(
     out: &Path,
     solved: &str,
     map: &MapArgs,
-    details: std::fmt::Arguments<'_>,
+    details: &str,
 ) -> Result<Report, CliError> {
     plan.write(out)
         .map_err(|e| CliError::input(e.to_string()))?;

@@ -212,10 +212,8 @@ pub fn run(a: PlanArgs) -> CliResult {
     // Setup (map, distance field, shape tables) is timed apart: the time limit
     // covers what follows it (docs/promises.md).
     let setup = Instant::now();
-    let (ctx, params, query, source) = a.problem.context(a.clearance)?;
+    let (ctx, params, query, map) = a.problem.context(a.clearance)?;
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
-    let grid = ctx.field().grid();
-    let (resolution, unknown_occ) = (grid.resolution(), grid.unknown_is_occupied());
     let settings = Settings {
         vertices: a.vertices,
         r_t: a.r_t,
@@ -257,26 +255,14 @@ pub fn run(a: PlanArgs) -> CliResult {
         (refined, Some(r))
     };
     let quality = Quality::of(&solution.steps);
-    let mut plan = to_plan(&solution, &params, resolution, unknown_occ);
+    let mut plan = to_plan(&solution, &params, map);
     annotate_quality(&mut plan, &quality, refinement.as_ref());
-    plan.map.source = source;
     let s = &solution.stats;
-    let report = write_plan(
-        &plan,
-        &a.out,
-        "solved on",
-        &a.problem.map,
-        format_args!(
-            "{} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations, {} follow), {} replans",
-            s.edges,
-            s.shape_changes,
-            s.lsc_uses,
-            s.srs_uses,
-            s.rotations,
-            s.follow_uses,
-            s.replans
-        ),
-    )?;
+    let details = format!(
+        "{} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations, {} follow), {} replans",
+        s.edges, s.shape_changes, s.lsc_uses, s.srs_uses, s.rotations, s.follow_uses, s.replans
+    );
+    let report = write_plan(&plan, &a.out, "solved on", &a.problem.map, &details)?;
     report.line(format_args!(
         "  setup {:.1} ms, search structures {:.1} ms (free regions {:.1} ms, uniform roadmap of {} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
         setup_s * 1e3,

@@ -14,6 +14,7 @@ use std::time::Instant;
 use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use aerial_chain::map::DistanceField;
 use aerial_chain::picture::{palette, stroke, Axis, Figure, Mark, Panel};
+use aerial_chain::plan_file::MapSection;
 use aerial_chain::planner::{to_plan, ArcPlanner, Planner, Query, Settings, Termination};
 use aerial_chain::problem::scenarios;
 use aerial_chain::sim::{
@@ -147,12 +148,7 @@ fn fly_both(run: &mut FlightRun) -> Result<(), String> {
         refinement.after.shape_motion_rad,
     );
     let grid = &sc.grid;
-    let plan = to_plan(
-        &solution,
-        &params,
-        grid.resolution(),
-        grid.unknown_is_occupied(),
-    );
+    let plan = to_plan(&solution, &params, MapSection::of(grid));
     let check = verify_plan(grid, &plan);
     if !check.ok {
         return Err(format!("plan invalid: {:?}", check.violation));

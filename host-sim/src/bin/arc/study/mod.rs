@@ -44,6 +44,7 @@ use rayon::prelude::*;
 use aerial_chain::baseline::{FullStatePrm, PrmError, PrmSettings};
 use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use aerial_chain::map::DistanceField;
+use aerial_chain::plan_file::MapSection;
 use aerial_chain::planner::{
     to_plan, ArcPlanner, Failure, Planner, Settings, Solution, SolutionStats, Termination,
 };
@@ -420,7 +421,7 @@ fn run_planner<P: Planner>(
             r.collision_s = Some(t.collision_s);
             r.search_s = Some(t.rest_s());
             let g = &env.scenario.grid;
-            let plan = to_plan(sol, &params, g.resolution(), g.unknown_is_occupied());
+            let plan = to_plan(sol, &params, MapSection::of(g));
             r.waypoints = Some(plan.waypoints.len());
             r.verified = Some(verify_plan(g, &plan).ok);
         }
@@ -495,7 +496,7 @@ fn passage_result(
     let spec = PassageSpec::parse(name).ok()?;
     let params = *planner.context().params();
     let g = &env.scenario.grid;
-    let as_plan = |s| to_plan(s, &params, g.resolution(), g.unknown_is_occupied());
+    let as_plan = |s| to_plan(s, &params, MapSection::of(g));
     let t = Instant::now();
     let (post, _) = planner.refine(sol, None);
     let post_s = t.elapsed().as_secs_f64();
