@@ -307,7 +307,7 @@ fn sample_points(tree: &OcTree, seed: u64) -> Vec<[f64; 3]> {
         .leaves()
         .step_by(7)
         .take(200)
-        .map(|l| l.center)
+        .map(|l| l.center.into())
         .collect();
     let (mn, mx) = tree.metric_bounds().unwrap();
     for _ in 0..300 {

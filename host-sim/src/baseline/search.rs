@@ -11,7 +11,7 @@ use super::roadmap::Roadmap;
 use super::{PrmError, PrmStats};
 use crate::collision::CollisionContext;
 use crate::planner::graph::{Edge, EdgeState, LazyOutcome, VertexId};
-use crate::planner::{Query, Source, Step, Termination};
+use crate::planner::{dist, Query, Source, Step, Termination};
 
 /// One query's lazy search.
 pub(super) struct LazySearch<'a> {
@@ -25,23 +25,18 @@ pub(super) struct LazySearch<'a> {
     pub(super) stats: PrmStats,
 }
 
-/// Euclidean distance (m).
-pub(super) fn dist3(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-}
-
 impl LazySearch<'_> {
     /// Plans `query` over the roadmap: the waypoints and the query's counters.
     pub(super) fn run(mut self, query: &Query) -> Result<(Vec<Step>, PrmStats), PrmError> {
         let (start, goal) = query.ends();
         let (start_shape, tol) = (query.start_shape, query.goal_tol);
         let first = Step {
-            xi: start,
+            xi: start.into(),
             shape: start_shape,
             source: Source::Start,
             shape_change: false,
         };
-        if dist3(start, goal) <= tol {
+        if dist(start, goal) <= tol {
             return Ok((vec![first], self.stats));
         }
         let n = self.roadmap.xi.len();
@@ -88,14 +83,14 @@ impl LazySearch<'_> {
             let sb = r.shapes[b];
             if r.shapes[a] != sb {
                 steps.push(Step {
-                    xi: r.xi[a],
+                    xi: r.xi[a].into(),
                     shape: sb,
                     source: Source::Sampled,
                     shape_change: true,
                 });
             }
             steps.push(Step {
-                xi: r.xi[b],
+                xi: r.xi[b].into(),
                 shape: sb,
                 source: Source::Sampled,
                 shape_change: false,
@@ -112,7 +107,7 @@ impl LazySearch<'_> {
         let is_goal: Vec<bool> =
             r.xi.iter()
                 .enumerate()
-                .map(|(i, p)| i != from && dist3(*p, goal) <= tol)
+                .map(|(i, p)| i != from && dist(*p, goal) <= tol)
                 .collect();
         let sampled = n - 1;
         let (ctx, stop, began) = (self.ctx, self.stop, self.began);
@@ -131,7 +126,7 @@ impl LazySearch<'_> {
             }
             free
         };
-        let h = |v: usize| (dist3(r.xi[v], goal) - tol).max(0.0);
+        let h = |v: usize| (dist(r.xi[v], goal) - tol).max(0.0);
         let stopped = || stop.time_limit.is_some_and(|t| began.elapsed() > t);
         let (outcome, iterations) = r.graph.lazy_prm(from, &is_goal, h, check, stopped);
         self.stats.iterations += iterations;

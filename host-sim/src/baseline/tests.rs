@@ -7,11 +7,11 @@ use std::time::Duration;
 use aerial_chain_core::{ChainParams, Shape};
 use nalgebra::Point3;
 
-use super::search::dist3;
 use super::*;
 use crate::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use crate::map::distance::DistanceField;
 use crate::plan_file::MapSection;
+use crate::planner::dist;
 use crate::planner::motion::to_plan;
 use crate::problem::scenarios;
 
@@ -53,7 +53,7 @@ fn solves_an_easy_query_and_the_plan_verifies() {
     let sol = res.expect("an open room is easy for 600 vertices");
     assert!(sol.steps.len() >= 2);
     let last = sol.steps.last().unwrap().xi;
-    assert!(dist3(last, [2.5, 2.0, 1.5]) <= 0.3 + 1e-12);
+    assert!(dist(last, [2.5, 2.0, 1.5]) <= 0.3 + 1e-12);
     assert_eq!(sol.stats.vertices, 600);
     assert!(sol.stats.edges_checked >= sol.stats.path_edges);
     let plan = to_plan(&sol, ctx.params(), MapSection::new(0.1, true));

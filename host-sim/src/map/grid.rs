@@ -200,9 +200,9 @@ impl Grid {
         let (lo, hi) = tree.metric_bounds().ok_or(GridError::Empty)?;
         Grid::from_leaves(
             tree.resolution(),
-            lo,
-            hi,
-            tree.leaves().map(|l| (l.center, l.size, l.occupied)),
+            lo.into(),
+            hi.into(),
+            tree.leaves().map(|l| (l.center.into(), l.size, l.occupied)),
             unknown_is_occupied,
         )
     }
@@ -254,8 +254,8 @@ impl Grid {
     }
 
     /// The map's bounding box `(min, max)` (m): unit centres must lie inside it.
-    pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
-        self.bounds
+    pub fn bounds(&self) -> (Point3<f64>, Point3<f64>) {
+        (self.bounds.0.into(), self.bounds.1.into())
     }
 
     /// Whether `p` lies in the bounding box (closed).

@@ -5,6 +5,8 @@
 //! animation of a motion lasting `T` has `ceil(T / step) + 1` frames; each shows for
 //! [`FRAME_DELAY_CS`], the last for longer before the loop starts over.
 
+use nalgebra::Point3;
+
 use super::{bounds, goal_marks, views, View, TITLE_H};
 use crate::map::grid::Grid;
 use crate::picture::{palette, ramp, stroke, Animation, DrawError, Figure, Mark};
@@ -66,9 +68,9 @@ pub struct Motion {
     /// Sample times (s), increasing.
     pub times: Vec<f64>,
     /// Unit centres at every sample, head first (m).
-    pub bodies: Vec<Vec<[f64; 3]>>,
+    pub bodies: Vec<Vec<Point3<f64>>>,
     /// The head's intended path (the plan's, or the reference a flight tracked).
-    pub planned: Vec<[f64; 3]>,
+    pub planned: Vec<Point3<f64>>,
     /// Radius of a unit (m).
     pub unit_radius: f64,
 }
@@ -77,13 +79,10 @@ impl Motion {
     /// The motion of a timed trajectory.
     pub fn of_trajectory(tr: &Trajectory) -> Self {
         let l = tr.params().link_length as f64;
-        let bodies: Vec<Vec<[f64; 3]>> = tr
+        let bodies: Vec<Vec<Point3<f64>>> = tr
             .zetas()
             .iter()
-            .map(|z| {
-                let body = crate::collision::exact::positions_f64(l, [z[0], z[1], z[2]], &z[3..]);
-                body.into_iter().map(Into::into).collect()
-            })
+            .map(|z| crate::collision::exact::positions_f64(l, [z[0], z[1], z[2]], &z[3..]))
             .collect();
         let planned = bodies.iter().map(|b| b[0]).collect();
         Self {
@@ -96,7 +95,7 @@ impl Motion {
 
     /// The motion of a simulated flight; the head's reference is its intended path.
     pub fn of_flight(flight: &Flight) -> Self {
-        let f = |p: [f32; 3]| p.map(f64::from);
+        let f = |p: [f32; 3]| Point3::from(p.map(f64::from));
         Self {
             times: flight.samples.iter().map(|s| s.t).collect(),
             bodies: flight
@@ -128,7 +127,7 @@ pub struct AnimationOptions {
     /// The figure's title.
     pub title: String,
     /// The goal and its tolerance (m).
-    pub goal: Option<([f64; 3], f64)>,
+    pub goal: Option<(Point3<f64>, f64)>,
     /// Time between frames (s); `None`: a step of 1, 2 or 5 times a power of ten
     /// (at least 0.1 s) giving at most about a hundred and twenty frames.
     pub step: Option<f64>,
@@ -212,7 +211,7 @@ pub fn animate(
 }
 
 /// Every `len / PATH_POINTS`-th of the first `len` points, and the last of them.
-fn thin(points: &[[f64; 3]], len: usize) -> impl Iterator<Item = &[f64; 3]> {
+fn thin(points: &[Point3<f64>], len: usize) -> impl Iterator<Item = &Point3<f64>> {
     let every = len.div_ceil(PATH_POINTS).max(1);
     points[..len]
         .iter()
@@ -224,7 +223,7 @@ fn thin(points: &[[f64; 3]], len: usize) -> impl Iterator<Item = &[f64; 3]> {
 fn overlay(views: &[View], motion: &Motion, t: f64, (w, h): (f64, f64)) -> Figure {
     let i = motion.at(t);
     let fill = ramp(t / motion.duration().max(1e-9));
-    let heads: Vec<[f64; 3]> = motion.bodies[..=i].iter().map(|b| b[0]).collect();
+    let heads: Vec<Point3<f64>> = motion.bodies[..=i].iter().map(|b| b[0]).collect();
     let mut f = Figure::overlay(w, h);
     for view in views {
         let mut p = view.panel();
@@ -301,7 +300,7 @@ mod tests {
     fn motion_finds_the_sample_at_a_time() {
         let m = Motion {
             times: vec![0.0, 0.5, 1.0],
-            bodies: vec![vec![[0.0; 3]]; 3],
+            bodies: vec![vec![Point3::origin()]; 3],
             ..Motion::default()
         };
         assert_eq!(m.at(0.0), 0);

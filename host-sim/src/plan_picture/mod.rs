@@ -16,6 +16,8 @@ pub use animation::{
 pub(crate) use still::thinned;
 pub use still::{draw, waypoint_times, PictureOptions};
 
+use nalgebra::Point3;
+
 use crate::map::grid::Grid;
 use crate::picture::{palette, Panel};
 
@@ -144,7 +146,7 @@ impl View {
 
     /// The panel with the obstacles of `grid` in the band `lo..hi` of the axis the
     /// view looks along.
-    fn with_obstacles(&self, grid: &Grid, lo: [f64; 3], hi: [f64; 3]) -> Panel {
+    fn with_obstacles(&self, grid: &Grid, lo: Point3<f64>, hi: Point3<f64>) -> Panel {
         let mut p = self.panel();
         for (a, b, share) in projected(
             grid,
@@ -160,13 +162,13 @@ impl View {
     }
 
     /// Point `q` seen in this view.
-    fn see(&self, q: &[f64; 3]) -> (f64, f64) {
+    fn see(&self, q: &Point3<f64>) -> (f64, f64) {
         (q[self.u], q[self.v])
     }
 }
 
 /// The box `(min, max)` around `points`; `None` when there are none.
-fn bounds<'a>(points: impl Iterator<Item = &'a [f64; 3]>) -> Option<([f64; 3], [f64; 3])> {
+fn bounds<'a>(points: impl Iterator<Item = &'a Point3<f64>>) -> Option<(Point3<f64>, Point3<f64>)> {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in points {
         for k in 0..3 {
@@ -174,11 +176,11 @@ fn bounds<'a>(points: impl Iterator<Item = &'a [f64; 3]>) -> Option<([f64; 3], [
             hi[k] = hi[k].max(p[k]);
         }
     }
-    lo[0].is_finite().then_some((lo, hi))
+    lo[0].is_finite().then_some((lo.into(), hi.into()))
 }
 
 /// The goal's marks: the point and its region.
-fn goal_marks(p: &mut Panel, view: &View, goal: Option<([f64; 3], f64)>) {
+fn goal_marks(p: &mut Panel, view: &View, goal: Option<(Point3<f64>, f64)>) {
     if let Some((g, tol)) = goal {
         let at = view.see(&g);
         p.ring(at, tol, palette::GOAL, true);

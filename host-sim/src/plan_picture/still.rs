@@ -7,6 +7,8 @@
 //! waypoints, in order. The fill of a chain is its time on the colour ramp, its rim the
 //! source of its shape change.
 
+use nalgebra::Point3;
+
 use super::{bounds, goal_marks, views};
 use crate::collision::exact::positions_f64;
 use crate::map::grid::Grid;
@@ -20,7 +22,7 @@ pub struct PictureOptions {
     /// The figure's title.
     pub title: String,
     /// The goal and its tolerance (m), marked as a point and a region.
-    pub goal: Option<([f64; 3], f64)>,
+    pub goal: Option<(Point3<f64>, f64)>,
     /// The time of every waypoint (s), for the colour ramp ([`waypoint_times`]);
     /// without them the ramp runs over the waypoints' order.
     pub times: Option<Vec<f64>>,
@@ -90,14 +92,11 @@ pub fn draw(grid: &Grid, plan: &Plan, opts: &PictureOptions) -> Figure {
     let params = plan.check().ok();
     let l = params.map(|p| p.link_length as f64).unwrap_or(0.5);
     let ru = params.map(|p| p.unit_radius as f64).unwrap_or(0.15);
-    let heads: Vec<[f64; 3]> = plan.waypoints.iter().map(|w| w.xi()).collect();
-    let bodies: Vec<Vec<[f64; 3]>> = plan
+    let heads: Vec<Point3<f64>> = plan.waypoints.iter().map(|w| w.xi().into()).collect();
+    let bodies: Vec<Vec<Point3<f64>>> = plan
         .waypoints
         .iter()
-        .map(|w| {
-            let body = positions_f64(l, w.xi(), w.eta());
-            body.into_iter().map(Into::into).collect()
-        })
+        .map(|w| positions_f64(l, w.xi(), w.eta()))
         .collect();
     let (blo, bhi) = bounds(bodies.iter().flatten()).unwrap_or_else(|| grid.bounds());
     let labels: Vec<String> = plan
@@ -134,7 +133,7 @@ pub fn draw(grid: &Grid, plan: &Plan, opts: &PictureOptions) -> Figure {
             let (a, b) = (heads[i - 1], heads[i]);
             let len = (0..3).map(|k| (b[k] - a[k]).powi(2)).sum::<f64>().sqrt();
             let pieces = ((len / PIECE_M).ceil() as usize).clamp(1, 64);
-            let at = |f: f64| -> [f64; 3] { std::array::from_fn(|k| a[k] + f * (b[k] - a[k])) };
+            let at = |f: f64| Point3::from(std::array::from_fn(|k| a[k] + f * (b[k] - a[k])));
             for j in 0..pieces {
                 let (f0, f1) = (j as f64 / pieces as f64, (j + 1) as f64 / pieces as f64);
                 let t = times[i - 1] + (f0 + f1) / 2.0 * (times[i] - times[i - 1]);
@@ -221,7 +220,7 @@ fn legend(
     t0: f64,
     t_end: f64,
     sources: &[Option<(Colour, &str)>],
-    goal: Option<([f64; 3], f64)>,
+    goal: Option<(Point3<f64>, f64)>,
 ) {
     fig.legend_mark(
         Mark::Ramp {

@@ -13,6 +13,7 @@
 use std::time::Instant;
 
 use aerial_chain_core::Shape;
+use nalgebra::Point3;
 use rand::SeedableRng;
 use rand_pcg::Pcg64;
 use serde_json::Value;
@@ -63,7 +64,8 @@ pub struct Stats {
     pub min_margin: f64,
     /// Head position at the start of the first edge flown at [`Self::min_margin`],
     /// when that is below the preferred clearance.
-    pub min_margin_at: Option<[f64; 3]>,
+    #[serde(skip)] // not a counter: `annotate` writes it
+    pub min_margin_at: Option<Point3<f64>>,
     /// Head route search (`lattice`): lattice points expanded (0: not used).
     pub lattice_expanded: usize,
     /// Head route search time (s), part of the query time.
@@ -240,11 +242,6 @@ impl ArcPlanner {
             .iter()
             .map(|c| c.configs + c.translations + c.shape_changes)
             .sum()
-    }
-
-    /// The head route search.
-    pub fn lattice(&self) -> &lattice::HeadLattice {
-        &self.lattice
     }
 
     /// Refuses a query whose start configuration is not valid or whose goal cannot
@@ -439,7 +436,7 @@ impl ArcPlanner {
                         from,
                         to,
                         replans,
-                        narrowest: route.map(|r| (r.narrowest, r.narrowest_margin)),
+                        narrowest: route.map(|r| (r.narrowest.into(), r.narrowest_margin)),
                     })
                 }
                 Err(e) => return Err(e),
@@ -537,8 +534,10 @@ impl SolutionStats for Stats {
         plan.stats
             .insert("min_margin".into(), serde_json::json!(self.min_margin));
         if let Some(at) = self.min_margin_at {
-            plan.stats
-                .insert("min_margin_at".into(), serde_json::json!(at));
+            plan.stats.insert(
+                "min_margin_at".into(),
+                serde_json::json!(<[f64; 3]>::from(at)),
+            );
         }
     }
 }

@@ -4,6 +4,7 @@
 use std::time::{Duration, Instant};
 
 use aerial_chain_core::Shape;
+use nalgebra::Point3;
 
 use super::expired;
 use crate::collision::CollisionContext;
@@ -40,22 +41,31 @@ impl Checker {
     }
 
     /// The shape is collision-free with the head at `xi` (shape known valid).
-    pub fn placement(&mut self, xi: [f64; 3], s: &Shape) -> bool {
+    pub fn placement(&mut self, xi: impl Into<Point3<f64>>, s: &Shape) -> bool {
+        let xi = xi.into();
         self.timed(|c| c.check_placement(xi, s).is_ok())
     }
 
     /// The configuration is valid (joint limits, self-collision, map).
-    pub fn config(&mut self, xi: [f64; 3], s: &Shape) -> bool {
+    pub fn config(&mut self, xi: impl Into<Point3<f64>>, s: &Shape) -> bool {
+        let xi = xi.into();
         self.timed(|c| c.check_config(xi, s).is_ok())
     }
 
     /// The chain in shape `s` can translate from `a` to `b`.
-    pub fn translation(&mut self, a: [f64; 3], b: [f64; 3], s: &Shape) -> bool {
+    pub fn translation(
+        &mut self,
+        a: impl Into<Point3<f64>>,
+        b: impl Into<Point3<f64>>,
+        s: &Shape,
+    ) -> bool {
+        let (a, b) = (a.into(), b.into());
         self.timed(|c| c.check_translation(a, b, s).is_ok())
     }
 
     /// The chain can change shape from `s` to `t` with the head at `xi`.
-    pub fn shape_change(&mut self, xi: [f64; 3], s: &Shape, t: &Shape) -> bool {
+    pub fn shape_change(&mut self, xi: impl Into<Point3<f64>>, s: &Shape, t: &Shape) -> bool {
+        let xi = xi.into();
         self.timed(|c| c.check_shape_change(xi, s, t).is_ok())
     }
 }

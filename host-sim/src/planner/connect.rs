@@ -5,10 +5,11 @@
 
 use aerial_chain_core::lsc::LscKind;
 use aerial_chain_core::Shape;
+use nalgebra::Point3;
 
 use super::candidates::{self, Candidate, Source};
 use super::construction::{Construction, Leg};
-use super::roadmap::{self, VertexId};
+use super::roadmap::VertexId;
 use super::{follow, srs_connect, Mode, Preference};
 use crate::collision::CollisionContext;
 
@@ -111,7 +112,7 @@ impl Construction<'_> {
     /// the body is laid back along the head's track ([`follow::lay_along_newest_last`]).
     fn follow(&mut self, a: [f64; 3], b: [f64; 3]) -> Option<Vec<Leg>> {
         let params = *self.planner.ctx.params();
-        let len = roadmap::dist(a, b);
+        let len = super::dist(a, b);
         let n = ((len / self.planner.settings.follow_step).ceil() as usize).max(1);
         // Newest point last: each step appends (inserting at the front made long
         // edges quadratic).
@@ -156,9 +157,9 @@ impl Construction<'_> {
     /// steps began. A rigid body's corners sharper than 90 degrees are cut first: a
     /// zig-zag at the bend limit (the serpentines) cannot be slid along.
     fn track(&self, a: [f64; 3]) -> Vec<nalgebra::Vector3<f32>> {
-        let v = |p: [f64; 3]| nalgebra::Vector3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+        let v = |p: Point3<f64>| nalgebra::Vector3::new(p[0] as f32, p[1] as f32, p[2] as f32);
         let params = self.planner.ctx.params();
-        let mut track = vec![v(a)];
+        let mut track = vec![v(a.into())];
         let mut length = 0.0;
         // Twice the chain's reach: a winding track takes more than one reach of chords.
         let need = 2.0 * (params.reach() as f64 + 1.0);
@@ -243,7 +244,7 @@ impl Construction<'_> {
 /// the segment `a b`, sampled every quarter voxel (m, at least 0).
 fn head_margin(ctx: &CollisionContext, a: [f64; 3], b: [f64; 3]) -> f64 {
     let step = ctx.field().grid().resolution() / 4.0;
-    let n = (roadmap::dist(a, b) / step).ceil().max(1.0) as usize;
+    let n = (super::dist(a, b) / step).ceil().max(1.0) as usize;
     let r_u = ctx.params().unit_radius as f64;
     (0..=n)
         .map(|i| {

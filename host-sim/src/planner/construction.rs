@@ -94,7 +94,7 @@ impl<'p> Construction<'p> {
             banned: BTreeSet::new(),
             current,
             steps: vec![Step {
-                xi: start,
+                xi: start.into(),
                 shape,
                 source: Source::Start,
                 shape_change: false,
@@ -171,8 +171,8 @@ impl<'p> Construction<'p> {
                 stuck_replans += 1;
                 if stuck_replans > self.max_replans {
                     return Err(PlanError::NoShape {
-                        from,
-                        to,
+                        from: from.into(),
+                        to: to.into(),
                         replans: self.stats.replans,
                         narrowest: None,
                     });
@@ -196,8 +196,8 @@ impl<'p> Construction<'p> {
                     }
                     Err(_) => {
                         return Err(PlanError::NoShape {
-                            from,
-                            to,
+                            from: from.into(),
+                            to: to.into(),
                             replans: self.stats.replans,
                             narrowest: None,
                         })
@@ -211,7 +211,7 @@ impl<'p> Construction<'p> {
         for &(len, m, at) in &self.relaxed {
             if len < self.steps.len() && m < self.stats.min_margin {
                 self.stats.min_margin = m;
-                self.stats.min_margin_at = Some(at);
+                self.stats.min_margin_at = Some(at.into());
             }
         }
         self.stats.timings.collision_s = self.checker.time.as_secs_f64();
@@ -237,7 +237,7 @@ impl<'p> Construction<'p> {
             }
             let cur = self.current;
             self.steps.push(Step {
-                xi: leg.to,
+                xi: leg.to.into(),
                 shape: cur.shape,
                 source: cur.source,
                 shape_change: false,

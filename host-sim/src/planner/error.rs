@@ -1,10 +1,13 @@
 //! Why the ARC planner gives no plan, or cannot be asked.
 
+use nalgebra::Point3;
+
 use super::Failure;
 
 /// A point for messages: `(x, y, z)` to the millimetre.
-pub(super) fn point(p: &[f64; 3]) -> String {
-    format!("({:.3}, {:.3}, {:.3})", p[0], p[1], p[2])
+pub(super) fn point(p: &(impl Copy + Into<Point3<f64>>)) -> String {
+    let p: Point3<f64> = (*p).into();
+    format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z)
 }
 
 /// Why a query has no solution, or cannot be asked.
@@ -39,14 +42,14 @@ pub enum PlanError {
     )]
     NoShape {
         /// The last edge tried.
-        from: [f64; 3],
+        from: Point3<f64>,
         /// Its end.
-        to: [f64; 3],
+        to: Point3<f64>,
         /// Replans made.
         replans: usize,
         /// The head route's narrowest point and the head's margin there (m), when the
         /// lattice found a route.
-        narrowest: Option<([f64; 3], f64)>,
+        narrowest: Option<(Point3<f64>, f64)>,
     },
     /// The head's sphere cannot get from the start to the goal at all: the lattice
     /// search flooded one side's free region without meeting the other.
@@ -72,7 +75,7 @@ pub enum PlanError {
 }
 
 /// The tail of [`PlanError::NoShape`]'s message: where the head route is narrowest.
-fn narrow_note(n: &Option<([f64; 3], f64)>) -> String {
+fn narrow_note(n: &Option<(Point3<f64>, f64)>) -> String {
     match n {
         Some((p, m)) => format!(
             "; the head route is narrowest at ({:.3}, {:.3}, {:.3}), where the head keeps {:.3} m from the map",

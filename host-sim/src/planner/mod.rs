@@ -42,7 +42,7 @@ use nalgebra::Point3;
 
 pub use arc::{ArcPlanner, Stats};
 pub use candidates::Source;
-pub use checker::Checker;
+pub(crate) use checker::Checker;
 pub use error::PlanError;
 pub use motion::{annotate_quality, source_label, to_plan};
 pub use refine::{Quality, Refinement};
@@ -82,7 +82,7 @@ impl Query {
 
     /// The head's start and goal as the arrays the collision checks and the roadmaps
     /// take.
-    pub fn ends(&self) -> ([f64; 3], [f64; 3]) {
+    pub(crate) fn ends(&self) -> ([f64; 3], [f64; 3]) {
         (self.start.into(), self.goal.into())
     }
 }
@@ -102,6 +102,11 @@ impl Termination {
     }
 }
 
+/// Euclidean distance between two points, arrays or points (m).
+pub(crate) fn dist(a: impl Into<Point3<f64>>, b: impl Into<Point3<f64>>) -> f64 {
+    nalgebra::distance(&a.into(), &b.into())
+}
+
 /// Whether `deadline` has passed.
 pub(crate) fn expired(deadline: Option<Instant>) -> bool {
     deadline.is_some_and(|d| Instant::now() > d)
@@ -111,7 +116,7 @@ pub(crate) fn expired(deadline: Option<Instant>) -> bool {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Step {
     /// Head position (m).
-    pub xi: [f64; 3],
+    pub xi: Point3<f64>,
     /// Shape.
     pub shape: Shape,
     /// Where the shape came from (for translations: the shape kept).

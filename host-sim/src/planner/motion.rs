@@ -36,7 +36,7 @@ pub fn to_plan<S: SolutionStats>(
     map: MapSection,
 ) -> Plan {
     let st = &solution.stats;
-    let steps = solution.steps.iter().map(|s| (s.xi, &s.shape));
+    let steps = solution.steps.iter().map(|s| (s.xi.into(), &s.shape));
     let mut plan = Plan::from_steps(
         params,
         map,

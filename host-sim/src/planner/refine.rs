@@ -21,6 +21,7 @@
 //! costs a few checks; a budget of checks bounds the whole pass. Refinement counts
 //! checks, not time, so it is deterministic: the same plan gives the same result.
 
+use nalgebra::Point3;
 use std::time::Instant;
 
 use aerial_chain_core::angle;
@@ -73,7 +74,7 @@ impl Quality {
         let mut q = Self::default();
         for w in steps.windows(2) {
             let (a, b) = (&w[0], &w[1]);
-            q.head_path_m += super::roadmap::dist(a.xi, b.xi);
+            q.head_path_m += super::dist(a.xi, b.xi);
             if differs(&a.shape, &b.shape) {
                 q.shape_changes += 1;
                 q.shape_motion_rad += shape_motion(&a.shape, &b.shape);
@@ -274,7 +275,7 @@ impl Pass<'_> {
             return None;
         }
         let (a, b) = (self.poses[i], self.poses[j]);
-        let moved = super::roadmap::dist(a.xi, b.xi) > 0.0;
+        let moved = super::dist(a.xi, b.xi) > 0.0;
         let change = differs(&a.shape, &b.shape);
         let translate = |shape: Shape, source: Source| Step {
             xi: b.xi,
@@ -282,7 +283,7 @@ impl Pass<'_> {
             source,
             shape_change: false,
         };
-        let change_at = |xi: [f64; 3]| Step {
+        let change_at = |xi: Point3<f64>| Step {
             xi,
             shape: b.shape,
             source: b.source,
@@ -369,23 +370,23 @@ impl Pass<'_> {
         }
     }
 
-    fn translation(&mut self, a: [f64; 3], b: [f64; 3], s: &Shape) -> bool {
+    fn translation(&mut self, a: Point3<f64>, b: Point3<f64>, s: &Shape) -> bool {
         self.checks += 1;
         self.checker.translation(a, b, s)
     }
 
-    fn shape_change(&mut self, xi: [f64; 3], s: &Shape, t: &Shape) -> bool {
+    fn shape_change(&mut self, xi: Point3<f64>, s: &Shape, t: &Shape) -> bool {
         self.checks += 1;
         self.checker.shape_change(xi, s, t)
     }
 }
 
 impl super::shorten::Checks for Pass<'_> {
-    fn translation(&mut self, a: [f64; 3], b: [f64; 3], s: &Shape) -> bool {
+    fn translation(&mut self, a: Point3<f64>, b: Point3<f64>, s: &Shape) -> bool {
         Pass::translation(self, a, b, s)
     }
 
-    fn shape_change(&mut self, xi: [f64; 3], s: &Shape, t: &Shape) -> bool {
+    fn shape_change(&mut self, xi: Point3<f64>, s: &Shape, t: &Shape) -> bool {
         Pass::shape_change(self, xi, s, t)
     }
 
@@ -410,7 +411,7 @@ mod tests {
 
     fn step(xi: [f64; 3], yaw: f32, shape_change: bool) -> Step {
         Step {
-            xi,
+            xi: xi.into(),
             shape: Shape::line(4, yaw),
             source: if shape_change {
                 Source::Rotation

@@ -15,6 +15,7 @@ use kiddo::SquaredEuclidean;
 use rand::Rng;
 use rand_pcg::Pcg64;
 
+use super::dist;
 use super::graph::{Edge, EdgeState, LazyGraph};
 use crate::collision::CollisionContext;
 
@@ -46,11 +47,6 @@ pub enum RouteError {
     StartIsolated,
     /// No path to the goal region exists in the roadmap.
     Unreachable,
-}
-
-/// Euclidean distance between two points (m).
-pub(super) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
 impl Roadmap {

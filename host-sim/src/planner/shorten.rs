@@ -30,6 +30,7 @@
 //! Everything is decided by checks in a fixed order, so it is deterministic.
 
 use aerial_chain_core::{angle, Shape, MAX_SHAPE_DIM};
+use nalgebra::Point3;
 
 use super::candidates::Source;
 use super::refine::shape_motion;
@@ -49,9 +50,9 @@ const MAX_PASSES: usize = 4;
 /// deadline).
 pub(super) trait Checks {
     /// The chain in shape `s` can translate from `a` to `b`.
-    fn translation(&mut self, a: [f64; 3], b: [f64; 3], s: &Shape) -> bool;
+    fn translation(&mut self, a: Point3<f64>, b: Point3<f64>, s: &Shape) -> bool;
     /// The chain can change shape from `s` to `t` with the head at `xi`.
-    fn shape_change(&mut self, xi: [f64; 3], s: &Shape, t: &Shape) -> bool;
+    fn shape_change(&mut self, xi: Point3<f64>, s: &Shape, t: &Shape) -> bool;
     /// No more checks may be made.
     fn exhausted(&self) -> bool;
 }
@@ -62,7 +63,7 @@ pub(super) trait Checks {
 struct Run {
     shape: Shape,
     source: Source,
-    pts: Vec<[f64; 3]>,
+    pts: Vec<Point3<f64>>,
     /// The pass that last changed it (0: none).
     changed: usize,
 }

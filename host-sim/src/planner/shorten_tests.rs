@@ -1,5 +1,6 @@
 use super::*;
 use crate::planner::refine::Quality;
+use nalgebra::Point3;
 
 /// Checks from two rules, one for translations (by where they begin along x and the
 /// shape flown) and one for
@@ -11,11 +12,11 @@ struct Rule<T: Fn(f64, &Shape) -> bool, C: Fn(&Shape, &Shape) -> bool> {
 }
 
 impl<T: Fn(f64, &Shape) -> bool, C: Fn(&Shape, &Shape) -> bool> Checks for Rule<T, C> {
-    fn translation(&mut self, a: [f64; 3], _: [f64; 3], s: &Shape) -> bool {
+    fn translation(&mut self, a: Point3<f64>, _: Point3<f64>, s: &Shape) -> bool {
         self.checks += 1;
         (self.translation)(a[0], s)
     }
-    fn shape_change(&mut self, _: [f64; 3], s: &Shape, t: &Shape) -> bool {
+    fn shape_change(&mut self, _: Point3<f64>, s: &Shape, t: &Shape) -> bool {
         self.checks += 1;
         (self.change)(s, t)
     }
@@ -46,7 +47,7 @@ fn bent(y0: f32, y1: f32) -> Shape {
 
 fn step(x: f64, shape: Shape, shape_change: bool) -> Step {
     Step {
-        xi: [x, 0.0, 1.0],
+        xi: Point3::new(x, 0.0, 1.0),
         shape,
         source: if shape_change {
             Source::Rotation

@@ -299,7 +299,7 @@ impl Widener<'_> {
         }
         let at = |t: f64| {
             let mut s = self.steps[e + 1];
-            s.xi = [0, 1, 2].map(|i| a[i] + t * (b[i] - a[i]));
+            s.xi = Point3::from([0, 1, 2].map(|i| a[i] + t * (b[i] - a[i])));
             s.shape_change = false;
             s
         };
@@ -427,7 +427,7 @@ impl Widener<'_> {
         let mut moved = self.steps.clone();
         for s in group {
             for st in &mut moved[s.first..=s.last] {
-                st.xi = [st.xi[0] + delta.x, st.xi[1] + delta.y, st.xi[2] + delta.z];
+                st.xi += delta;
             }
         }
         let lo = group
@@ -584,7 +584,7 @@ mod tests {
 
     fn step(xi: [f64; 3], shape: &Shape) -> Step {
         Step {
-            xi,
+            xi: xi.into(),
             shape: *shape,
             source: Source::Follow,
             shape_change: false,

@@ -46,7 +46,7 @@ pub struct ControllerConfig {
     /// Largest angular acceleration a link controller asks for (rad/s^2).
     pub link_max_angular_accel: f64,
     /// Closed-loop natural frequency of each unit's roll, pitch and yaw (rad/s).
-    pub unit_bandwidth: [f64; 3],
+    pub unit_bandwidth: V3,
     /// Damping ratio of each unit's attitude.
     pub unit_damping: f64,
     /// Largest tilt of any unit's thrust from vertical (rad).
@@ -66,7 +66,7 @@ impl Default for ControllerConfig {
             link_bandwidth: 3.0,
             link_damping: 1.0,
             link_max_angular_accel: 8.0,
-            unit_bandwidth: [14.0, 14.0, 6.0],
+            unit_bandwidth: V3::new(14.0, 14.0, 6.0),
             unit_damping: 0.9,
             tilt_max: 35f64.to_radians(),
             disturbance_gain: 5.0,
@@ -115,7 +115,7 @@ pub struct ControlOutput {
     /// The force asked of each unit (world, N), after the tilt limit.
     pub forces: Vec<V3>,
     /// Each unit's commanded `[roll, pitch, yaw]` (rad).
-    pub attitude_cmd: Vec<[f64; 3]>,
+    pub attitude_cmd: Vec<V3>,
     /// Each link's measured `(pitch, yaw)` (rad).
     pub link_angles: Vec<(f64, f64)>,
     /// Whether the last MPC solve succeeded (false: a fallback PD law was used).
@@ -414,7 +414,7 @@ impl ChainController {
         units: &[BodyState],
         forces: &[V3],
         head_yaw: f64,
-    ) -> (Vec<UnitCommand>, Vec<V3>, Vec<[f64; 3]>) {
+    ) -> (Vec<UnitCommand>, Vec<V3>, Vec<V3>) {
         let n = units.len();
         let g = self.model.gravity;
         let unit = self.model.unit;
@@ -447,7 +447,7 @@ impl ChainController {
                 &AttitudeSetpoint::hold(r_d),
             );
             let rpy = euler_zyx(&r_d);
-            attitude_cmd.push([rpy[0] as f64, rpy[1] as f64, rpy[2] as f64]);
+            attitude_cmd.push(V3::new(rpy[0] as f64, rpy[1] as f64, rpy[2] as f64));
             commands.push(UnitCommand {
                 thrust,
                 moment: out.moment.cast::<f64>(),

@@ -6,6 +6,7 @@
 
 use aerial_chain_core::ChainParams;
 
+use super::dynamics::V3;
 use super::SettingsError;
 
 /// Standard gravity (m/s^2).
@@ -17,13 +18,13 @@ pub struct UnitModel {
     /// Mass (kg).
     pub mass: f64,
     /// Principal moments of inertia about body x, y, z (kg m^2).
-    pub inertia: [f64; 3],
+    pub inertia: V3,
     /// Smallest collective thrust (N): rotors do not reverse.
     pub thrust_min: f64,
     /// Largest collective thrust (N).
     pub thrust_max: f64,
     /// Largest body moment about x, y, z (N m).
-    pub max_moment: [f64; 3],
+    pub max_moment: V3,
     /// Time constant of the first-order lag from commanded to produced thrust and
     /// moment (s): the motors' spin-up.
     pub motor_time_constant: f64,
@@ -33,11 +34,11 @@ impl Default for UnitModel {
     fn default() -> Self {
         Self {
             mass: 1.0,
-            inertia: [0.0082, 0.0082, 0.0149],
+            inertia: V3::new(0.0082, 0.0082, 0.0149),
             thrust_min: 0.5,
             // A thrust-to-weight ratio of about 2.2 for a unit carrying a link.
             thrust_max: 24.0,
-            max_moment: [1.0, 1.0, 0.15],
+            max_moment: V3::new(1.0, 1.0, 0.15),
             motor_time_constant: 0.02,
         }
     }
@@ -66,9 +67,9 @@ impl Default for LinkModel {
 
 impl LinkModel {
     /// Principal inertia of a link of length `l` about its axis (x) and across it.
-    pub fn inertia(&self, l: f64) -> [f64; 3] {
+    pub fn inertia(&self, l: f64) -> V3 {
         let across = self.mass * l * l / 12.0;
-        [self.min_axial_inertia, across, across]
+        V3::new(self.min_axial_inertia, across, across)
     }
 }
 

@@ -302,7 +302,7 @@ pub fn run(a: PlanArgs) -> CliResult {
         timed = Some(tr);
     }
     if let Some(pic) = &a.picture {
-        let goal = Some((query.goal.into(), query.goal_tol));
+        let goal = Some((query.goal, query.goal_tol));
         match draw(&a, pic, grid, &plan, timed, goal)? {
             Some((frames, step)) => report.line(format_args!(
                 "  animation: {} ({frames} frames, one per {step} s of the trajectory)",
@@ -323,7 +323,7 @@ fn draw(
     grid: &aerial_chain::map::Grid,
     plan: &aerial_chain::plan_file::Plan,
     timed: Option<aerial_chain::trajectory::Trajectory>,
-    goal: Option<([f64; 3], f64)>,
+    goal: Option<(nalgebra::Point3<f64>, f64)>,
 ) -> Result<Option<(usize, f64)>, CliError> {
     use aerial_chain::plan_picture::{self as pp, AnimationOptions, Motion, PictureOptions};
     let title = format!("ARCplanner on {}", a.problem.map.name());

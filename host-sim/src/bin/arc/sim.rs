@@ -216,7 +216,7 @@ pub fn run(a: SimArgs) -> CliResult {
             goal: flight
                 .samples
                 .last()
-                .map(|s| (s.head_ref.map(f64::from), a.goal_tol)),
+                .map(|s| (s.head_ref.map(f64::from).into(), a.goal_tol)),
             step: a.frame_step,
             planned_label: "head reference".into(),
         };

@@ -12,7 +12,7 @@ use super::tree::{
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Leaf {
     /// Centre of the cube, metres, computed exactly as OctoMap's `keyToCoord(key, depth)`.
-    pub center: [f64; 3],
+    pub center: Point3<f64>,
     /// Edge of the cube, metres: `resolution * 2^(16 - depth)` (OctoMap's `getNodeSize`).
     pub size: f64,
     /// True when occupied, false when free.
@@ -36,8 +36,8 @@ impl OcTree {
     /// The box around all known leaves, `(min, max)`, computed exactly as OctoMap's
     /// `getMetricMin`/`getMetricMax` (for each leaf, `centre - size/2` and that plus `size`).
     /// `None` for an empty tree (where OctoMap reports zeros).
-    pub fn metric_bounds(&self) -> Option<([f64; 3], [f64; 3])> {
-        self.stats.bounds
+    pub fn metric_bounds(&self) -> Option<(Point3<f64>, Point3<f64>)> {
+        self.stats.bounds.map(|(lo, hi)| (lo.into(), hi.into()))
     }
 
     /// `(occupied leaves, free leaves)`.
@@ -143,7 +143,7 @@ impl Iterator for Leaves<'_> {
                 c => {
                     let size = node_size(self.tree.resolution, depth);
                     return Some(Leaf {
-                        center: cell.map(|i| cell_center(i, depth, size)),
+                        center: cell.map(|i| cell_center(i, depth, size)).into(),
                         size,
                         occupied: c == CHILD_OCCUPIED,
                         depth,

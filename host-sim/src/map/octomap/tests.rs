@@ -2,6 +2,8 @@
 //! bit and child order, header parsing, round trips, pruning, and every way a file can
 //! be bad. The comparison with the real library is in `host-sim/tests/octomap_reference.rs`.
 
+use nalgebra::Point3;
+
 use super::query::Leaf;
 use super::*;
 
@@ -69,10 +71,10 @@ fn err(bytes: &[u8]) -> MapFileError {
 }
 
 /// OctoMap's calcMinMax, visiting every leaf.
-fn brute_bounds(tree: &OcTree) -> Option<([f64; 3], [f64; 3])> {
-    let mut out: Option<([f64; 3], [f64; 3])> = None;
+fn brute_bounds(tree: &OcTree) -> Option<(Point3<f64>, Point3<f64>)> {
+    let mut out: Option<(Point3<f64>, Point3<f64>)> = None;
     for leaf in tree.leaves() {
-        let (mut mn, mut mx) = out.unwrap_or(([f64::MAX; 3], [-f64::MAX; 3]));
+        let (mut mn, mut mx) = out.unwrap_or(([f64::MAX; 3].into(), [-f64::MAX; 3].into()));
         for a in 0..3 {
             let lo = leaf.center[a] - leaf.size / 2.0;
             mn[a] = mn[a].min(lo);
@@ -94,19 +96,19 @@ fn bit_order_and_child_order_follow_octomap() {
         leaves,
         vec![
             Leaf {
-                center: [-h, -h, -h],
+                center: [-h, -h, -h].into(),
                 size: 32768.0,
                 occupied: true,
                 depth: 1
             },
             Leaf {
-                center: [h, -h, -h],
+                center: [h, -h, -h].into(),
                 size: 32768.0,
                 occupied: false,
                 depth: 1
             },
             Leaf {
-                center: [8192.0; 3],
+                center: [8192.0; 3].into(),
                 size: 16384.0,
                 occupied: false,
                 depth: 2
@@ -120,7 +122,10 @@ fn bit_order_and_child_order_follow_octomap() {
     assert_eq!(tree.query([20000.0, 20000.0, 20000.0]), None);
     assert_eq!(
         tree.metric_bounds(),
-        Some(([-32768.0, -32768.0, -32768.0], [32768.0, 16384.0, 16384.0]))
+        Some((
+            Point3::new(-32768.0, -32768.0, -32768.0),
+            Point3::new(32768.0, 16384.0, 16384.0)
+        ))
     );
     // The writer gives back the same tree bytes.
     assert!(tree.to_bt_bytes().ends_with(&[0x06, 0xc0, 0x01, 0x00]));
@@ -140,13 +145,16 @@ fn writer_header_is_octomaps() {
     assert_eq!(
         leaves,
         vec![Leaf {
-            center: [0.025; 3],
+            center: [0.025; 3].into(),
             size: 0.05,
             occupied: true,
             depth: 16
         }]
     );
-    assert_eq!(tree.metric_bounds(), Some(([0.0; 3], [0.05; 3])));
+    assert_eq!(
+        tree.metric_bounds(),
+        Some(([0.0; 3].into(), [0.05; 3].into()))
+    );
 }
 
 #[test]

@@ -35,6 +35,7 @@ impl HeadLattice {
     }
 
     /// Whether the sphere of radius `r_min` is free at `p` (exact test).
+    #[cfg(test)]
     pub fn is_free(&self, field: &DistanceField, p: [f64; 3]) -> bool {
         self.point_clearance(field, p).is_some()
     }

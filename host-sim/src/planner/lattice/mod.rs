@@ -57,6 +57,7 @@ mod tests;
 pub use crate::collision::exact::exact_clearance;
 pub use regions::Regions;
 
+use super::dist;
 use crate::collision::{CollisionContext, FK_TOLERANCE};
 use crate::map::distance::DistanceField;
 use nodes::Nodes;
@@ -158,8 +159,8 @@ impl HeadLattice {
         let unit_r = ctx.params().unit_radius as f64;
         let pref = ctx.clearance_margin();
         Self {
-            lo,
-            hi,
+            lo: lo.into(),
+            hi: hi.into(),
             h,
             n: dims.map(|d| 2 * d as i64),
             unit_r,
@@ -232,11 +233,6 @@ impl HeadLattice {
         self.r_min
     }
 
-    /// Lattice spacing `h` (m).
-    pub fn spacing(&self) -> f64 {
-        self.h
-    }
-
     pub(super) fn pack(&self, i: [i64; 3]) -> Option<u64> {
         if (0..3).all(|a| i[a] >= 0 && i[a] <= self.n[a])
             && self.n.iter().all(|&n| n < (1 << AXIS_BITS))
@@ -279,6 +275,7 @@ impl HeadLattice {
     /// First over the voxel centres (an eighth of the points), which finds a route in
     /// all but the tightest passages; then, when that fails, over the whole half-cell
     /// lattice, with the floods that prove a failure.
+    #[cfg(test)]
     pub fn route(
         &self,
         ctx_min: &CollisionContext,
@@ -414,9 +411,4 @@ pub(super) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 pub(super) fn norm(a: [f64; 3]) -> f64 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
-}
-
-/// Euclidean distance (m).
-pub(super) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
