@@ -94,6 +94,59 @@ pub enum FileError {
     },
 }
 
+/// A rule of the `arc-trajectory/1` format that needs no map, broken: each names the
+/// field and the value at fault.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SampleError {
+    /// Another format or version.
+    #[error("format = {0:?}, expected {FORMAT:?}")]
+    Format(String),
+    /// The chain or map section, as a plan file's rules have it.
+    #[error(transparent)]
+    Section(#[from] FormatError),
+    /// A trajectory without samples.
+    #[error("samples is empty")]
+    NoSamples,
+    /// A time or a `zeta` that is not finite, or a `zeta` of the wrong length.
+    #[error(
+        "samples[{index}]: t and zeta must be finite, zeta {expected} numbers for N = {units}"
+    )]
+    Zeta {
+        /// The sample.
+        index: usize,
+        /// Numbers a configuration of this chain has (`2N + 2`).
+        expected: usize,
+        /// The chain's units.
+        units: usize,
+    },
+    /// Unit positions or attitudes not one per unit.
+    #[error("samples[{index}]: p and q must have {units} entries")]
+    Entries {
+        /// The sample.
+        index: usize,
+        /// The chain's units.
+        units: usize,
+    },
+    /// A recorded unit position that is not where `zeta` puts the unit.
+    #[error("samples[{index}].p[{unit}] is not where zeta puts unit {}", unit + 1)]
+    Position {
+        /// The sample.
+        index: usize,
+        /// The unit (0-based).
+        unit: usize,
+    },
+    /// A recorded unit attitude that is not the head's yaw.
+    #[error("samples[{index}].q[{unit}] is not the head's yaw zeta[3] = {yaw}")]
+    Attitude {
+        /// The sample.
+        index: usize,
+        /// The unit (0-based).
+        unit: usize,
+        /// The head's yaw in the sample (rad).
+        yaw: f64,
+    },
+}
+
 /// Quaternion `[w, x, y, z]` of a rotation by `yaw` about z.
 fn yaw_quaternion(yaw: f64) -> [f64; 4] {
     [(yaw / 2.0).cos(), 0.0, 0.0, (yaw / 2.0).sin()]
@@ -165,7 +218,10 @@ impl TrajectoryFile {
             }),
             Ok(file) => match file.check() {
                 Ok(_) => Ok(file),
-                Err(what) => Err(FileError::Invalid { path, what }),
+                Err(e) => Err(FileError::Invalid {
+                    path,
+                    what: e.to_string(),
+                }),
             },
         }
     }
@@ -174,29 +230,30 @@ impl TrajectoryFile {
     /// sample, every `zeta` of the chain's length and finite, and the recorded unit
     /// positions and attitudes those `zeta` give (within 1e-6). Time order and the
     /// motion itself are [`super::check_samples`]'s.
-    pub fn check(&self) -> Result<ChainParams, String> {
+    pub fn check(&self) -> Result<ChainParams, SampleError> {
         if self.format != FORMAT {
-            return Err(format!("format = {:?}, expected {FORMAT:?}", self.format));
+            return Err(SampleError::Format(self.format.clone()));
         }
-        let params = self.chain.to_params().map_err(|e| e.to_string())?;
+        let params = self.chain.to_params()?;
         if !(self.map.resolution.is_finite() && self.map.resolution > 0.0) {
-            return Err(FormatError::Resolution(self.map.resolution).to_string());
+            return Err(FormatError::Resolution(self.map.resolution).into());
         }
         if self.samples.is_empty() {
-            return Err("samples is empty".into());
+            return Err(SampleError::NoSamples);
         }
         let n = params.n();
         let l = params.link_length as f64;
         for (i, s) in self.samples.iter().enumerate() {
             let z = &s.zeta;
             if z.len() != 2 * n + 2 || z.iter().chain([&s.t]).any(|v| !v.is_finite()) {
-                return Err(format!(
-                    "samples[{i}]: t and zeta must be finite, zeta {} numbers for N = {n}",
-                    2 * n + 2
-                ));
+                return Err(SampleError::Zeta {
+                    index: i,
+                    expected: 2 * n + 2,
+                    units: n,
+                });
             }
             if s.p.len() != n || s.q.len() != n {
-                return Err(format!("samples[{i}]: p and q must have {n} entries"));
+                return Err(SampleError::Entries { index: i, units: n });
             }
             let p = positions_f64(l, [z[0], z[1], z[2]], &z[3..]);
             let q = yaw_quaternion(z[3]);
@@ -211,17 +268,15 @@ impl TrajectoryFile {
                         .fold(0.0, f64::max)
                 };
                 if dp.is_nan() || dp > RECORD_TOLERANCE {
-                    return Err(format!(
-                        "samples[{i}].p[{u}] is not where zeta puts unit {}",
-                        u + 1
-                    ));
+                    return Err(SampleError::Position { index: i, unit: u });
                 }
                 let off = dq(1.0).min(dq(-1.0));
                 if off.is_nan() || off > RECORD_TOLERANCE {
-                    return Err(format!(
-                        "samples[{i}].q[{u}] is not the head's yaw zeta[3] = {}",
-                        z[3]
-                    ));
+                    return Err(SampleError::Attitude {
+                        index: i,
+                        unit: u,
+                        yaw: z[3],
+                    });
                 }
             }
         }

@@ -29,7 +29,7 @@ use crate::plan_file::{ChainSection, FormatError, MapSection, Plan};
 
 pub use build::{build, Trajectory};
 pub use check::{check_samples, CheckReport, Peaks, Problem, Violation, LIMIT_TOLERANCE};
-pub use file::{FileError, SampleRow, TrajectoryFile, TrajectoryStats, FORMAT};
+pub use file::{FileError, SampleError, SampleRow, TrajectoryFile, TrajectoryStats, FORMAT};
 
 use serde::{Deserialize, Serialize};
 
