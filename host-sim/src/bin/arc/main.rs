@@ -90,25 +90,15 @@ enum Command {
     )]
     Tables(tables::TablesCommand),
     /// Draw the shape library (LSC) in top and side view.
-    #[command(after_help = "Example:\n  arc shapes --units 6 --out lsc.svg")]
     Shapes(tables::ShapesArgs),
     /// Plan a collision-free motion with shape changes (the ARCplanner).
-    #[command(
-        after_help = "Example:\n  arc plan --scenario window --units 5 --out window.json --picture window.svg"
-    )]
     Plan(Box<plan::PlanArgs>),
     /// Check a plan or a trajectory exactly against a map (docs/model.md), independent
     /// of the planner.
     ///
     /// A trajectory is checked against the limits given here, not the ones it records.
-    #[command(
-        after_help = "Examples:\n  arc verify --scenario window --plan window.json\n  arc verify --scenario window --trajectory window-t.json"
-    )]
     Verify(verify::VerifyArgs),
     /// Time a plan into a trajectory that blends through its corners (CSV or JSON).
-    #[command(
-        after_help = "Example:\n  arc trajectory --scenario window --plan window.json --out window-t.json"
-    )]
     Trajectory(trajectory::TrajectoryArgs),
     /// Maps: export built-in scenarios as OctoMap files, inspect and draw maps.
     #[command(subcommand, after_help = "Example:\n  arc map info maps/geb079.bt")]
@@ -117,18 +107,12 @@ enum Command {
     #[command(subcommand, after_help = "Example:\n  arc bench paper --quick")]
     Bench(bench::BenchCommand),
     /// Fly a plan: chain dynamics, head MPC, link SO(3) controllers, unit attitude loops.
-    #[command(
-        after_help = "Example:\n  arc sim --scenario window --plan window.json --picture flight.svg"
-    )]
     Sim(sim::SimArgs),
     /// Write one HTML page with a 3D view of a plan (and a flight) on its map.
     ///
     /// The page opens from disk in a browser, offline. Waypoint times are those `arc sim`
     /// flies with its default limits; a flight keeps its own times. `view.html#t=3.5`
     /// opens at 3.5 s.
-    #[command(
-        after_help = "Examples:\n  arc view --scenario window --plan window.json --out view.html\n  arc sim --scenario window --plan window.json --out flight.json\n  arc view --scenario window --plan window.json --flight flight.json --out view.html"
-    )]
     View(view::ViewArgs),
 }
 

@@ -21,6 +21,9 @@ use aerial_chain::tables::{ShapeTables, TableSettings};
 
 /// `arc plan`
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  arc plan --scenario window --units 5 --out window.json --picture window.svg"
+)]
 pub struct PlanArgs {
     #[command(flatten)]
     problem: ProblemArgs,

@@ -25,6 +25,9 @@ use aerial_chain::trajectory::{self, Trajectory, TrajectoryError};
 
 /// `arc sim`
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  arc sim --scenario window --plan window.json --picture flight.svg"
+)]
 pub struct SimArgs {
     #[command(flatten)]
     map: MapArgs,

@@ -52,6 +52,7 @@ pub struct BuildArgs {
 
 /// `arc shapes`
 #[derive(Args, Debug)]
+#[command(after_help = "Example:\n  arc shapes --units 6 --out lsc.svg")]
 pub struct ShapesArgs {
     #[command(flatten)]
     chain: ChainArgs,

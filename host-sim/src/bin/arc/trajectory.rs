@@ -80,6 +80,9 @@ impl TimingArgs {
 
 /// `arc trajectory`
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  arc trajectory --scenario window --plan window.json --out window-t.json"
+)]
 pub struct TrajectoryArgs {
     #[command(flatten)]
     map: MapArgs,

@@ -14,6 +14,9 @@ use aerial_chain::trajectory::check_samples;
 
 /// `arc verify`
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Examples:\n  arc verify --scenario window --plan window.json\n  arc verify --scenario window --trajectory window-t.json"
+)]
 pub struct VerifyArgs {
     #[command(flatten)]
     map: MapArgs,

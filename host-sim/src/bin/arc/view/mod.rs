@@ -15,6 +15,9 @@ use scene::{FlightFile, Region, Scene};
 
 /// `arc view`
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Examples:\n  arc view --scenario window --plan window.json --out view.html\n  arc sim --scenario window --plan window.json --out flight.json\n  arc view --scenario window --plan window.json --flight flight.json --out view.html"
+)]
 pub struct ViewArgs {
     #[command(flatten)]
     map: MapArgs,
