@@ -1,6 +1,6 @@
 //! Why the full-state PRM gives no plan, or cannot be asked.
 
-use crate::planner::Failure;
+use crate::planner::{Failure, QueryError};
 
 /// Why a query has no answer, or cannot be asked.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -28,6 +28,15 @@ pub enum PrmError {
         /// A* searches made.
         iterations: usize,
     },
+}
+
+impl From<QueryError> for PrmError {
+    fn from(e: QueryError) -> Self {
+        match e {
+            QueryError::Start(why) => PrmError::StartInvalid(why),
+            QueryError::Goal(why) => PrmError::GoalInvalid(why),
+        }
+    }
 }
 
 impl Failure for PrmError {

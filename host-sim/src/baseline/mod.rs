@@ -57,7 +57,7 @@ use crate::collision::CollisionContext;
 use crate::plan_file::{Plan, Timings};
 use crate::planner::{Planner, Query, Solution, SolutionStats, Step, Termination};
 pub use error::PrmError;
-use roadmap::{valid_tolerance, Roadmap};
+use roadmap::Roadmap;
 use search::LazySearch;
 pub use settings::{prm_star_k, PrmSettings};
 
@@ -120,34 +120,6 @@ impl FullStatePrm {
     pub fn settings(&self) -> &PrmSettings {
         &self.settings
     }
-
-    /// Refuses a query of another chain, from an invalid start, or to a goal that
-    /// cannot hold the head.
-    fn check_query(&self, query: &Query) -> Result<(), PrmError> {
-        let ((start, goal), start_shape) = (query.ends(), &query.start_shape);
-        if start_shape.units() != self.ctx.params().n() {
-            return Err(PrmError::StartInvalid(format!(
-                "the start shape has {} units, the chain {}",
-                start_shape.units(),
-                self.ctx.params().n()
-            )));
-        }
-        self.ctx
-            .check_config(start, start_shape)
-            .map_err(|c| PrmError::StartInvalid(c.to_string()))?;
-        if !goal.iter().all(|v| v.is_finite()) || !self.ctx.is_head_free(goal) {
-            return Err(PrmError::GoalInvalid(format!(
-                "the head's sphere (radius + clearance) does not fit at {goal:?}"
-            )));
-        }
-        if !valid_tolerance(query.goal_tol) {
-            return Err(PrmError::GoalInvalid(format!(
-                "goal tolerance {} must be a finite number >= 0",
-                query.goal_tol
-            )));
-        }
-        Ok(())
-    }
 }
 
 impl Planner for FullStatePrm {
@@ -177,7 +149,7 @@ impl Planner for FullStatePrm {
     /// tolerance of its goal. Builds the roadmap first if needed (its time is reported
     /// apart, and capped by the same time limit).
     fn solve(&mut self, query: &Query, stop: Termination) -> Result<PrmSolution, PrmError> {
-        self.check_query(query)?;
+        query.check(&self.ctx)?;
         // One time limit for the roadmap and the query together (docs/promises.md).
         let solve_began = Instant::now();
         self.setup(query, stop);

@@ -19,7 +19,6 @@ use rand_pcg::Pcg64;
 use serde_json::Value;
 
 use super::construction::Construction;
-use super::error::point;
 use super::motion::source_label;
 use super::roadmap::Roadmap;
 use super::{
@@ -244,27 +243,6 @@ impl ArcPlanner {
             .sum()
     }
 
-    /// Refuses a query whose start configuration is not valid or whose goal cannot
-    /// hold the head (at the smallest clearance).
-    fn check_query(&self, query: &Query) -> Result<(), PlanError> {
-        let (start, goal) = query.ends();
-        self.ctx_min
-            .check_config(start, &query.start_shape)
-            .map_err(|c| PlanError::StartInvalid(c.to_string()))?;
-        if !self.ctx_min.is_head_free(goal) {
-            let why = if self.ctx.field().grid().in_bounds(goal) {
-                format!(
-                    "the head's sphere (radius + clearance) collides at {}",
-                    point(&goal)
-                )
-            } else {
-                format!("{} is outside the map's bounds", point(&goal))
-            };
-            return Err(PlanError::GoalInvalid(why));
-        }
-        Ok(())
-    }
-
     /// Plans `query` ([`Planner::solve`]). With the lattice on, first the quick
     /// straight-line head route ([`lattice::HeadLattice::quick_route`]) and the online
     /// construction along it alone: where no wall stands between start and goal (open
@@ -283,7 +261,7 @@ impl ArcPlanner {
             roadmap_s: self.setup_until(deadline),
             ..Built::default()
         };
-        self.check_query(query)?;
+        query.check(&self.ctx_min)?;
         let mut on_route = None;
         if self.settings.head_lattice {
             let (start, goal) = query.ends();

@@ -2,7 +2,7 @@
 
 use nalgebra::Point3;
 
-use super::Failure;
+use super::{Failure, QueryError};
 
 /// A point for messages: `(x, y, z)` to the millimetre.
 pub(super) fn point(p: &(impl Copy + Into<Point3<f64>>)) -> String {
@@ -72,6 +72,15 @@ pub enum PlanError {
         /// Replans made.
         replans: usize,
     },
+}
+
+impl From<QueryError> for PlanError {
+    fn from(e: QueryError) -> Self {
+        match e {
+            QueryError::Start(why) => PlanError::StartInvalid(why),
+            QueryError::Goal(why) => PlanError::GoalInvalid(why),
+        }
+    }
 }
 
 /// The tail of [`PlanError::NoShape`]'s message: where the head route is narrowest.

@@ -80,11 +80,52 @@ impl Query {
         }
     }
 
+    /// Refuses a query that cannot be asked in `ctx`: a start shape of another chain,
+    /// a start configuration that is not valid, a goal where the head's sphere does
+    /// not fit, or a goal tolerance that is not a finite number `>= 0`.
+    pub fn check(&self, ctx: &CollisionContext) -> Result<(), QueryError> {
+        let n = ctx.params().n();
+        if self.start_shape.units() != n {
+            let units = self.start_shape.units();
+            let why = format!("the start shape has {units} units, the chain {n}");
+            return Err(QueryError::Start(why));
+        }
+        ctx.check_config(self.start, &self.start_shape)
+            .map_err(|c| QueryError::Start(c.to_string()))?;
+        if !ctx.is_head_free(self.goal) {
+            let at = error::point(&self.goal);
+            let why = match ctx.field().grid().in_bounds(self.goal) {
+                true => format!("the head's sphere (radius + clearance) collides at {at}"),
+                false => format!("{at} is outside the map's bounds"),
+            };
+            return Err(QueryError::Goal(why));
+        }
+        if !(self.goal_tol.is_finite() && self.goal_tol >= 0.0) {
+            let why = format!(
+                "goal tolerance {} must be a finite number >= 0",
+                self.goal_tol
+            );
+            return Err(QueryError::Goal(why));
+        }
+        Ok(())
+    }
+
     /// The head's start and goal as the arrays the collision checks and the roadmaps
     /// take.
     pub(crate) fn ends(&self) -> ([f64; 3], [f64; 3]) {
         (self.start.into(), self.goal.into())
     }
+}
+
+/// Why a query cannot be asked of a planner (both planners refuse the same queries).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum QueryError {
+    /// The start configuration is not valid, or not of the planner's chain.
+    #[error("start is invalid: {0}")]
+    Start(String),
+    /// The goal cannot hold the head, or its tolerance is no finite number `>= 0`.
+    #[error("goal is invalid: {0}")]
+    Goal(String),
 }
 
 /// When to stop a query early.
@@ -187,4 +228,46 @@ pub trait Planner {
 
     /// The counters of the roadmap alone (after [`Self::setup`]; zeros before).
     fn roadmap_stats(&self) -> Self::Stats;
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use aerial_chain_core::ChainParams;
+
+    use super::*;
+    use crate::collision::DEFAULT_CLEARANCE;
+    use crate::map::distance::DistanceField;
+    use crate::problem::scenarios;
+
+    #[test]
+    fn queries_that_cannot_be_asked_are_refused_by_what_is_wrong() {
+        let sc = scenarios::build("window").unwrap();
+        let params = ChainParams::new(3);
+        let field = Arc::new(DistanceField::new(sc.grid.clone()));
+        let ctx = CollisionContext::new(field, params, DEFAULT_CLEARANCE).unwrap();
+        let shape = sc.start_shape(3).unwrap();
+        let ok = Query::new(sc.start, shape, sc.goal);
+        assert_eq!(ok.check(&ctx), Ok(()));
+        let other_chain = Query::new(sc.start, sc.start_shape(4).unwrap(), sc.goal);
+        let in_wall = Query::new(Point3::new(4.1, 1.0, 1.5), shape, sc.goal);
+        for q in [other_chain, in_wall] {
+            assert!(matches!(q.check(&ctx), Err(QueryError::Start(_))));
+        }
+        let outside = Query::new(sc.start, shape, Point3::new(100.0, 0.0, 0.0));
+        let e = outside.check(&ctx).unwrap_err().to_string();
+        assert!(
+            e.contains("(100.000, 0.000, 0.000) is outside the map's bounds"),
+            "{e}"
+        );
+        let nan_goal = Query::new(sc.start, shape, Point3::new(f64::NAN, 0.0, 0.0));
+        let nan_tol = Query {
+            goal_tol: f64::NAN,
+            ..ok.clone()
+        };
+        for q in [nan_goal, nan_tol] {
+            assert!(matches!(q.check(&ctx), Err(QueryError::Goal(_))));
+        }
+    }
 }
