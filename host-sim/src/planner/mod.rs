@@ -264,7 +264,7 @@ mod tests {
         let nan_goal = Query::new(sc.start, shape, Point3::new(f64::NAN, 0.0, 0.0));
         let nan_tol = Query {
             goal_tol: f64::NAN,
-            ..ok.clone()
+            ..ok
         };
         for q in [nan_goal, nan_tol] {
             assert!(matches!(q.check(&ctx), Err(QueryError::Goal(_))));
