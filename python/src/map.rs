@@ -96,7 +96,8 @@ impl Map {
         py: Python<'py>,
     ) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>) {
         let (lo, hi) = self.grid.bounds();
-        (lo.to_vec().into_pyarray(py), hi.to_vec().into_pyarray(py))
+        let array = |p: nalgebra::Point3<f64>| p.coords.as_slice().to_vec().into_pyarray(py);
+        (array(lo), array(hi))
     }
 
     /// The scenario's head start (array of 3, m); `None` for a map file.

@@ -13,6 +13,7 @@ use pyo3::prelude::*;
 
 use aerial_chain::collision::{verify_plan, CollisionContext, EdgeKind, DEFAULT_CLEARANCE};
 use aerial_chain::map::DistanceField;
+use aerial_chain::plan_file::MapSection;
 use aerial_chain::planner::{
     annotate_quality, to_plan, ArcPlanner, Planner, Quality, Query, Settings, Termination,
 };
@@ -413,19 +414,13 @@ pub fn plan(
         } else {
             (solution, None)
         };
-        let grid = &map.grid;
-        let mut plan = to_plan(
-            &solution,
-            &params,
-            grid.resolution(),
-            grid.unknown_is_occupied(),
-        );
+        let section = MapSection::of(&map.grid).with_source(map.source.clone());
+        let mut plan = to_plan(&solution, &params, section);
         annotate_quality(
             &mut plan,
             &Quality::of(&solution.steps),
             refinement.as_ref(),
         );
-        plan.map.source = map.source.clone();
         Ok(plan)
     });
     Plan::checked(plan.map_err(err::<PlanError>)?)
