@@ -30,7 +30,7 @@ use super::dynamics::{BodyState, UnitCommand, V3};
 use super::model::ChainModel;
 use super::mpc::{HeadMpc, MpcConfig, MpcError, MpcRef};
 use super::reference::{RefPoint, Reference};
-use super::SettingsError;
+use super::{all_non_negative, all_positive, SettingsError};
 
 /// Tuning of the control stack.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -78,30 +78,27 @@ impl ControllerConfig {
     /// Checks the numbers.
     pub fn validate(&self) -> Result<(), SettingsError> {
         self.mpc.validate()?;
-        let pos = |v: f64| v.is_finite() && v > 0.0;
-        if !(pos(self.mpc_period)
-            && pos(self.link_bandwidth)
-            && pos(self.link_damping)
-            && pos(self.link_max_angular_accel))
-        {
-            return Err(SettingsError::Rule("controller periods, link bandwidth, damping and acceleration limit must be positive"));
-        }
-        if !(self.unit_bandwidth.iter().all(|&w| pos(w)) && pos(self.unit_damping)) {
-            return Err(SettingsError::Rule(
-                "unit attitude bandwidths and damping must be positive",
-            ));
-        }
-        if !(self.tilt_max > 0.0 && self.tilt_max < 1.4) {
-            return Err(SettingsError::Rule(
-                "tilt limit must lie in (0, 80) degrees",
-            ));
-        }
-        if !(self.disturbance_gain.is_finite() && self.disturbance_gain >= 0.0) {
-            return Err(SettingsError::Rule(
-                "disturbance observer gain must be non-negative",
-            ));
-        }
-        Ok(())
+        let link = [
+            self.link_bandwidth,
+            self.link_damping,
+            self.link_max_angular_accel,
+        ];
+        SettingsError::check(
+            all_positive(&[self.mpc_period]) && all_positive(&link),
+            "controller periods, link bandwidth, damping and acceleration limit must be positive",
+        )?;
+        SettingsError::check(
+            all_positive(self.unit_bandwidth.as_slice()) && all_positive(&[self.unit_damping]),
+            "unit attitude bandwidths and damping must be positive",
+        )?;
+        SettingsError::check(
+            self.tilt_max > 0.0 && self.tilt_max < 1.4,
+            "tilt limit must lie in (0, 80) degrees",
+        )?;
+        SettingsError::check(
+            all_non_negative(&[self.disturbance_gain]),
+            "disturbance observer gain must be non-negative",
+        )
     }
 }
 

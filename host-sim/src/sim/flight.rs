@@ -23,7 +23,7 @@ use super::controller::{ChainController, ControllerConfig};
 use super::dynamics::{Actuator, BodyState, ChainDynamics, DynamicsError, V3};
 use super::model::ChainModel;
 use super::reference::{RefPoint, Reference, ReferenceError, ReferenceLimits};
-use super::SettingsError;
+use super::{all_positive, SettingsError};
 
 /// A disturbance force held on units for a while.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -92,31 +92,29 @@ impl SimConfig {
 
     /// Checks the numbers.
     pub fn validate(&self) -> Result<(), SettingsError> {
-        let pos = |v: f64| v.is_finite() && v > 0.0;
         if !(self.rate.is_finite() && (500.0..=20_000.0).contains(&self.rate)) {
             return Err(SettingsError::Rate(self.rate));
         }
-        if !(pos(self.settle_time)
-            && pos(self.settle_hold)
-            && pos(self.goal_tolerance)
-            && pos(self.angle_tolerance)
-            && pos(self.divergence))
-        {
-            return Err(SettingsError::Rule(
-                "settle times, tolerances and the divergence bound must be positive",
-            ));
-        }
-        if !(self.min_time.is_finite() && (0.0..=3600.0).contains(&self.min_time)) {
-            return Err(SettingsError::Rule(
-                "minimum flight time must lie in [0, 3600] s",
-            ));
-        }
+        let arrival = [
+            self.settle_time,
+            self.settle_hold,
+            self.goal_tolerance,
+            self.angle_tolerance,
+        ];
+        SettingsError::check(
+            all_positive(&arrival) && all_positive(&[self.divergence]),
+            "settle times, tolerances and the divergence bound must be positive",
+        )?;
+        SettingsError::check(
+            (0.0..=3600.0).contains(&self.min_time),
+            "minimum flight time must lie in [0, 3600] s",
+        )?;
         for g in &self.gusts {
-            if !(g.start.is_finite() && pos(g.duration) && g.force.iter().all(|v| v.is_finite())) {
-                return Err(SettingsError::Rule(
-                    "gusts need a finite start, a positive duration and a finite force",
-                ));
-            }
+            let finite = g.start.is_finite() && g.force.iter().all(|v| v.is_finite());
+            SettingsError::check(
+                finite && all_positive(&[g.duration]),
+                "gusts need a finite start, a positive duration and a finite force",
+            )?;
         }
         self.controller.validate()?;
         self.limits.validate()

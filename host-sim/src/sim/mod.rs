@@ -41,6 +41,26 @@ pub enum SettingsError {
     },
 }
 
+impl SettingsError {
+    /// `Ok` where the rule holds, else the rule `why` as the error.
+    pub(crate) fn check(holds: bool, why: &'static str) -> Result<(), Self> {
+        match holds {
+            true => Ok(()),
+            false => Err(Self::Rule(why)),
+        }
+    }
+}
+
+/// Whether every value is a finite number above zero.
+pub(crate) fn all_positive(values: &[f64]) -> bool {
+    values.iter().all(|v| v.is_finite() && *v > 0.0)
+}
+
+/// Whether every value is a finite number, zero or above.
+pub(crate) fn all_non_negative(values: &[f64]) -> bool {
+    values.iter().all(|v| v.is_finite() && *v >= 0.0)
+}
+
 pub use clearance::{footprint, MapClearance};
 
 // The type of `Sample::units` and `Sample::links`, so that users of a recorded flight

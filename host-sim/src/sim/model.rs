@@ -7,7 +7,7 @@
 use aerial_chain_core::ChainParams;
 
 use super::dynamics::V3;
-use super::SettingsError;
+use super::{all_non_negative, all_positive, SettingsError};
 
 /// Standard gravity (m/s^2).
 pub const GRAVITY: f64 = 9.81;
@@ -116,34 +116,24 @@ impl ChainModel {
     /// Checks that every number is finite and physical.
     pub fn validate(&self) -> Result<(), SettingsError> {
         let u = &self.unit;
-        let pos = |v: f64| v.is_finite() && v > 0.0;
-        if !pos(u.mass) || !u.inertia.iter().all(|&j| pos(j)) {
-            return Err(SettingsError::Rule(
-                "unit mass and inertia must be positive",
-            ));
-        }
-        if !(u.thrust_min.is_finite()
-            && u.thrust_min >= 0.0
-            && pos(u.thrust_max)
-            && u.thrust_max > u.thrust_min)
-        {
-            return Err(SettingsError::Rule(
-                "unit thrust limits must satisfy 0 <= min < max",
-            ));
-        }
-        if !u.max_moment.iter().all(|&m| pos(m)) || !pos(u.motor_time_constant) {
-            return Err(SettingsError::Rule(
-                "unit moment limits and motor time constant must be positive",
-            ));
-        }
-        if !pos(self.link.mass) || !pos(self.link.min_axial_inertia) {
-            return Err(SettingsError::Rule(
-                "link mass and axial inertia must be positive",
-            ));
-        }
-        if !pos(self.gravity) {
-            return Err(SettingsError::Rule("gravity must be positive"));
-        }
+        SettingsError::check(
+            all_positive(&[u.mass]) && all_positive(u.inertia.as_slice()),
+            "unit mass and inertia must be positive",
+        )?;
+        SettingsError::check(
+            all_non_negative(&[u.thrust_min])
+                && all_positive(&[u.thrust_max])
+                && u.thrust_max > u.thrust_min,
+            "unit thrust limits must satisfy 0 <= min < max",
+        )?;
+        SettingsError::check(
+            all_positive(u.max_moment.as_slice()) && all_positive(&[u.motor_time_constant]),
+            "unit moment limits and motor time constant must be positive",
+        )?;
+        SettingsError::check(
+            all_positive(&[self.link.mass, self.link.min_axial_inertia, self.gravity]),
+            "link mass, axial inertia and gravity must be positive",
+        )?;
         // Every unit must be able to hover with its share of the links.
         let hover = (u.mass + self.link.mass) * self.gravity;
         if u.thrust_max < 1.2 * hover {

@@ -24,7 +24,7 @@ use clarabel::solver::{
 
 use super::dynamics::V3;
 use super::model::GRAVITY;
-use super::SettingsError;
+use super::{all_non_negative, all_positive, SettingsError};
 
 /// Tuning and limits of the head MPC.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,43 +74,27 @@ impl Default for MpcConfig {
 impl MpcConfig {
     /// Checks the numbers.
     pub fn validate(&self) -> Result<(), SettingsError> {
-        let pos = |v: f64| v.is_finite() && v > 0.0;
-        let nonneg = |v: f64| v.is_finite() && v >= 0.0;
-        if !(1..=200).contains(&self.horizon) || !pos(self.step) {
-            return Err(SettingsError::Rule(
-                "MPC horizon must be 1..=200 steps of positive length",
-            ));
-        }
-        if !(nonneg(self.q_pos)
-            && nonneg(self.q_vel)
-            && nonneg(self.q_terminal)
-            && pos(self.r_acc)
-            && nonneg(self.r_jerk))
-        {
-            return Err(SettingsError::Rule(
-                "MPC weights must be non-negative (r_acc positive)",
-            ));
-        }
-        if !(pos(self.a_xy_max)
-            && self.a_z_min.is_finite()
-            && self.a_z_min < 0.0
-            && pos(self.a_z_max))
-        {
-            return Err(SettingsError::Rule(
-                "MPC acceleration limits must bracket zero",
-            ));
-        }
-        if self.a_z_min <= -GRAVITY {
-            return Err(SettingsError::Rule(
-                "MPC a_z_min must be above -g (the rotors cannot pull down)",
-            ));
-        }
-        if !(self.tilt_max > 0.0 && self.tilt_max < 1.4) {
-            return Err(SettingsError::Rule(
-                "MPC tilt limit must lie in (0, 80) degrees",
-            ));
-        }
-        Ok(())
+        SettingsError::check(
+            (1..=200).contains(&self.horizon) && all_positive(&[self.step]),
+            "MPC horizon must be 1..=200 steps of positive length",
+        )?;
+        let weights = [self.q_pos, self.q_vel, self.q_terminal, self.r_jerk];
+        SettingsError::check(
+            all_non_negative(&weights) && all_positive(&[self.r_acc]),
+            "MPC weights must be non-negative (r_acc positive)",
+        )?;
+        SettingsError::check(
+            all_positive(&[self.a_xy_max, self.a_z_max, -self.a_z_min]),
+            "MPC acceleration limits must bracket zero",
+        )?;
+        SettingsError::check(
+            self.a_z_min > -GRAVITY,
+            "MPC a_z_min must be above -g (the rotors cannot pull down)",
+        )?;
+        SettingsError::check(
+            self.tilt_max > 0.0 && self.tilt_max < 1.4,
+            "MPC tilt limit must lie in (0, 80) degrees",
+        )
     }
 }
 

@@ -11,7 +11,7 @@
 //! head fixed. An edge that changes both is refused.
 
 use super::dynamics::{unit_positions, V3};
-use super::SettingsError;
+use super::{all_non_negative, all_positive, SettingsError};
 use crate::collision::verify::{zeta_delta, STAY_TOLERANCE};
 
 /// Peak acceleration of a smoothstep speed ramp, per unit of cruise rate over ramp
@@ -76,22 +76,19 @@ impl Default for ReferenceLimits {
 impl ReferenceLimits {
     /// Checks that every limit is finite and positive (the hold may be zero).
     pub fn validate(&self) -> Result<(), SettingsError> {
-        let pos = |v: f64| v.is_finite() && v > 0.0;
-        if !(pos(self.speed)
-            && pos(self.accel)
-            && pos(self.angular_rate)
-            && pos(self.angular_accel))
-        {
-            return Err(SettingsError::Rule(
-                "speed, acceleration and angular limits must be positive",
-            ));
-        }
-        if !(self.start_hold.is_finite() && self.start_hold >= 0.0) {
-            return Err(SettingsError::Rule(
-                "start hold must be a non-negative number of seconds",
-            ));
-        }
-        Ok(())
+        SettingsError::check(
+            all_positive(&[
+                self.speed,
+                self.accel,
+                self.angular_rate,
+                self.angular_accel,
+            ]),
+            "speed, acceleration and angular limits must be positive",
+        )?;
+        SettingsError::check(
+            all_non_negative(&[self.start_hold]),
+            "start hold must be a non-negative number of seconds",
+        )
     }
 }
 
