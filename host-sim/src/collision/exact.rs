@@ -9,6 +9,7 @@ use aerial_chain_core::{ChainParams, Shape};
 use nalgebra::{Point3, Vector3};
 
 use super::OutOfBounds;
+use crate::map::blocks::BLOCK;
 use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
 
@@ -126,7 +127,10 @@ pub struct Nearest {
 /// distance `<= reach`; `None` when every obstacle cube is farther than `reach`.
 /// Exact: every voxel intersecting the segment's bounding box grown by `reach` is
 /// examined (a voxel outside it is more than `reach` away along some axis), including
-/// voxels outside the grid (unknown, obstacles when unknown space counts as occupied).
+/// voxels outside the grid (unknown, obstacles when unknown space counts as occupied),
+/// except those in blocks the grid proves free of obstacles
+/// ([`Grid::block_may_hold_obstacle`]). Of several cubes at the same distance, the one
+/// first in z, then y, then x.
 pub fn nearest_obstacle(
     grid: &Grid,
     a: impl Into<Point3<f64>>,
@@ -137,6 +141,39 @@ pub fn nearest_obstacle(
     if !(reach.is_finite() && reach >= 0.0) || a.iter().chain(b.iter()).any(|v| !v.is_finite()) {
         return None;
     }
+    let (lo, hi) = search_box(grid, a, b, reach);
+    let origin = grid.origin().map(i64::from);
+    let edge = BLOCK as i64;
+    // The blocks (grid-local) the box touches, and the voxels of each inside the box.
+    let block = |ax: usize, i: i64| (i - origin[ax]).div_euclid(edge);
+    let span = |ax: usize, b: i64| {
+        let first = origin[ax] + b * edge;
+        (first.max(lo[ax]), (first + edge - 1).min(hi[ax]))
+    };
+    let mut search = Search::new(a, b, reach, grid.resolution());
+    for bz in block(2, lo[2])..=block(2, hi[2]) {
+        for by in block(1, lo[1])..=block(1, hi[1]) {
+            for bx in block(0, lo[0])..=block(0, hi[0]) {
+                if !grid.block_may_hold_obstacle([bx, by, bz]) {
+                    continue;
+                }
+                let (zs, ys, xs) = (span(2, bz), span(1, by), span(0, bx));
+                for z in zs.0..=zs.1 {
+                    for y in ys.0..=ys.1 {
+                        for x in xs.0..=xs.1 {
+                            search.visit(grid, [x, y, z]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    search.best.map(|(n, _)| n)
+}
+
+/// The lattice indices (inclusive) of the voxels that can lie within `reach` of the
+/// segment `a b`, with a voxel to spare on every side.
+fn search_box(grid: &Grid, a: Point3<f64>, b: Point3<f64>, reach: f64) -> ([i64; 3], [i64; 3]) {
     let r = grid.resolution();
     let mut lo = [0i64; 3];
     let mut hi = [0i64; 3];
@@ -146,45 +183,74 @@ pub fn nearest_obstacle(
         lo[ax] = (mn / r).floor() as i64 - 1;
         hi[ax] = (mx / r).floor() as i64 + 1;
     }
-    let point = a == b;
-    let half_diag = 0.5 * r * 3f64.sqrt();
-    let mut best: Option<Nearest> = None;
-    for z in lo[2]..=hi[2] {
-        for y in lo[1]..=hi[1] {
-            for x in lo[0]..=hi[0] {
-                let i = [x as i32, y as i32, z as i32];
-                if !grid.is_obstacle(i) {
-                    continue;
-                }
-                let c = grid.voxel_center(i);
-                // Cheap rejection by the centre's distance.
-                let dc = if point {
-                    let e = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-                    (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
-                } else {
-                    point_segment_distance(c, a, b)
-                };
-                let limit = best.map_or(reach, |n| n.distance.min(reach));
-                if dc - half_diag > limit {
-                    continue;
-                }
-                let half = Vector3::repeat(0.5 * r);
-                let (vlo, vhi) = (c - half, c + half);
-                let d = if point {
-                    point_box_distance(a, vlo, vhi)
-                } else {
-                    segment_box_distance(a, b, vlo, vhi)
-                };
-                if d <= limit && best.is_none_or(|n| d < n.distance) {
-                    best = Some(Nearest {
-                        distance: d,
-                        voxel: c,
-                    });
-                }
-            }
+    (lo, hi)
+}
+
+/// The nearest obstacle cube to a point or segment found so far.
+struct Search {
+    a: Point3<f64>,
+    b: Point3<f64>,
+    reach: f64,
+    half: f64,
+    half_diag: f64,
+    /// The nearest cube and its index `[z, y, x]`, which breaks ties.
+    best: Option<(Nearest, [i64; 3])>,
+}
+
+impl Search {
+    fn new(a: Point3<f64>, b: Point3<f64>, reach: f64, resolution: f64) -> Self {
+        Self {
+            a,
+            b,
+            reach,
+            half: 0.5 * resolution,
+            half_diag: 0.5 * resolution * 3f64.sqrt(),
+            best: None,
         }
     }
-    best
+
+    /// Measures lattice voxel `i` when it is an obstacle.
+    fn visit(&mut self, grid: &Grid, i: [i64; 3]) {
+        let i32s = i.map(|v| v as i32);
+        if !grid.is_obstacle(i32s) {
+            return;
+        }
+        let (a, b) = (self.a, self.b);
+        let c = grid.voxel_center(i32s);
+        // Cheap rejection by the centre's distance.
+        let dc = if a == b {
+            let e = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
+        } else {
+            point_segment_distance(c, a, b)
+        };
+        let limit = self
+            .best
+            .map_or(self.reach, |(n, _)| n.distance.min(self.reach));
+        if dc - self.half_diag > limit {
+            return;
+        }
+        let half = Vector3::repeat(self.half);
+        let (vlo, vhi) = (c - half, c + half);
+        let d = if a == b {
+            point_box_distance(a, vlo, vhi)
+        } else {
+            segment_box_distance(a, b, vlo, vhi)
+        };
+        let key = [i[2], i[1], i[0]];
+        let better = self
+            .best
+            .is_none_or(|(n, k)| d < n.distance || (d == n.distance && key < k));
+        if d <= limit && better {
+            self.best = Some((
+                Nearest {
+                    distance: d,
+                    voxel: c,
+                },
+                key,
+            ));
+        }
+    }
 }
 
 /// Unit centres of a chain in `f64` (paper Eq. 2), from a head position and the shape

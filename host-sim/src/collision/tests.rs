@@ -274,3 +274,126 @@ fn contact_within_rounding_is_contact() {
     let ok = at(1e-6).unwrap();
     assert!((ok.clearance - 1e-6).abs() < 1e-9, "{ok:?}");
 }
+
+/// The nearest obstacle cube by reading every voxel of the search box, in z, y, x
+/// order, keeping the first of the nearest: what [`exact::nearest_obstacle`] must
+/// give while it skips the blocks the grid proves empty.
+fn nearest_by_every_voxel(
+    grid: &Grid,
+    a: Point3<f64>,
+    b: Point3<f64>,
+    reach: f64,
+) -> Option<exact::Nearest> {
+    let r = grid.resolution();
+    let lo: Vec<i64> = (0..3)
+        .map(|k| ((a[k].min(b[k]) - reach) / r).floor() as i64 - 1)
+        .collect();
+    let hi: Vec<i64> = (0..3)
+        .map(|k| ((a[k].max(b[k]) + reach) / r).floor() as i64 + 1)
+        .collect();
+    let mut best: Option<exact::Nearest> = None;
+    for z in lo[2]..=hi[2] {
+        for y in lo[1]..=hi[1] {
+            for x in lo[0]..=hi[0] {
+                let i = [x as i32, y as i32, z as i32];
+                if !grid.is_obstacle(i) {
+                    continue;
+                }
+                let c = grid.voxel_center(i);
+                let half = Vector3::repeat(0.5 * r);
+                let d = match a == b {
+                    true => exact::point_box_distance(a, c - half, c + half),
+                    false => exact::segment_box_distance(a, b, c - half, c + half),
+                };
+                let limit = best.map_or(reach, |n| n.distance.min(reach));
+                if d <= limit && best.is_none_or(|n| d < n.distance) {
+                    best = Some(exact::Nearest {
+                        distance: d,
+                        voxel: c,
+                    });
+                }
+            }
+        }
+    }
+    best
+}
+
+/// A random small grid: dims, origin, a first fill, then one state per voxel (occupied
+/// and unknown voxels each none, sparse or dense, so that whole blocks hold only one
+/// kind), and the unknown rule.
+fn small_grid() -> impl Strategy<Value = Grid> {
+    (
+        proptest::array::uniform3(1usize..14),
+        proptest::array::uniform3(-6i32..6),
+        proptest::collection::vec(0u16..1000, 1000),
+        (0usize..3, 0usize..3),
+        (any::<bool>(), 0usize..3),
+    )
+        .prop_map(|(dims, origin, draws, (occ, unk), (unknown_occ, fill))| {
+            // Per mille of occupied and of unknown voxels.
+            let (occ, unk) = ([0, 5, 100][occ], [0, 5, 100][unk]);
+            let states: Vec<u8> = draws
+                .iter()
+                .map(|&d| match d {
+                    d if d < occ => 0,
+                    d if d < occ + unk => 1,
+                    _ => 2,
+                })
+                .collect();
+            // Every voxel is then written: from an unknown or occupied grid that carves
+            // (and keeps the summary's counts through every change).
+            let fill = [Cell::Free, Cell::Unknown, Cell::Occupied][fill];
+            let mut g = Grid::new(0.1, origin, dims, fill, unknown_occ).unwrap();
+            let mut k = 0;
+            for z in 0..dims[2] as i32 {
+                for y in 0..dims[1] as i32 {
+                    for x in 0..dims[0] as i32 {
+                        let state = match states[k % states.len()] {
+                            0 => Cell::Occupied,
+                            1 => Cell::Unknown,
+                            _ => Cell::Free,
+                        };
+                        g.set([origin[0] + x, origin[1] + y, origin[2] + z], state);
+                        k += 1;
+                    }
+                }
+            }
+            g
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// Skipping the blocks the grid proves empty finds the same cube, at the same
+    /// distance, as reading every voxel, inside the grid, across its faces and beyond.
+    #[test]
+    fn nearest_obstacle_skips_only_empty_blocks(
+        grid in small_grid(),
+        a in proptest::array::uniform3(-1.0f64..1.6),
+        b in proptest::array::uniform3(-1.0f64..1.6),
+        point in any::<bool>(),
+        reach in 0.0f64..0.6,
+    ) {
+        let (a, b) = (Point3::from(a), Point3::from(if point { a } else { b }));
+        let fast = exact::nearest_obstacle(&grid, a, b, reach);
+        let every = nearest_by_every_voxel(&grid, a, b, reach);
+        prop_assert_eq!(fast, every);
+    }
+}
+
+#[test]
+fn nearest_obstacle_sees_voxels_set_after_a_search() {
+    let mut g = Grid::new(0.1, [0, 0, 0], [20, 20, 20], Cell::Free, false).unwrap();
+    let p = Point3::new(1.0, 1.0, 1.0);
+    assert_eq!(exact::nearest_obstacle(&g, p, p, 0.3), None);
+    // The summary made by that search must not hide what is set now.
+    g.set([11, 10, 10], Cell::Occupied);
+    let n = exact::nearest_obstacle(&g, p, p, 0.3).expect("the new voxel is 0.1 m away");
+    assert!((n.distance - 0.1).abs() < 1e-12, "{n:?}");
+    g.fill_box([0.5, 0.5, 0.5], [0.7, 0.7, 0.7], Cell::Occupied);
+    let q = Point3::new(0.45, 0.6, 0.6);
+    assert!(
+        exact::nearest_obstacle(&g, q, q, 0.06).is_some_and(|n| (n.distance - 0.05).abs() < 1e-12)
+    );
+}

@@ -13,6 +13,8 @@
 
 use nalgebra::Point3;
 
+use super::blocks::ObstacleBlocks;
+
 /// Largest number of voxels a grid may hold (400 M: 400 MB of cells, 1.6 GB of distance
 /// field). Larger maps are refused with [`GridError::TooLarge`] rather than exhausting memory.
 pub const MAX_CELLS: usize = 400_000_000;
@@ -30,7 +32,7 @@ pub enum Cell {
 }
 
 impl Cell {
-    fn from_u8(v: u8) -> Cell {
+    pub(crate) fn from_u8(v: u8) -> Cell {
         match v {
             0 => Cell::Free,
             1 => Cell::Occupied,
@@ -91,6 +93,8 @@ pub struct Grid {
     bounds: ([f64; 3], [f64; 3]),
     cells: Vec<u8>,
     unknown_is_occupied: bool,
+    /// Which blocks may hold an obstacle, kept up to date by every write to `cells`.
+    blocks: ObstacleBlocks,
 }
 
 impl Grid {
@@ -128,6 +132,7 @@ impl Grid {
             dims,
             bounds: (lo, hi),
             cells: vec![fill as u8; total],
+            blocks: ObstacleBlocks::new(dims, fill),
             unknown_is_occupied,
         })
     }
@@ -233,7 +238,11 @@ impl Grid {
         for z in lo[2]..hi[2] {
             for y in lo[1]..hi[1] {
                 let row = self.dims[0] * (y as usize + self.dims[1] * z as usize);
-                self.cells[row + lo[0] as usize..row + hi[0] as usize].fill(state as u8);
+                let (x0, x1) = (lo[0] as usize, hi[0] as usize);
+                let run = &mut self.cells[row + x0..row + x1];
+                self.blocks
+                    .write_run(run, x0, y as usize, z as usize, state);
+                run.fill(state as u8);
             }
         }
     }
@@ -287,6 +296,7 @@ impl Grid {
     }
 
     /// Centre of the voxel with lattice index `i` (m).
+    #[inline]
     pub fn voxel_center(&self, i: [i32; 3]) -> Point3<f64> {
         i.map(|v| (v as f64 + 0.5) * self.resolution).into()
     }
@@ -330,6 +340,8 @@ impl Grid {
     pub fn set(&mut self, i: [i32; 3], state: Cell) {
         if let Some(l) = self.local(i) {
             let k = self.linear(l);
+            self.blocks
+                .write_run(&self.cells[k..=k], l[0], l[1], l[2], state);
             self.cells[k] = state as u8;
         }
     }
@@ -343,6 +355,13 @@ impl Grid {
             Cell::Free => false,
             Cell::Unknown => self.unknown_is_occupied,
         }
+    }
+
+    /// Whether grid-local block `b` (voxels `BLOCK * b` to `BLOCK * b + BLOCK - 1` per
+    /// axis, any index: beyond the grid is unknown) may hold an obstacle. `false` proves
+    /// that none of its voxels is one.
+    pub(crate) fn block_may_hold_obstacle(&self, b: [i64; 3]) -> bool {
+        self.blocks.may_hold(b, self.unknown_is_occupied)
     }
 
     /// Whether the voxel containing `p` is an obstacle.
@@ -407,7 +426,9 @@ impl Grid {
         for z in a0[2]..a1[2] {
             for y in a0[1]..a1[1] {
                 let row = self.dims[0] * (y + self.dims[1] * z);
-                self.cells[row + a0[0]..row + a1[0]].fill(state as u8);
+                let run = &mut self.cells[row + a0[0]..row + a1[0]];
+                self.blocks.write_run(run, a0[0], y, z, state);
+                run.fill(state as u8);
             }
         }
     }
@@ -426,6 +447,7 @@ impl Grid {
                     ];
                     if inside(self.voxel_center(i)) {
                         let k = self.linear([x, y, z]);
+                        self.blocks.write_run(&self.cells[k..=k], x, y, z, state);
                         self.cells[k] = state as u8;
                     }
                 }
@@ -457,6 +479,32 @@ impl Grid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_obstacle_summary_counts_every_write() {
+        let mut g = Grid::new(0.1, [-3, 2, 0], [13, 9, 7], Cell::Unknown, true).unwrap();
+        let recount = |g: &Grid| ObstacleBlocks::count(g.dims, &g.cells);
+        assert_eq!(g.blocks, recount(&g));
+        g.fill_box([-0.2, 0.3, 0.0], [0.8, 1.0, 0.6], Cell::Free);
+        assert_eq!(g.blocks, recount(&g));
+        g.fill_where(Cell::Occupied, |p| p.x > 0.5 && p.z < 0.3);
+        g.set([0, 4, 3], Cell::Occupied);
+        g.set([0, 4, 3], Cell::Free);
+        g.set([-3, 2, 0], Cell::Free);
+        assert_eq!(g.blocks, recount(&g));
+        // Carved free and cleared again, a block inside the grid proves itself empty.
+        g.fill_box([-0.3, 0.2, 0.0], [1.0, 1.1, 0.7], Cell::Free);
+        assert_eq!(g.blocks, recount(&g));
+        assert!(!g.block_may_hold_obstacle([0, 0, 0]));
+        assert!(
+            g.block_may_hold_obstacle([3, 0, 0]),
+            "it reaches beyond the grid"
+        );
+        assert!(
+            g.block_may_hold_obstacle([-1, 0, 0]),
+            "beyond the grid is unknown"
+        );
+    }
 
     #[test]
     fn lattice_and_bounds() {

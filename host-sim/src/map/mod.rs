@@ -1,4 +1,5 @@
 //! Maps: OctoMap files, occupancy grids and distance fields.
+pub(crate) mod blocks;
 pub(crate) mod distance;
 pub(crate) mod grid;
 pub(crate) mod octomap;
