@@ -412,9 +412,16 @@ pub fn exact_clearance(
                 // them only its two x faces do (the shell, not the whole cube).
                 let face = dz.abs() == k || dy.abs() == k;
                 let step = if face { 1 } else { (2 * k).max(1) };
+                // The row is looked up once; its voxels are then read directly.
+                let row = g.raw_row(c0[1] + dy, c0[2] + dz);
                 for dx in (-k..=k).step_by(step as usize) {
                     let i = [c0[0] + dx, c0[1] + dy, c0[2] + dz];
-                    if !g.is_obstacle(i) {
+                    let raw = row.and_then(|(cells, x0)| {
+                        usize::try_from(i[0] - x0)
+                            .ok()
+                            .and_then(|x| cells.get(x).copied())
+                    });
+                    if !g.is_obstacle_raw(raw) {
                         continue;
                     }
                     let c = g.voxel_center(i);

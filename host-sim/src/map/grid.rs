@@ -369,6 +369,27 @@ impl Grid {
         self.is_obstacle(self.lattice_index(p))
     }
 
+    /// The raw states of the row of lattice voxels `(y, z)` and the lattice x of its
+    /// first voxel; `None` when the row lies outside the grid (all unknown). Read with
+    /// [`Self::is_obstacle_raw`].
+    #[inline]
+    pub(crate) fn raw_row(&self, y: i32, z: i32) -> Option<(&[u8], i32)> {
+        let l = self.local([self.origin[0], y, z])?;
+        let start = self.linear(l);
+        Some((&self.cells[start..start + self.dims[0]], self.origin[0]))
+    }
+
+    /// Whether a voxel of raw state `v` (from [`Self::raw_row`]; `None`: outside the
+    /// grid) is an obstacle.
+    #[inline]
+    pub(crate) fn is_obstacle_raw(&self, v: Option<u8>) -> bool {
+        match v.map(Cell::from_u8) {
+            Some(Cell::Occupied) => true,
+            Some(Cell::Free) => false,
+            Some(Cell::Unknown) | None => self.unknown_is_occupied,
+        }
+    }
+
     /// Whether each voxel of row `(y, z)` (local indices) is an obstacle, x first.
     pub(crate) fn obstacle_row(&self, y: usize, z: usize) -> impl Iterator<Item = bool> + '_ {
         let start = self.linear([0, y, z]);
