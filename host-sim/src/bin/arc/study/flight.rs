@@ -22,6 +22,8 @@ use aerial_chain::sim::{
 };
 use aerial_chain::tables::{ShapeTables, TableSettings};
 use aerial_chain::trajectory;
+
+use super::report::csv_field;
 use aerial_chain_core::ChainParams;
 
 /// One run: a plan, flown both ways.
@@ -212,8 +214,8 @@ pub fn csv(runs: &[FlightRun], speed: f64) -> String {
         };
         let _ = writeln!(
             s,
-            "{},{},{},{:.3},{:.2},{},{:.3},{:.3},{},{},{},{:.1},{:.1},{:.2},{},{},{:?}",
-            r.scenario,
+            "{},{},{},{:.3},{:.2},{},{:.3},{:.3},{},{},{},{:.1},{:.1},{:.2},{},{},{}",
+            csv_field(&r.scenario),
             r.units,
             r.seed,
             r.head_path_m,
@@ -229,7 +231,7 @@ pub fn csv(runs: &[FlightRun], speed: f64) -> String {
             r.trajectory_duration_s,
             f(r.before),
             f(r.after),
-            r.error
+            csv_field(&r.error)
         );
     }
     s
@@ -394,8 +396,8 @@ mod tests {
     fn table_csv_and_plot_of_the_runs() {
         let mut runs = vec![run("maze", 1, 60.0, 30.0), run("maze", 2, 80.0, 50.0)];
         runs.extend([
-            run("passage:a", 1, 30.0, 20.0),
-            run("passage:b", 2, 40.0, 30.0),
+            run("passage:w=0.5,angle=45", 1, 30.0, 20.0),
+            run("passage:w=0.55,angle=30,door=0.6", 2, 40.0, 30.0),
         ]);
         runs[3].units = 7;
         let md = markdown(&runs, 0.5);
@@ -413,8 +415,17 @@ mod tests {
         );
         let csv = csv(&runs, 0.5);
         assert_eq!(csv.lines().count(), 5);
-        let cols = csv.lines().next().unwrap().split(',').count();
-        assert!(csv.lines().all(|l| l.split(',').count() == cols), "{csv}");
+        // Fields, outside quotes (a passage's name holds commas).
+        let fields = |l: &str| {
+            1 + l
+                .split('"')
+                .step_by(2)
+                .map(|p| p.matches(',').count())
+                .sum::<usize>()
+        };
+        let cols = fields(csv.lines().next().unwrap());
+        assert!(csv.lines().all(|l| fields(l) == cols), "{csv}");
+        assert!(csv.contains("\n\"passage:w=0.5,angle=45\",5,1,"), "{csv}");
         let svg = figure(&runs, 0.5);
         assert!(svg.starts_with("<svg") && svg.contains("target: 2 x path / speed"));
         assert!(median(vec![f64::NAN]).is_nan());
