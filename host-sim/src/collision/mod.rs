@@ -601,6 +601,9 @@ impl CollisionContext {
             let frac = if dist > 0.0 { u / dist } else { 0.0 };
             // Units first (the links use their bounds).
             for i in 0..n {
+                if !needs_bound(&horizon, n, i, u) {
+                    continue;
+                }
                 let q = p0[i] + off;
                 c[i] = self.bound(q, self.unit_r + self.min_step);
                 if horizon[i] <= u {
@@ -680,6 +683,9 @@ impl CollisionContext {
             };
             let p = self.points(head, &s);
             for i in 0..n {
+                if !needs_bound(&horizon, n, i, t) {
+                    continue;
+                }
                 c[i] = self.bound(p[i], self.unit_r + self.min_step);
                 if horizon[i] <= t {
                     // Inside-the-box margin and obstacle margin.
@@ -729,6 +735,14 @@ impl CollisionContext {
             }
         }
     }
+}
+
+/// Whether unit `i`'s bound is needed at `u` along an edge: its own horizon or that of
+/// a link it ends (`horizon`: units `0..n`, then links) is reached. The others are
+/// proven free further on; measuring them anyway cost most of a translation check.
+#[inline]
+fn needs_bound(horizon: &[f64], n: usize, i: usize, u: f64) -> bool {
+    horizon[i] <= u || (i > 0 && horizon[n + i - 1] <= u) || (i + 1 < n && horizon[n + i] <= u)
 }
 
 /// [`CollisionContext::check_config`] as a free function.

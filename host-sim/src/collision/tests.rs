@@ -382,6 +382,53 @@ proptest! {
     }
 }
 
+/// The distance from `p` to the nearest obstacle cube by reading every voxel within
+/// `cap` (and a voxel more) of it; `cap` when none is nearer.
+fn clearance_by_every_voxel(grid: &Grid, p: Point3<f64>, cap: f64) -> f64 {
+    let r = grid.resolution();
+    let c = grid.lattice_index(p);
+    let k = (cap / r).ceil() as i32 + 2;
+    let half = Vector3::repeat(0.5 * r);
+    let mut best = cap;
+    for z in c[2] - k..=c[2] + k {
+        for y in c[1] - k..=c[1] + k {
+            for x in c[0] - k..=c[0] + k {
+                if grid.is_obstacle([x, y, z]) {
+                    let v = grid.voxel_center([x, y, z]);
+                    best = best.min(exact::point_box_distance(p, v - half, v + half));
+                }
+            }
+        }
+    }
+    best
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// `exact_clearance` keeps its contract against reading every voxel: the exact
+    /// distance when it lies between `stop` and `cap`, else a value at or below `stop`,
+    /// or at least `cap`; inside the grid, across its faces and beyond.
+    #[test]
+    fn exact_clearance_matches_every_voxel(
+        grid in small_grid(),
+        p in proptest::array::uniform3(-1.0f64..1.6),
+        stop in -0.1f64..0.3,
+        reach in 0.0f64..0.5,
+    ) {
+        let (p, cap) = (Point3::from(p), stop.max(0.0) + reach);
+        let every = clearance_by_every_voxel(&grid, p, cap);
+        let fast = exact::exact_clearance(&DistanceField::new(grid), p, stop, cap);
+        if every <= stop {
+            prop_assert!(fast <= stop, "{fast} > stop {stop} ({every})");
+        } else if every >= cap {
+            prop_assert!(fast >= cap, "{fast} < cap {cap} ({every})");
+        } else {
+            prop_assert_eq!(fast, every);
+        }
+    }
+}
+
 #[test]
 fn nearest_obstacle_sees_voxels_set_after_a_search() {
     let mut g = Grid::new(0.1, [0, 0, 0], [20, 20, 20], Cell::Free, false).unwrap();
