@@ -523,7 +523,14 @@ impl Widener<'_> {
             let c = if lb - r_u >= CAP - r_v {
                 lb - r_u
             } else {
-                self.distance(p) - r_u
+                // Only a distance below the best so far can matter: the search for the
+                // nearest cube stops there (most samples of an edge are wider).
+                let below = best.clearance + r_u;
+                let d = exact_clearance(field, p, 0.0, below);
+                if d >= below {
+                    continue;
+                }
+                d - r_u
             };
             if c <= floor {
                 return None;
