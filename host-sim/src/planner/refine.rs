@@ -129,7 +129,8 @@ impl ArcPlanner {
         // As before widening existed: shortcuts and smaller shape changes at the
         // search's margin.
         let (steps, mut checks) = self.shortcut(&self.ctx, &solution.steps, deadline);
-        let mut chosen = (steps, self.ctx.clone(), 0);
+        // The steps, their context, and the first widening's moves when its plan is taken.
+        let mut chosen = (steps, self.ctx.clone(), None);
         // Widen the search's plan first, where it has the most stations to move; then
         // refine and shorten without giving back what that won (`keep_margin`). The
         // result is taken unless it asks for more shape motion (where a narrow door
@@ -141,11 +142,17 @@ impl ArcPlanner {
             checks += spent;
             let motion = |s: &[Step]| Quality::of(s).shape_motion_rad;
             if motion(&kept) <= motion(&chosen.0) * KEEP_MOTION + 1e-9 {
-                chosen = (kept, ctx, first.moves);
+                chosen = (kept, ctx, Some(first.moves));
             }
         }
         let (steps, ctx, first_moves) = chosen;
-        let (steps, last) = super::widen::widen(&ctx, &self.ctx_min, steps);
+        // Where neither the widened plan was taken nor refinement changed the search's
+        // plan, the last widening would repeat the first, move for move.
+        let (steps, last) = if first_moves.is_none() && steps == solution.steps {
+            (widened, first)
+        } else {
+            super::widen::widen(&ctx, &self.ctx_min, steps)
+        };
         let mut stats = solution.stats.clone();
         super::construction::count_sources(&steps, &mut stats);
         let report = Refinement {
@@ -154,7 +161,7 @@ impl ArcPlanner {
             checks,
             widening: Widening {
                 before: first.before,
-                moves: first_moves + last.moves,
+                moves: first_moves.unwrap_or(0) + last.moves,
                 ..last
             },
             time_s: began.elapsed().as_secs_f64(),

@@ -645,6 +645,24 @@ mod tests {
         assert!(out.iter().all(|s| !s.shape_change));
     }
 
+    /// Refinement reuses the first widening's result where the second would get the
+    /// same plan in the same context: that holds only while widening is deterministic.
+    #[test]
+    fn the_same_plan_widens_the_same_way() {
+        let ctx = window();
+        let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
+        let steps = vec![
+            step([0.4, 1.0, 1.0], &straight),
+            step([1.2, 1.04, 0.97], &straight),
+            step([3.6, 1.04, 0.97], &straight),
+            step([3.8, 1.0, 1.0], &straight),
+        ];
+        let (a, ra) = widen(&ctx, &ctx, steps.clone());
+        let (b, rb) = widen(&ctx, &ctx, steps);
+        assert!(ra.moves > 0);
+        assert_eq!((a, ra), (b, rb));
+    }
+
     #[test]
     fn wide_plans_are_left_alone() {
         let ctx = window();
