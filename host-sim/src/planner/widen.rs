@@ -621,17 +621,18 @@ mod tests {
         out
     }
 
+    /// A straight chain through the window 4 cm off its centre line in y and 3 cm in z.
+    fn off_centre() -> Vec<Step> {
+        let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
+        let (y, z) = (1.04, 0.97);
+        [[0.4, 1.0, 1.0], [1.2, y, z], [3.6, y, z], [3.8, 1.0, 1.0]]
+            .map(|xi| step(xi, &straight))
+            .to_vec()
+    }
+
     #[test]
     fn an_off_centre_passage_moves_to_the_middle_and_stays_admissible() {
-        let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
-        // Through the window 4 cm off its centre line in y and 3 cm in z.
-        let (y, z) = (1.04, 0.97);
-        let out = widened_in_the_window(&[
-            step([0.4, 1.0, 1.0], &straight),
-            step([1.2, y, z], &straight),
-            step([3.6, y, z], &straight),
-            step([3.8, 1.0, 1.0], &straight),
-        ]);
+        let out = widened_in_the_window(&off_centre());
         assert!(out.len() >= 4);
     }
 
@@ -652,15 +653,8 @@ mod tests {
     #[test]
     fn the_same_plan_widens_the_same_way() {
         let ctx = window();
-        let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
-        let steps = vec![
-            step([0.4, 1.0, 1.0], &straight),
-            step([1.2, 1.04, 0.97], &straight),
-            step([3.6, 1.04, 0.97], &straight),
-            step([3.8, 1.0, 1.0], &straight),
-        ];
-        let (a, ra) = widen(&ctx, &ctx, steps.clone());
-        let (b, rb) = widen(&ctx, &ctx, steps);
+        let (a, ra) = widen(&ctx, &ctx, off_centre());
+        let (b, rb) = widen(&ctx, &ctx, off_centre());
         assert!(ra.moves > 0);
         assert_eq!((a, ra), (b, rb));
     }
