@@ -30,9 +30,9 @@
 //! the edge parameter has advanced by `m / speed`. Each body keeps its own certified
 //! horizon, and the edge is evaluated only where some horizon ends (and only for the
 //! bodies whose horizon ends there, with the units at the ends of such a link), so
-//! open space is crossed in a few samples and no collision is ever skipped. A body whose margin falls
-//! below [`CollisionContext::min_step`] is reported as colliding (conservatively), which
-//! also bounds the work per edge. Limits and self-collision along a shape change come
+//! open space is crossed in a few samples and no collision is ever skipped. A body
+//! whose margin falls below [`CollisionContext::min_step`] is reported as colliding
+//! (conservatively), which also bounds the work per edge. Limits and self-collision along a shape change come
 //! from `aerial_chain_core::validity::check_transition`.
 
 pub(crate) mod exact;

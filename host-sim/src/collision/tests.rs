@@ -382,27 +382,6 @@ proptest! {
     }
 }
 
-/// The distance from `p` to the nearest obstacle cube by reading every voxel within
-/// `cap` (and a voxel more) of it; `cap` when none is nearer.
-fn clearance_by_every_voxel(grid: &Grid, p: Point3<f64>, cap: f64) -> f64 {
-    let r = grid.resolution();
-    let c = grid.lattice_index(p);
-    let k = (cap / r).ceil() as i32 + 2;
-    let half = Vector3::repeat(0.5 * r);
-    let mut best = cap;
-    for z in c[2] - k..=c[2] + k {
-        for y in c[1] - k..=c[1] + k {
-            for x in c[0] - k..=c[0] + k {
-                if grid.is_obstacle([x, y, z]) {
-                    let v = grid.voxel_center([x, y, z]);
-                    best = best.min(exact::point_box_distance(p, v - half, v + half));
-                }
-            }
-        }
-    }
-    best
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
 
@@ -417,7 +396,7 @@ proptest! {
         reach in 0.0f64..0.5,
     ) {
         let (p, cap) = (Point3::from(p), stop.max(0.0) + reach);
-        let every = clearance_by_every_voxel(&grid, p, cap);
+        let every = nearest_by_every_voxel(&grid, p, p, cap).map_or(cap, |n| n.distance);
         let fast = exact::exact_clearance(&DistanceField::new(grid), p, stop, cap);
         if every <= stop {
             prop_assert!(fast <= stop, "{fast} > stop {stop} ({every})");

@@ -414,7 +414,12 @@ impl Widener<'_> {
 
     /// Distance from `p` to the nearest obstacle cube, capped at `CAP + r_u`.
     fn distance(&self, p: Point3<f64>) -> f64 {
-        let cap = CAP + self.ctx.params().unit_radius as f64;
+        self.distance_below(p, CAP + self.ctx.params().unit_radius as f64)
+    }
+
+    /// Distance from `p` to the nearest obstacle cube, capped at `cap`: the search for
+    /// the nearest cube stops there.
+    fn distance_below(&self, p: Point3<f64>, cap: f64) -> f64 {
         let f = self.ctx.field();
         if f.clearance_above(p, cap) >= cap {
             return cap;
@@ -525,10 +530,10 @@ impl Widener<'_> {
             let c = if lb - r_u >= CAP - r_v {
                 lb - r_u
             } else {
-                // Only a distance below the best so far can matter: the search for the
-                // nearest cube stops there (most samples of an edge are wider).
+                // Only a distance below the best so far can matter (most samples of
+                // an edge are wider).
                 let below = best.clearance + r_u;
-                let d = exact_clearance(field, p, 0.0, below);
+                let d = self.distance_below(p, below);
                 if d >= below {
                     continue;
                 }
