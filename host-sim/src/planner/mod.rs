@@ -13,7 +13,7 @@
 //! - [`ArcPlanner`], the paper's ARCplanner (`arc`): a lazy head roadmap
 //!   (`roadmap`, `lattice`) and, per head edge, the cheapest shape that gets the
 //!   chain along it (`construction`, `connect`, `candidates`, `follow`,
-//!   `srs_connect`), then `refine`, `shorten` and `widen`;
+//!   `srs_connect`), then `refine`, `shorten`, `widen` and `thread`;
 //! - the full-state PRM baseline, [`crate::baseline::FullStatePrm`].
 //!
 //! Both search their roadmaps with the one lazy graph search of `graph`.
@@ -33,6 +33,7 @@ pub(crate) mod roadmap;
 mod settings;
 mod shorten;
 pub(crate) mod srs_connect;
+mod thread;
 mod widen;
 
 use std::time::{Duration, Instant};

@@ -68,6 +68,7 @@ pub fn annotate_quality(plan: &mut Plan, quality: &Quality, refinement: Option<&
             "moves": w.moves,
         }),
     );
+    m.insert("threaded".into(), r.threaded.into());
     plan.stats.insert("refinement".into(), Value::Object(m));
     if let Some(Value::Object(t)) = plan.stats.get_mut("timing") {
         t.insert("refine_s".into(), r.time_s.into());

@@ -384,5 +384,10 @@ fn print_quality(report: &Report, q: &Quality, refinement: Option<&Refinement>) 
                 w.before, w.after, w.moves
             ));
         }
+        if r.threaded {
+            report.line(format_args!(
+                "  threaded: the chain follows its head along the route, straightened through the middle of each passage"
+            ));
+        }
     }
 }
