@@ -32,8 +32,8 @@ use crate::collision::CollisionContext;
 /// this (m): the passages widening works on (`super::widen::CAP`).
 const PINCH: f64 = super::widen::CAP;
 
-/// A unit inside a pinch (distance to the map under its radius plus this share of
-/// [`PINCH`]) may drift this share of the map's resolution off its track per step.
+/// For the step length, a unit is inside a pinch where its distance to the map is
+/// under its radius plus this share of [`PINCH`].
 const IN_PINCH: f64 = 0.5;
 
 /// How far (share of the resolution) a translation may carry a unit in a pinch off
@@ -344,9 +344,7 @@ impl Router<'_> {
                 .find(|t| self.ctx.clearance(c + sign * t * u) >= limit)
         };
         let (a, b) = (c - reach(-1.0)? * u, c + reach(1.0)? * u);
-        let cap = limit;
-        let f = self.ctx.field();
-        let middle = exact_clearance(f, c, 0.0, cap).min(cap) - self.r_u();
+        let middle = exact_clearance(self.ctx.field(), c, 0.0, limit).min(limit) - self.r_u();
         (middle > 0.0 && self.head_flies(a, b)).then_some(Pinch { a, b, middle })
     }
 
@@ -382,7 +380,7 @@ impl Router<'_> {
         sum.try_normalize(1e-9).unwrap_or(guess)
     }
 
-    /// The point of the line through `c` along `u`, within half a metre, where the
+    /// The point of the line through `c` along `u`, within 20 half voxels, where the
     /// distance field's bound is least: inside the pinch rather than at its mouth.
     fn narrowest_along(&self, c: Point3<f64>, u: Vector3<f64>) -> Point3<f64> {
         let h = self.res() / 2.0;
