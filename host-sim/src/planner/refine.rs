@@ -173,7 +173,8 @@ impl ArcPlanner {
         } else {
             super::widen::widen(&ctx, &self.ctx_min, steps)
         };
-        let (steps, last, threaded) = self.threaded_if_better(&solution.steps, steps, last);
+        let (steps, last, threaded) =
+            self.threaded_if_better(&solution.steps, steps, last, deadline);
         let mut stats = solution.stats.clone();
         super::construction::count_sources(&steps, &mut stats);
         let report = Refinement {
@@ -224,6 +225,7 @@ impl ArcPlanner {
         raw: &[Step],
         steps: Vec<Step>,
         widening: Widening,
+        deadline: Option<Instant>,
     ) -> (Vec<Step>, Widening, bool) {
         let Some(threading) = super::thread::Threading::of(&self.ctx, raw) else {
             return (steps, widening, false);
@@ -232,7 +234,8 @@ impl ArcPlanner {
         if share >= super::widen::CENTRED {
             return (steps, widening, false);
         }
-        let Some(t) = threading.follow(&self.ctx, &raw[0], self.settings.follow_step) else {
+        let Some(t) = threading.follow(&self.ctx, &raw[0], self.settings.follow_step, deadline)
+        else {
             return (steps, widening, false);
         };
         let passing = threading.measure(&self.ctx, &t, true);

@@ -18,6 +18,8 @@
 //! where one does not, threading gives up and the plan keeps the other stages'
 //! result.
 
+use std::time::Instant;
+
 use aerial_chain_core::kinematics::{link_direction, offsets};
 use aerial_chain_core::Shape;
 use nalgebra::{Point3, Vector3};
@@ -92,17 +94,19 @@ impl Threading {
     }
 
     /// The plan that follows the route from `start` in follow-the-leader steps of at
-    /// most `step` (m); `None` where any step fails the checks of `ctx`.
+    /// most `step` (m); `None` where any step fails the checks of `ctx`, or the
+    /// checks run past `deadline` (the query's time limit).
     pub(super) fn follow(
         &self,
         ctx: &CollisionContext,
         start: &Step,
         step: f64,
+        deadline: Option<Instant>,
     ) -> Option<Vec<Step>> {
         if step <= 0.0 {
             return None;
         }
-        Follower::new(ctx, start, step).along(&self.route)
+        Follower::new(ctx, start, step, deadline).along(&self.route)
     }
 
     /// How `steps` passes the pinches, over the samples of every edge at twice the
@@ -490,10 +494,10 @@ struct Follower<'a> {
 }
 
 impl<'a> Follower<'a> {
-    fn new(ctx: &'a CollisionContext, start: &Step, step: f64) -> Self {
+    fn new(ctx: &'a CollisionContext, start: &Step, step: f64, deadline: Option<Instant>) -> Self {
         Self {
             ctx,
-            checker: Checker::new(ctx.clone(), None),
+            checker: Checker::new(ctx.clone(), deadline),
             track: body_track(ctx.params(), start),
             steps: vec![*start],
             step,
@@ -679,7 +683,7 @@ mod tests {
             .collect();
         let threading = Threading::of(&ctx, &raw).expect("a pinch");
         let out = threading
-            .follow(&ctx, &raw[0], 0.1)
+            .follow(&ctx, &raw[0], 0.1, None)
             .expect("the window can be threaded");
         assert_eq!(out[0], raw[0]);
         assert_eq!(out[out.len() - 1].xi, raw[2].xi);
