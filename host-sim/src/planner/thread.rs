@@ -25,6 +25,7 @@ use aerial_chain_core::Shape;
 use nalgebra::{Point3, Vector3};
 
 use super::candidates::Source;
+use super::widen::{distance, gradient, zeta};
 use super::{follow, Checker, Step};
 use crate::collision::exact::{exact_clearance, positions_f64};
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
@@ -136,15 +137,15 @@ impl Threading {
             for j in (0..=n).step_by(2).chain([n]) {
                 let z = edge_sample(kind, &za, &zb, j as f64 / n as f64);
                 for p in positions_f64(l, [z[0], z[1], z[2]], &z[3..]) {
-                    let alongside: Vec<&Pinch> =
-                        self.pinches.iter().filter(|k| k.alongside(p)).collect();
-                    if (alongside.is_empty() && !every_unit) || field.clearance_above(p, cap) >= cap
+                    let alongside = || self.pinches.iter().filter(|k| k.alongside(p));
+                    if (!every_unit && alongside().next().is_none())
+                        || field.clearance_above(p, cap) >= cap
                     {
                         continue;
                     }
                     let d = exact_clearance(field, p, 0.0, cap).min(cap) - r_u;
                     out.narrowest = out.narrowest.min(d);
-                    for k in alongside {
+                    for k in alongside() {
                         out.share = out.share.min(d / k.middle.max(1e-9));
                     }
                 }
@@ -174,12 +175,6 @@ impl Pinch {
         let along = w.dot(&u);
         (0.0..=(self.b - self.a).norm()).contains(&along) && (w - along * u).norm() <= 1.0
     }
-}
-
-fn zeta(s: &Step) -> Vec<f64> {
-    let mut z = vec![s.xi.x, s.xi.y, s.xi.z];
-    z.extend(s.shape.as_slice().iter().map(|&a| a as f64));
-    z
 }
 
 /// Pinches of a head route and their axes.
@@ -412,29 +407,15 @@ impl Router<'_> {
     /// `c` moved across `u` (in the plane normal to it) to where the distance to the
     /// map is largest: gradient ascent with shrinking steps.
     fn centre(&self, mut c: Point3<f64>, u: Vector3<f64>) -> Point3<f64> {
-        let cap = self.r_u() + PINCH;
-        let dist = |p: Point3<f64>| {
-            let f = self.ctx.field();
-            if f.clearance_above(p, cap) >= cap {
-                cap
-            } else {
-                exact_clearance(f, p, 0.0, cap).min(cap)
-            }
-        };
-        let hh = self.res() / 8.0;
-        let mut d = dist(c);
+        let mut d = distance(self.ctx, c);
         for step in [0.4, 0.2, 0.1, 0.05, 0.025] {
             for _ in 0..12 {
-                let g = Vector3::from_fn(|i, _| {
-                    let mut e = Vector3::zeros();
-                    e[i] = hh;
-                    (dist(c + e) - dist(c - e)) / (2.0 * hh)
-                });
+                let g = gradient(self.ctx, c);
                 let Some(g) = (g - g.dot(&u) * u).try_normalize(1e-6) else {
                     break;
                 };
                 let next = c + step * self.res() * g;
-                let dn = dist(next);
+                let dn = distance(self.ctx, next);
                 if dn <= d + 1e-9 {
                     break;
                 }

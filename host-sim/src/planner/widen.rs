@@ -349,14 +349,9 @@ impl Widener<'_> {
             .collect()
     }
 
-    /// The gradient of the distance to the map at `p` (central differences).
+    /// The gradient of the distance to the map at `p`.
     fn gradient(&self, p: Point3<f64>) -> Vector3<f64> {
-        let h = self.ctx.field().grid().resolution() / 8.0;
-        Vector3::from_fn(|i, _| {
-            let mut e = Vector3::zeros();
-            e[i] = h;
-            (self.distance(p + e) - self.distance(p - e)) / (2.0 * h)
-        })
+        gradient(self.ctx, p)
     }
 
     /// The clearance a unit would keep in the middle of the passage at `p`: over the
@@ -415,17 +410,12 @@ impl Widener<'_> {
 
     /// Distance from `p` to the nearest obstacle cube, capped at `CAP + r_u`.
     fn distance(&self, p: Point3<f64>) -> f64 {
-        self.distance_below(p, CAP + self.ctx.params().unit_radius as f64)
+        distance(self.ctx, p)
     }
 
-    /// Distance from `p` to the nearest obstacle cube, capped at `cap`: the search for
-    /// the nearest cube stops there.
+    /// Distance from `p` to the nearest obstacle cube, capped at `cap`.
     fn distance_below(&self, p: Point3<f64>, cap: f64) -> f64 {
-        let f = self.ctx.field();
-        if f.clearance_above(p, cap) >= cap {
-            return cap;
-        }
-        exact_clearance(f, p, 0.0, cap).min(cap)
+        distance_below(self.ctx, p, cap)
     }
 
     /// Moves the stations of `group` by `delta` when that widens every edge it touches
@@ -571,8 +561,34 @@ fn edge_passes(check: &mut Checker, a: &Step, b: &Step) -> bool {
     }
 }
 
+/// Distance from `p` to the nearest obstacle cube, capped at `CAP + r_u`: as far as
+/// a passage's middle matters to widening (and to `super::thread`).
+pub(super) fn distance(ctx: &CollisionContext, p: Point3<f64>) -> f64 {
+    distance_below(ctx, p, CAP + ctx.params().unit_radius as f64)
+}
+
+/// Distance from `p` to the nearest obstacle cube, capped at `cap`: the distance
+/// field's bound first, and the search for the nearest cube stops at `cap`.
+pub(super) fn distance_below(ctx: &CollisionContext, p: Point3<f64>, cap: f64) -> f64 {
+    let f = ctx.field();
+    if f.clearance_above(p, cap) >= cap {
+        return cap;
+    }
+    exact_clearance(f, p, 0.0, cap).min(cap)
+}
+
+/// The gradient of [`distance`] at `p` (central differences, an eighth of a voxel).
+pub(super) fn gradient(ctx: &CollisionContext, p: Point3<f64>) -> Vector3<f64> {
+    let h = ctx.field().grid().resolution() / 8.0;
+    Vector3::from_fn(|i, _| {
+        let mut e = Vector3::zeros();
+        e[i] = h;
+        (distance(ctx, p + e) - distance(ctx, p - e)) / (2.0 * h)
+    })
+}
+
 /// A step's configuration `zeta` in `f64`.
-fn zeta(s: &Step) -> Vec<f64> {
+pub(super) fn zeta(s: &Step) -> Vec<f64> {
     s.xi.iter()
         .copied()
         .chain(s.shape.as_slice().iter().map(|&v| v as f64))
