@@ -15,14 +15,16 @@
 //! with the other velocity zero. The ramps of an edge must fit (`r (U + W) / 2 <= 1`):
 //! where they do not, the edge's cruise is lowered until they do.
 //!
-//! Before that, a translation and the shape change beside it may be merged into one
-//! motion, straight in `zeta`, that moves head and shape at once (`super::merge`).
+//! Before that, consecutive edges may be merged into one motion, straight in `zeta`,
+//! that moves head and shape at once (`super::merge`): a run of short edges that
+//! already lie nearly on a line in `zeta`, or a translation and the shape change beside
+//! it.
 //!
 //! What a blend or a merge can break is the chain's validity (the map, self-collision,
 //! the bend limit) and the clearance the planner kept: the sampled trajectory is checked
 //! exactly ([`super::check_samples`]), and where the motion is not the plan's own every
 //! body must also keep `Settings::clearance` from the map. A blended corner where the
-//! check fails is unblended, else a merged pair there is split, and the timing redone,
+//! check fails is unblended, else a merged motion there is halved, and the timing redone,
 //! until the whole passes. Without blends the chain is on the plan's own edges, resting
 //! on a sample at every waypoint, so only a plan that is itself inadmissible fails.
 
@@ -89,7 +91,8 @@ impl Trajectory {
     pub fn blended(&self) -> usize {
         self.blended
     }
-    /// Pairs of a translation and a shape change flown at once, as one move.
+    /// Edges flown in one move with the edge before them (a merged pair counts one, a
+    /// run of `k` edges `k - 1`).
     pub fn merged(&self) -> usize {
         self.merged
     }
@@ -124,13 +127,13 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
         .map(|s| (s.delta[0].powi(2) + s.delta[1].powi(2) + s.delta[2].powi(2)).sqrt())
         .sum();
     let demands: Vec<Demand> = edges.iter().map(|e| Demand::of(e, l)).collect();
-    let mut merged = merge::candidates(&edges, settings.blend);
+    let mut merged = merge::candidates(&edges, l, settings.blend);
     // blend[k]: the motion that starts with edge k is blended with the one before.
     let mut blend: Vec<bool> = (0..edges.len()).map(|k| k > 0 && settings.blend).collect();
     // What the last round checked: its segments, and the first sample it found wrong.
     let mut last: Option<(Vec<Segment>, usize)> = None;
     loop {
-        let (motions, firsts, max_rates) = merge::assemble(&edges, &demands, &merged, &limits);
+        let (motions, firsts, max_rates) = merge::assemble(&edges, &demands, &merged, &limits, l);
         let merged_m: Vec<bool> = firsts
             .iter()
             .map(|&k| merged.get(k + 1).copied().unwrap_or(false))
@@ -180,8 +183,10 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
         last = Some((segs.to_vec(), v.sample));
         if let Some(m) = corner_near(segs, &blend_m, &v, settings.dt) {
             blend[firsts[m]] = false;
-        } else if let Some(m) = motion_near(segs, &v, settings.dt).filter(|&m| merged_m[m]) {
-            merged[firsts[m] + 1] = false;
+        } else if let Some(m) = merged_near(segs, &merged_m, &v, settings.dt) {
+            // Halve the merged motion (a pair comes apart).
+            let (first, last) = (firsts[m], merge::run_end(&merged, firsts[m]));
+            merged[first + (last - first).div_ceil(2)] = false;
         } else {
             return Err(TrajectoryError::Inadmissible(v));
         }
@@ -222,11 +227,12 @@ pub(super) fn max_angle(delta: &[f64]) -> f64 {
     delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()))
 }
 
-/// The motion whose time (two samples either side) holds `v`, the last if several.
-fn motion_near(segments: &[Segment], v: &Violation, dt: f64) -> Option<usize> {
-    let pad = 2.0 * dt;
+/// The merged motion whose time (two samples either side) holds `v`, the last if
+/// several.
+fn merged_near(segments: &[Segment], merged: &[bool], v: &Violation, dt: f64) -> Option<usize> {
+    let (pad, t) = (2.0 * dt, v.t + v.fraction * dt);
     (0..segments.len()).rev().find(|&m| {
-        v.t >= segments[m].t0 - pad && v.t <= segments[m].t0 + segments[m].duration + pad
+        merged[m] && t >= segments[m].t0 - pad && t <= segments[m].t0 + segments[m].duration + pad
     })
 }
 
@@ -244,10 +250,10 @@ fn sample(r: &Reference, dt: f64) -> (Vec<f64>, Vec<Vec<f64>>) {
 
 /// The blended corner whose overlap (two samples either side) holds `v`.
 fn corner_near(segments: &[Segment], blend: &[bool], v: &Violation, dt: f64) -> Option<usize> {
-    let pad = 2.0 * dt;
+    let (pad, t) = (2.0 * dt, v.t + v.fraction * dt);
     (1..segments.len()).find(|&k| {
         let prev = &segments[k - 1];
-        blend[k] && v.t >= segments[k].t0 - pad && v.t <= prev.t0 + prev.duration + pad
+        blend[k] && t >= segments[k].t0 - pad && t <= prev.t0 + prev.duration + pad
     })
 }
 

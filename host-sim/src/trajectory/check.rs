@@ -244,8 +244,8 @@ impl Checker<'_> {
             .iter()
             .map(|z| positions_f64(l, [z[0], z[1], z[2]], &z[3..]))
             .collect();
-        if let Some(z) = zetas.first() {
-            self.configuration(z, 0.0).map_err(|p| at(0, p))?;
+        if let (Some(z), Some(&t)) = (zetas.first(), times.first()) {
+            self.configuration(z, t).map_err(|p| at(0, p))?;
         }
         for j in 0..zetas.len().saturating_sub(1) {
             let dt = times[j + 1] - times[j];

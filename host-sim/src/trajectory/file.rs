@@ -47,7 +47,7 @@ pub struct TrajectoryStats {
     pub corners: usize,
     /// Corners flown blended.
     pub blended: usize,
-    /// Pairs of a translation and a shape change flown at once.
+    /// Corners flown as one move with the edge before them (merged edges).
     #[serde(default)]
     pub merged: usize,
 }

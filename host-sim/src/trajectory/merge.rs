@@ -1,13 +1,19 @@
-//! Merged edges: a translation and the shape change beside it flown at once, as one
-//! straight move in `zeta` (head and shape together), where that is admissible.
+//! Merged edges: consecutive edges flown at once, as one straight move in `zeta` (head
+//! and shape together), where that is admissible.
 //!
 //! A shape change limited by the angular rate leaves most of the speed budget unused,
 //! and a translation uses none of the angular budget: flown together they take
-//! `max((len + w) / speed, max_angle / angular_rate)` instead of the sum of both, where
-//! `len` is the head's travel and `w` the fastest any unit moves per unit of the shape
-//! change's progress (a unit's velocity is the head's plus the shape's part, so its
-//! speed is at most `r (len + w)` at rate `r`). `w` is measured along the shape change
-//! and made an upper bound by the largest change of velocity between measurements.
+//! `max(w / speed, max_angle / angular_rate)` instead of the sum of both, where `w` is
+//! the fastest any unit moves per unit of the merged motion's progress (head and shape
+//! together), measured along the motion and made an upper bound by the largest change
+//! of velocity between measurements.
+//!
+//! Two kinds of merge are tried: a *run*, many short edges whose waypoints lie within
+//! [`RUN_TOLERANCE`] of the straight move through them (follow-the-leader steps, a
+//! chain bending around its head's track a little at a time: flown edge by edge, every
+//! step would start and end a link's turn, and the ramps between such short edges
+//! bring the chain almost to rest); and a *pair*, a translation with the shape change
+//! beside it.
 
 use super::build::max_angle;
 use crate::collision::exact::positions_f64;
@@ -17,45 +23,42 @@ use crate::sim::ReferenceLimits;
 /// Measurements along a shape change for its fastest unit.
 const SPEED_SAMPLES: usize = 128;
 
-/// What the rate of an edge depends on.
+/// How far (m) a run's straight move may carry any unit from where the plan has it at
+/// the run's inner waypoints: a fraction of the planner's clearance margin (0.05 m),
+/// which the trajectory check then asks of the whole move.
+pub(super) const RUN_TOLERANCE: f64 = 0.02;
+
+/// Most edges one run joins.
+const MAX_RUN: usize = 64;
+
+/// What the rate of a motion depends on.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Demand {
-    /// Head travel (m).
-    len: f64,
-    /// Upper bound on the fastest unit's speed from the shape part, per unit progress (m).
-    sweep: f64,
+    /// Upper bound on the fastest unit's speed per unit of progress (m).
+    speed: f64,
     /// Largest change of any angle (rad).
     angle: f64,
 }
 
 impl Demand {
-    /// The demand of one edge of a chain with links of length `l`.
+    /// The demand of one motion (an edge, or merged edges) of a chain with links of
+    /// length `l`.
     pub(super) fn of(e: &Segment, l: f64) -> Self {
         let d = &e.delta;
         Self {
-            len: (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(),
-            sweep: match e.kind {
-                SegmentKind::ShapeChange => shape_speed(l, &e.from[3..], &d[3..]),
-                _ => 0.0,
+            speed: match e.kind {
+                SegmentKind::ShapeChange => motion_speed(l, &d[..3], &e.from[3..], &d[3..]),
+                _ => (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(),
             },
             angle: max_angle(d),
-        }
-    }
-
-    /// Two edges at once.
-    fn plus(self, o: Self) -> Self {
-        Self {
-            len: self.len + o.len,
-            sweep: self.sweep + o.sweep,
-            angle: self.angle.max(o.angle),
         }
     }
 
     /// The largest rate of progress within the speed and angular-rate limits.
     pub(super) fn max_rate(&self, lim: &ReferenceLimits) -> f64 {
         let mut r = f64::INFINITY;
-        if self.len + self.sweep > 0.0 {
-            r = r.min(lim.speed / (self.len + self.sweep));
+        if self.speed > 0.0 {
+            r = r.min(lim.speed / self.speed);
         }
         if self.angle > 0.0 {
             r = r.min(lim.angular_rate / self.angle);
@@ -64,16 +67,19 @@ impl Demand {
     }
 }
 
-/// An upper bound on the speed of any unit, per unit of progress, while the shape moves
-/// linearly from `eta` by `d_eta` with the head fixed: the largest chord speed between
-/// `SPEED_SAMPLES` measurements, plus the most a velocity can change between two of them
-/// (a link direction's second derivative is at most `(|dtheta| + |dpsi|)^2`); never more
-/// than the bound `l * sum_k sqrt(dtheta_k^2 + dpsi_k^2)`.
-pub(super) fn shape_speed(l: f64, eta: &[f64], d_eta: &[f64]) -> f64 {
+/// An upper bound on the speed of any unit, per unit of progress, while the head moves
+/// by `d_head` and the shape from `eta` by `d_eta`, both linearly: the largest chord
+/// speed between `SPEED_SAMPLES` measurements, plus the most a velocity can change
+/// between two of them (the head's part is constant; a link direction's second
+/// derivative is at most `(|dtheta| + |dpsi|)^2`); never more than the bound
+/// `|d_head| + l * sum_k sqrt(dtheta_k^2 + dpsi_k^2)`. Measured on the whole motion,
+/// not as the head's speed plus the shape's: a chain following its head moves every
+/// unit about as fast as the head, where the sum would count it twice.
+pub(super) fn motion_speed(l: f64, d_head: &[f64], eta: &[f64], d_eta: &[f64]) -> f64 {
     let links = (eta.len() - 1) / 2;
     let at = |s: f64| {
         let e: Vec<f64> = eta.iter().zip(d_eta).map(|(a, d)| a + s * d).collect();
-        positions_f64(l, [0.0; 3], &e)
+        positions_f64(l, [s * d_head[0], s * d_head[1], s * d_head[2]], &e)
     };
     let n = SPEED_SAMPLES as f64;
     let mut best = 0.0f64;
@@ -92,81 +98,216 @@ pub(super) fn shape_speed(l: f64, eta: &[f64], d_eta: &[f64]) -> f64 {
         curve += (dt.abs() + dp.abs()).powi(2);
         bound += (dt * dt + dp * dp).sqrt();
     }
-    (best + l * curve / n).min(l * bound)
+    let head = (d_head[0] * d_head[0] + d_head[1] * d_head[1] + d_head[2] * d_head[2]).sqrt();
+    (best + l * curve / n).min(head + l * bound)
 }
 
-/// The edges with merged pairs joined: each motion, and the edge it starts with.
-/// `merged[k]`: edge `k` is flown together with edge `k - 1`.
+/// The edges with merged runs joined: each motion, the edge it starts with, and its
+/// largest rate of progress. `merged[k]`: edge `k` is flown together with edge `k - 1`.
 pub(super) fn assemble(
     edges: &[Segment],
     demands: &[Demand],
     merged: &[bool],
     lim: &ReferenceLimits,
+    l: f64,
 ) -> (Vec<Segment>, Vec<usize>, Vec<f64>) {
     let (mut motions, mut firsts, mut rates) = (Vec::new(), Vec::new(), Vec::new());
     let mut k = 0;
     while k < edges.len() {
+        let end = run_end(merged, k);
         let mut e = edges[k].clone();
-        let mut demand = demands[k];
-        if k + 1 < edges.len() && merged[k + 1] {
+        for next in &edges[k + 1..=end] {
             e.delta
                 .iter_mut()
-                .zip(&edges[k + 1].delta)
+                .zip(&next.delta)
                 .for_each(|(a, b)| *a += b);
-            e.kind = SegmentKind::ShapeChange;
-            e.to_waypoint = edges[k + 1].to_waypoint;
-            demand = demand.plus(demands[k + 1]);
+            if next.kind == SegmentKind::ShapeChange {
+                e.kind = SegmentKind::ShapeChange;
+            }
+            e.to_waypoint = next.to_waypoint;
         }
+        let demand = match end - k {
+            0 => demands[k],
+            _ => Demand::of(&e, l),
+        };
         motions.push(e);
         firsts.push(k);
         rates.push(demand.max_rate(lim));
-        k += if k + 1 < edges.len() && merged[k + 1] {
-            2
-        } else {
-            1
-        };
+        k = end + 1;
     }
     (motions, firsts, rates)
 }
 
-/// The pairs worth trying, left to right: a translation next to a shape change, each
-/// edge in at most one pair.
-pub(super) fn candidates(edges: &[Segment], on: bool) -> Vec<bool> {
+/// The last edge of the motion that starts with edge `k`.
+pub(super) fn run_end(merged: &[bool], k: usize) -> usize {
+    let mut end = k;
+    while end + 1 < merged.len() && merged[end + 1] {
+        end += 1;
+    }
+    end
+}
+
+/// The merges worth trying, left to right: the longest run from each edge on (a run
+/// of one edge is none), else a translation next to a shape change; each edge in at
+/// most one motion.
+pub(super) fn candidates(edges: &[Segment], l: f64, on: bool) -> Vec<bool> {
     let mut merged = vec![false; edges.len()];
     if !on {
         return merged;
     }
-    for k in 1..edges.len() {
-        let pair = (edges[k - 1].kind, edges[k].kind);
-        let mixed = matches!(
-            pair,
+    let mixed = |a: SegmentKind, b: SegmentKind| {
+        matches!(
+            (a, b),
             (SegmentKind::Translation, SegmentKind::ShapeChange)
                 | (SegmentKind::ShapeChange, SegmentKind::Translation)
-        );
-        if mixed && !merged[k - 1] {
-            merged[k] = true;
+        )
+    };
+    let mut k = 0;
+    while k < edges.len() {
+        // Runs grow by whole follow-the-leader steps (a shape change and a translation)
+        // where a single edge more would end half way through one.
+        let mut end = k;
+        while let Some(next) = [end + 2, end + 1]
+            .into_iter()
+            .find(|&e| e < edges.len() && e - k < MAX_RUN && straight(&edges[k..=e], l))
+        {
+            end = next;
         }
+        if end == k && k + 1 < edges.len() && mixed(edges[k].kind, edges[k + 1].kind) {
+            end = k + 1;
+        }
+        merged[k + 1..=end].iter_mut().for_each(|m| *m = true);
+        k = end + 1;
     }
     merged
+}
+
+/// Whether the straight move from the start of `run` to its end passes every inner
+/// waypoint within [`RUN_TOLERANCE`]: each unit's distance from where the plan has it,
+/// where the move has the head as far along as the plan has it there. Where the head
+/// moves, only the waypoints that end a translation are compared: a follow-the-leader
+/// step changes shape, then translates, and its straight version moves both at once,
+/// so the waypoint between the two is off any straight line by the step itself.
+fn straight(run: &[Segment], l: f64) -> bool {
+    let dim = run[0].delta.len();
+    let head = |d: &[f64]| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let angles = |d: &[f64]| d[3..].iter().map(|a| a.abs()).sum::<f64>();
+    let head_total: f64 = run.iter().map(|e| head(&e.delta)).sum();
+    let angle_total: f64 = run.iter().map(|e| angles(&e.delta)).sum();
+    let start = &run[0].from;
+    let whole: Vec<f64> = (0..dim)
+        .map(|i| run.iter().map(|e| e.delta[i]).sum())
+        .collect();
+    let mut at = start.clone();
+    let (mut head_done, mut angle_done) = (0.0, 0.0);
+    for e in &run[..run.len() - 1] {
+        at.iter_mut().zip(&e.delta).for_each(|(a, d)| *a += d);
+        head_done += head(&e.delta);
+        angle_done += angles(&e.delta);
+        let share = if head_total > 0.0 {
+            if e.kind != SegmentKind::Translation {
+                continue;
+            }
+            head_done / head_total
+        } else if angle_total > 0.0 {
+            angle_done / angle_total
+        } else {
+            continue;
+        };
+        let line: Vec<f64> = start
+            .iter()
+            .zip(&whole)
+            .map(|(a, d)| a + share * d)
+            .collect();
+        let plan = positions_f64(l, [at[0], at[1], at[2]], &at[3..]);
+        let moved = positions_f64(l, [line[0], line[1], line[2]], &line[3..]);
+        let off = plan.iter().zip(&moved).any(|(p, q)| {
+            (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)
+                > RUN_TOLERANCE * RUN_TOLERANCE
+        });
+        if off {
+            return false;
+        }
+    }
+    true
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// The edges of waypoints `(head, yaw of a straight chain of 4 units)`.
+    fn edges(points: &[([f64; 3], f64)]) -> Vec<Segment> {
+        let w: Vec<Vec<f64>> = points
+            .iter()
+            .map(|(h, yaw)| {
+                let mut z = h.to_vec();
+                z.push(*yaw);
+                for _ in 0..3 {
+                    z.extend([0.0, *yaw]);
+                }
+                z
+            })
+            .collect();
+        let lim = ReferenceLimits {
+            start_hold: 0.0,
+            ..Default::default()
+        };
+        crate::sim::reference::Reference::new(4, 0.5, &w, &lim)
+            .unwrap()
+            .segments()
+            .to_vec()
+    }
+
     #[test]
-    fn shape_speed_bounds_every_unit_and_is_tight_for_a_rotation() {
+    fn runs_join_what_lies_on_a_line_and_stop_at_corners() {
+        // Three translations along x, then one along y: the first three are one run.
+        let e = edges(&[
+            ([0.0, 0.0, 1.0], 0.0),
+            ([0.1, 0.0, 1.0], 0.0),
+            ([0.2, 0.0, 1.0], 0.0),
+            ([0.3, 0.0, 1.0], 0.0),
+            ([0.3, 0.1, 1.0], 0.0),
+        ]);
+        assert_eq!(candidates(&e, 0.5, true), [false, true, true, false]);
+        assert_eq!(candidates(&e, 0.5, false), [false; 4]);
+        // A small turn of the chain between two translations along its axis: the
+        // straight move would swing the tail 1.5 * 0.1 rad off at the waypoint between,
+        // far past the tolerance, so only the pair (translation, turn) is merged.
+        let e = edges(&[
+            ([0.0, 0.0, 1.0], 0.0),
+            ([0.1, 0.0, 1.0], 0.0),
+            ([0.1, 0.0, 1.0], 0.1),
+            ([0.2, 0.0, 1.0], 0.1),
+        ]);
+        assert_eq!(candidates(&e, 0.5, true), [false, true, false]);
+        let (motions, firsts, _) = assemble(
+            &e,
+            &e.iter().map(|x| Demand::of(x, 0.5)).collect::<Vec<_>>(),
+            &candidates(&e, 0.5, true),
+            &ReferenceLimits::default(),
+            0.5,
+        );
+        assert_eq!(firsts, [0, 2]);
+        assert_eq!(motions[0].kind, SegmentKind::ShapeChange);
+        assert!(
+            (motions[0].delta[0] - 0.1).abs() < 1e-12 && (motions[0].delta[3] - 0.1).abs() < 1e-12
+        );
+    }
+
+    #[test]
+    fn motion_speed_bounds_every_unit_and_is_tight_for_a_rotation() {
         // The whole chain turned about the head: the tail (3 links out) moves 3 l per
         // radian, and the bound says so.
         let (l, eta, d) = (0.5, [0.0; 7], [0.5, 0.0, 0.5, 0.0, 0.5, 0.0, 0.5]);
-        let w = shape_speed(l, &eta, &d);
+        let w = motion_speed(l, &[0.0; 3], &eta, &d);
         assert!(
             w >= 3.0 * l * 0.5 - 1e-12 && w <= 3.0 * l * 0.5 * 1.01,
             "{w}"
         );
         // Links turning against each other: the measured speed is well below the bound.
         let d = [0.0, 0.0, 0.6, 0.0, -0.6, 0.0, 0.6];
-        let w = shape_speed(l, &eta, &d);
+        let w = motion_speed(l, &[0.0; 3], &eta, &d);
         assert!(w < 0.8 * l * 1.8, "{w}");
         // Fine measurement never under the truth.
         let fine = |s: f64| {

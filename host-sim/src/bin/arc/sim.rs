@@ -276,7 +276,7 @@ fn timed(
     match trajectory::build(plan, grid, &a.timing.settings()?) {
         Ok(tr) => {
             say(format_args!(
-                "  timing: trajectory of {:.2} s ({:.2} s stopping at every waypoint), {} of {} corners blended, {} translations and shape changes merged",
+                "  timing: trajectory of {:.2} s ({:.2} s stopping at every waypoint), {} of {} corners blended, {} corners merged",
                 tr.duration(),
                 tr.stop_go_duration(),
                 tr.blended(),

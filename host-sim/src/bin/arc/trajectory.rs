@@ -126,7 +126,7 @@ pub fn write(tr: &Trajectory, plan: &Plan, out: &Path, report: &Report) -> CliRe
         .write(out)
         .map_err(|e| CliError::input(e.to_string()))?;
     report.line(format_args!(
-        "  trajectory {}: {:.2} s ({:.2} s stopping at every waypoint), {} of {} corners blended, {} translations and shape changes merged, head path {:.2} m, {} samples",
+        "  trajectory {}: {:.2} s ({:.2} s stopping at every waypoint), {} of {} corners blended, {} corners merged, head path {:.2} m, {} samples",
         crate::fsutil::output_name(out),
         tr.duration(),
         tr.stop_go_duration(),
