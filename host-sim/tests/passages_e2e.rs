@@ -46,6 +46,24 @@ fn half_metre_windows_at_45_degrees_and_tunnels_plan_for_5_and_6_units() {
 }
 
 #[test]
+fn the_search_threads_an_opening_that_whole_shapes_cannot_pass_without_a_roadmap() {
+    // Eight units at 49 degrees to a 0.55 m window 0.29 m off the room's axis, then a
+    // 0.5 m door: no library or random shape flies the quick head route, and the
+    // uniform roadmap took a second of replans to find another way in. The search now
+    // threads the chain along the route instead.
+    let dir = tempfile::tempdir().unwrap();
+    let name = "passage:w=0.52,angle=49,offset=-0.29,wall=0.13,door=0.5,door_offset=0.17";
+    let plan = plan_and_verify(name, 8, dir.path());
+    assert_eq!(plan.stats["roadmap_vertices"], 0, "{:?}", plan.stats);
+    assert!(plan.stats["follow_uses"].as_u64().unwrap() > 0);
+    let spec = PassageSpec::parse(&name["passage:".len()..]).unwrap();
+    let params = aerial_chain_core::ChainParams::new(8);
+    for o in spec.opening_clearances(&plan, &params).unwrap() {
+        assert!(o.clearance >= o.target, "{o:?}");
+    }
+}
+
+#[test]
 fn family_names_parse_and_build() {
     let spec = PassageSpec::parse("w=0.55,angle=30,door=0.7").unwrap();
     let sc = scenarios::build(&spec.name()).unwrap();

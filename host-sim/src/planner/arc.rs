@@ -82,6 +82,12 @@ pub struct Stats {
     pub roadmap_edges: usize,
 }
 
+/// The search threads the quick route ([`ArcPlanner::threaded_on_route`]) where it
+/// passes an opening that leaves a unit less than this share of widening's reach
+/// (`super::widen::CAP`) in its middle: a window or a door, not a wide passage where a
+/// follower would turn through every corner of the route.
+const THREAD_OPENING: f64 = 0.9;
+
 /// The planner: a map context, a chain's shape tables, settings, and the roadmap.
 pub struct ArcPlanner {
     /// The map and chain at the preferred clearance.
@@ -271,6 +277,9 @@ impl ArcPlanner {
                 .quick_route(&self.ctx_min, start, goal, deadline);
             built.lattice_s += t.elapsed().as_secs_f64();
             on_route = self.solve_on_route(query, stop, began, &built)?;
+            if on_route.is_none() {
+                on_route = self.threaded_on_route(query, &built, deadline);
+            }
             // Where the chain could not fly it alone, the roadmap is tried on its own
             // first: a long chain replans better over samples than along the route's
             // free edges. The route joins the roadmap after that fails.
@@ -330,6 +339,45 @@ impl ArcPlanner {
             Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. }) => Ok(None),
             Err(e) => Err(e),
         }
+    }
+
+    /// The chain following its head along the route in `built`, straightened through
+    /// the axis of each pinch (`super::thread`), where the chain could not fly the
+    /// route with whole shapes and the route passes an opening that leaves a unit less
+    /// than [`THREAD_OPENING`] of widening's reach in its middle: at an oblique window
+    /// the chain lines up with the opening and threads it, where the roadmap would
+    /// sample the room for another way in. `None` where the route has no such opening
+    /// or a step fails the checks.
+    fn threaded_on_route(
+        &self,
+        query: &Query,
+        built: &Built,
+        deadline: Option<Instant>,
+    ) -> Option<(Vec<Step>, Stats)> {
+        let points: Vec<Point3<f64>> = built
+            .route
+            .as_ref()?
+            .points
+            .iter()
+            .map(|&p| p.into())
+            .collect();
+        let threading = super::thread::Threading::along(&self.ctx, &points)?;
+        if threading.narrowest_middle() >= THREAD_OPENING * super::widen::CAP {
+            return None;
+        }
+        let start = Step {
+            xi: query.start,
+            shape: query.start_shape,
+            source: super::Source::Start,
+            shape_change: false,
+        };
+        let (steps, checks) =
+            threading.follow(&self.ctx, &start, self.settings.follow_step, deadline)?;
+        let mut stats = Stats::default();
+        super::construction::count_sources(&steps, &mut stats);
+        stats.min_margin = self.ctx.clearance_margin();
+        stats.timings.collision_s = checks.as_secs_f64();
+        Some((steps, stats))
     }
 
     /// The lattice search guided by the labelled free regions (labelled now if need

@@ -234,7 +234,8 @@ impl ArcPlanner {
         if share >= super::widen::CENTRED {
             return (steps, widening, false);
         }
-        let Some(t) = threading.follow(&self.ctx, &raw[0], self.settings.follow_step, deadline)
+        let Some((t, _)) =
+            threading.follow(&self.ctx, &raw[0], self.settings.follow_step, deadline)
         else {
             return (steps, widening, false);
         };

@@ -18,7 +18,7 @@
 //! where one does not, threading gives up and the plan keeps the other stages'
 //! result.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use aerial_chain_core::kinematics::{link_direction, offsets};
 use aerial_chain_core::Shape;
@@ -91,23 +91,35 @@ impl Threading {
                 route.push(s.xi);
             }
         }
+        Self::along(ctx, &route)
+    }
+
+    /// The head route `route` (start first) straightened through its pinches; `None`
+    /// when it has none.
+    pub(super) fn along(ctx: &CollisionContext, route: &[Point3<f64>]) -> Option<Self> {
         if route.len() < 2 {
             return None;
         }
-        let (route, pinches) = Router { ctx }.straightened(&route);
+        let (route, pinches) = Router { ctx }.straightened(route);
         (!pinches.is_empty()).then_some(Self { route, pinches })
     }
 
+    /// The least clearance a unit keeps in the middle of any of the route's pinches
+    /// (m; at most [`PINCH`]).
+    pub(super) fn narrowest_middle(&self) -> f64 {
+        self.pinches.iter().map(|p| p.middle).fold(PINCH, f64::min)
+    }
+
     /// The plan that follows the route from `start` in follow-the-leader steps of at
-    /// most `step` (m); `None` where any step fails the checks of `ctx`, or the
-    /// checks run past `deadline` (the query's time limit).
+    /// most `step` (m), and the time its checks took; `None` where any step fails the
+    /// checks of `ctx`, or the checks run past `deadline` (the query's time limit).
     pub(super) fn follow(
         &self,
         ctx: &CollisionContext,
         start: &Step,
         step: f64,
         deadline: Option<Instant>,
-    ) -> Option<Vec<Step>> {
+    ) -> Option<(Vec<Step>, Duration)> {
         if step <= 0.0 {
             return None;
         }
@@ -555,8 +567,9 @@ impl<'a> Follower<'a> {
         }
     }
 
-    /// The steps that fly the head along `route` (which starts at the start's head).
-    fn along(mut self, route: &[Point3<f64>]) -> Option<Vec<Step>> {
+    /// The steps that fly the head along `route` (which starts at the start's head),
+    /// and the time their checks took.
+    fn along(mut self, route: &[Point3<f64>]) -> Option<(Vec<Step>, Duration)> {
         self.align(route[1] - route[0]);
         for w in route.windows(2) {
             let mut p = self.head();
@@ -585,7 +598,7 @@ impl<'a> Follower<'a> {
                 p = q;
             }
         }
-        Some(self.steps)
+        Some((self.steps, self.checker.time))
     }
 
     fn head(&self) -> Point3<f64> {
@@ -699,7 +712,7 @@ mod tests {
             })
             .collect();
         let threading = Threading::of(&ctx, &raw).expect("a pinch");
-        let out = threading
+        let (out, _) = threading
             .follow(&ctx, &raw[0], 0.1, None)
             .expect("the window can be threaded");
         assert_eq!(out[0], raw[0]);
