@@ -352,11 +352,8 @@ impl Router<'_> {
         c = self.centre(c, u);
         (c, u) = self.through_tunnel(c, u);
         let limit = self.r_u() + PINCH;
-        let h = self.res() / 2.0;
         let reach = |sign: f64| {
-            (1..)
-                .map(|k| k as f64 * h)
-                .take_while(|t| *t < 4.0)
+            self.out_along()
                 .find(|t| self.ctx.clearance(c + sign * t * u) >= limit)
         };
         let (a, b) = (c - reach(-1.0)? * u, c + reach(1.0)? * u);
@@ -396,19 +393,24 @@ impl Router<'_> {
         sum.try_normalize(1e-9).unwrap_or(guess)
     }
 
+    /// Distances out along a pinch's axis from its middle, every half voxel up to
+    /// 4 m: where a pinch's ends are looked for.
+    fn out_along(&self) -> impl Iterator<Item = f64> {
+        let h = self.res() / 2.0;
+        (1..).map(move |k| k as f64 * h).take_while(|t| *t < 4.0)
+    }
+
     /// In a tunnel (a pinch at least [`TUNNEL`] long) the cone of free lines is
     /// narrow and the direction grid biases its mean by a degree or two, which a
     /// metre of tunnel turns into centimetres: there the axis is the line through the
     /// middles of its cross-sections near either end.
     fn through_tunnel(&self, c: Point3<f64>, u: Vector3<f64>) -> (Point3<f64>, Vector3<f64>) {
-        let h = self.res() / 2.0;
         // Inside the tunnel the distance field's bound stays within a voxel of the
         // narrowest (a tilted guess drifts towards a side by less).
         let floor = self.ctx.clearance(c) + self.res();
         let extent = |sign: f64| {
-            (1..)
-                .map(|k| k as f64 * h)
-                .take_while(|t| *t < 4.0 && self.ctx.clearance(c + sign * t * u) <= floor)
+            self.out_along()
+                .take_while(|t| self.ctx.clearance(c + sign * t * u) <= floor)
                 .last()
                 .unwrap_or(0.0)
         };

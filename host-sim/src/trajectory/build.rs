@@ -31,7 +31,7 @@
 use aerial_chain_core::ChainParams;
 
 use super::check::{check_with_margin, Violation};
-use super::merge::{self, Demand};
+use super::merge;
 use super::{Plan, Settings, TrajectoryError, MAX_SAMPLES};
 use crate::map::Grid;
 use crate::sim::reference::{Reference, Scaling, Segment};
@@ -126,14 +126,15 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
         .iter()
         .map(|s| (s.delta[0].powi(2) + s.delta[1].powi(2) + s.delta[2].powi(2)).sqrt())
         .sum();
-    let demands: Vec<Demand> = edges.iter().map(|e| Demand::of(e, l)).collect();
+    let mut demands = merge::Demands::new();
     let mut merged = merge::candidates(&edges, l, settings.blend);
     // blend[k]: the motion that starts with edge k is blended with the one before.
     let mut blend: Vec<bool> = (0..edges.len()).map(|k| k > 0 && settings.blend).collect();
     // What the last round checked: its segments, and the first sample it found wrong.
     let mut last: Option<(Vec<Segment>, usize)> = None;
     loop {
-        let (motions, firsts, max_rates) = merge::assemble(&edges, &demands, &merged, &limits, l);
+        let (motions, firsts, max_rates) =
+            merge::assemble(&edges, &mut demands, &merged, &limits, l);
         let merged_m: Vec<bool> = firsts
             .iter()
             .map(|&k| merged.get(k + 1).copied().unwrap_or(false))
@@ -227,10 +228,15 @@ pub(super) fn max_angle(delta: &[f64]) -> f64 {
     delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()))
 }
 
+/// When `v` happened: its interval's start plus its share of the sample spacing.
+fn at(v: &Violation, dt: f64) -> f64 {
+    v.t + v.fraction * dt
+}
+
 /// The merged motion whose time (two samples either side) holds `v`, the last if
 /// several.
 fn merged_near(segments: &[Segment], merged: &[bool], v: &Violation, dt: f64) -> Option<usize> {
-    let (pad, t) = (2.0 * dt, v.t + v.fraction * dt);
+    let (pad, t) = (2.0 * dt, at(v, dt));
     (0..segments.len()).rev().find(|&m| {
         merged[m] && t >= segments[m].t0 - pad && t <= segments[m].t0 + segments[m].duration + pad
     })
@@ -250,7 +256,7 @@ fn sample(r: &Reference, dt: f64) -> (Vec<f64>, Vec<Vec<f64>>) {
 
 /// The blended corner whose overlap (two samples either side) holds `v`.
 fn corner_near(segments: &[Segment], blend: &[bool], v: &Violation, dt: f64) -> Option<usize> {
-    let (pad, t) = (2.0 * dt, v.t + v.fraction * dt);
+    let (pad, t) = (2.0 * dt, at(v, dt));
     (1..segments.len()).find(|&k| {
         let prev = &segments[k - 1];
         blend[k] && t >= segments[k].t0 - pad && t <= prev.t0 + prev.duration + pad

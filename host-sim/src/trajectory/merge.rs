@@ -102,11 +102,16 @@ pub(super) fn motion_speed(l: f64, d_head: &[f64], eta: &[f64], d_eta: &[f64]) -
     (best + l * curve / n).min(head + l * bound)
 }
 
+/// The demands of motions already measured, by their first and last edge: the
+/// generator assembles the motions again after every failed check, and most of them
+/// are the same.
+pub(super) type Demands = std::collections::HashMap<(usize, usize), Demand>;
+
 /// The edges with merged runs joined: each motion, the edge it starts with, and its
 /// largest rate of progress. `merged[k]`: edge `k` is flown together with edge `k - 1`.
 pub(super) fn assemble(
     edges: &[Segment],
-    demands: &[Demand],
+    demands: &mut Demands,
     merged: &[bool],
     lim: &ReferenceLimits,
     l: f64,
@@ -126,10 +131,7 @@ pub(super) fn assemble(
             }
             e.to_waypoint = next.to_waypoint;
         }
-        let demand = match end - k {
-            0 => demands[k],
-            _ => Demand::of(&e, l),
-        };
+        let demand = *demands.entry((k, end)).or_insert_with(|| Demand::of(&e, l));
         motions.push(e);
         firsts.push(k);
         rates.push(demand.max_rate(lim));
@@ -283,7 +285,7 @@ mod tests {
         assert_eq!(candidates(&e, 0.5, true), [false, true, false]);
         let (motions, firsts, _) = assemble(
             &e,
-            &e.iter().map(|x| Demand::of(x, 0.5)).collect::<Vec<_>>(),
+            &mut Demands::new(),
             &candidates(&e, 0.5, true),
             &ReferenceLimits::default(),
             0.5,
