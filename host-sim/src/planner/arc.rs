@@ -380,9 +380,10 @@ impl ArcPlanner {
         Some((steps, stats))
     }
 
-    /// The lattice search guided by the labelled free regions (labelled now if need
-    /// be), where the uniform roadmap failed: a proof that start and goal lie in
-    /// separate regions ends the query; a route found is flown alone
+    /// Where the uniform roadmap failed: the quick route, if the query found one,
+    /// joins the roadmap; else the lattice search guided by the labelled free regions
+    /// (labelled now if need be) runs: a proof that start and goal lie in separate
+    /// regions ends the query; a route found is flown alone
     /// ([`Self::solve_on_route`]) and else joins the roadmap.
     fn guided_attempt(
         &self,
@@ -391,14 +392,17 @@ impl ArcPlanner {
         began: Instant,
         built: &mut Built,
     ) -> Result<Option<(Vec<Step>, Stats)>, PlanError> {
+        if let Some(quick) = built.quick.take() {
+            // Tried alone before: now it joins the roadmap. A route joins start and
+            // goal, so there is no separation to look for (labelling the regions
+            // would cost a flood of the whole map).
+            built.route = Some(quick);
+            return Ok(None);
+        }
         let (start, goal) = query.ends();
         built.regions_s += self.ensure_regions();
         if let Some(sep) = self.lattice.separation(self.ctx.field(), start, goal) {
             return Err(self.separated(sep));
-        }
-        if let Some(quick) = built.quick.take() {
-            built.route = Some(quick);
-            return Ok(None); // tried alone before: now it joins the roadmap
         }
         let (budget, deadline) = (self.lattice.budget, stop.deadline(began));
         built.route = self.head_route(start, goal, budget, deadline, &mut built.lattice_s)?;
