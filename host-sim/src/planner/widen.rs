@@ -17,6 +17,10 @@
 //! against voxel cube) at twice the verifier's sample spacing; within `r_v` of the cap
 //! the distance field's bound stands in for it.
 //!
+//! An edge is judged by its narrowest sample, which lies in one passage; a second
+//! pass ([`Widener::other_passages`]) widens translations that cross another passage
+//! off its middle, by moves that narrow no edge.
+//!
 //! The start and the goal stay where they are. Work is counted in edge measurements
 //! ([`BUDGET`]), not time, so the result is deterministic.
 
@@ -57,6 +61,21 @@ pub(super) const CENTRED: f64 = 0.93;
 
 /// Smallest gain (m) that counts as widening.
 const GAIN: f64 = 1e-4;
+
+/// The share of its passage's middle the passages issue asks a plan to keep. A
+/// passage matters to widening up to the width where that share of its middle is
+/// [`CAP`]: a door 0.85 m wide leaves a unit 0.275 m in its middle, and 0.9 of that
+/// is less than the cap.
+const TARGET_SHARE: f64 = 0.9;
+
+/// Samples farther apart than this (m) may lie in two passages: an edge crossing
+/// both is judged by its narrowest sample, in one of them, and
+/// [`Widener::other_passages`] looks for the other.
+const SEPARATE: f64 = 0.8;
+
+/// Samples of another passage looked at per edge, narrowest first, each at least
+/// [`SEPARATE`] from the ones before (a long tunnel holds several).
+const OTHER_CANDIDATES: usize = 3;
 
 /// A run of steps at one head position: the translation into it, its shape changes,
 /// and the translation out of it move with it.
@@ -122,6 +141,7 @@ pub(super) fn widen(
             w.stuck[e] = true;
         }
     }
+    moves += w.other_passages();
     let after = w.narrowest();
     let in_passages = w.narrowest_in_passages();
     (
@@ -225,7 +245,7 @@ impl Widener<'_> {
         let narrow = self.narrow[e];
         let grad = self.gradient(narrow.at);
         match self.passage(narrow.at, grad, along) {
-            Some(best) if narrow.clearance < CENTRED * best => {}
+            Some(best) if narrow.clearance < aim(best) => {}
             // Open on one side, or as wide as the passage allows.
             _ => return false,
         }
@@ -386,13 +406,13 @@ impl Widener<'_> {
             .min_by(f64::total_cmp)
     }
 
-    /// How far from `p` along `u` the first obstacle lies, within `2 (CAP + r_u)`:
-    /// sphere tracing, with the distance field's lower bound while it is large and the
-    /// exact distance near the obstacle.
+    /// How far from `p` along `u` the first obstacle lies, within the widest passage
+    /// that matters, `2 (CAP / TARGET_SHARE + r_u)`: sphere tracing, with the distance
+    /// field's lower bound while it is large and the exact distance near the obstacle.
     fn free_run(&self, p: Point3<f64>, u: Vector3<f64>) -> Option<f64> {
         let f = self.ctx.field();
         let r_v = f.grid().resolution();
-        let reach = 2.0 * (CAP + self.ctx.params().unit_radius as f64);
+        let reach = 2.0 * (CAP / TARGET_SHARE + self.ctx.params().unit_radius as f64);
         let mut t = 0.0;
         while t < reach {
             let q = p + u * t;
@@ -464,6 +484,129 @@ impl Widener<'_> {
         true
     }
 
+    /// The second pass: a translation whose narrowest sample keeps its passage's
+    /// share may cross another passage off its middle (a tunnel, then a door a chain
+    /// length further: widening judged the edge by the tunnel). For each such
+    /// translation, the narrowest samples away from its narrowest
+    /// ([`OTHER_CANDIDATES`], [`SEPARATE`] apart) are measured against their own
+    /// passage's middle, and the first off it is widened by moves of the edge's
+    /// stations that widen it there and narrow no edge they touch. Returns the moves.
+    fn other_passages(&mut self) -> usize {
+        let mut moves = 0;
+        for e in 0..self.narrow.len() {
+            let Some(along) = self.along(e) else { continue };
+            while self.spent < BUDGET && self.narrow[e].clearance < CAP {
+                let Some((target, away)) = self.off_middle(e, along) else {
+                    break;
+                };
+                let (a, b) = (self.station(e), self.station(e + 1));
+                let groups: Vec<Vec<Station>> = [vec![a, b], vec![b], vec![a]]
+                    .into_iter()
+                    .filter(|g| g.iter().all(|&s| self.movable(s)))
+                    .collect();
+                let grad = self.gradient(target.at);
+                let Some(d) = self.directions(grad, Some(along)).first().copied() else {
+                    break;
+                };
+                let r_v = self.ctx.field().grid().resolution();
+                let taken = STEPS.iter().any(|&f| {
+                    groups.iter().any(|g| {
+                        self.spent < BUDGET && self.try_move_at(g, d * (f * r_v), e, target, &away)
+                    })
+                });
+                if !taken {
+                    break;
+                }
+                moves += 1;
+            }
+        }
+        moves
+    }
+
+    /// The narrowest sample of translation `e` in a passage other than its
+    /// narrowest's, when it keeps less than its passage's aim ([`aim`]), with the
+    /// samples of the other passages looked at before it.
+    fn off_middle(
+        &mut self,
+        e: usize,
+        along: Vector3<f64>,
+    ) -> Option<(Narrowest, Vec<Point3<f64>>)> {
+        let steps = self.steps.clone();
+        let mut away = vec![self.narrow[e].at];
+        for _ in 0..OTHER_CANDIDATES {
+            let far = |p: &Point3<f64>| away.iter().all(|q| (p - q).norm() > SEPARATE);
+            let n = self.measure_where(e, &steps, f64::NEG_INFINITY, far)?;
+            if n.clearance >= CAP {
+                return None;
+            }
+            if let Some(middle) = self.passage(n.at, self.gradient(n.at), Some(along)) {
+                if n.clearance < aim(middle) {
+                    return Some((n, away));
+                }
+            }
+            away.push(n.at);
+        }
+        None
+    }
+
+    /// [`Self::try_move`] for a sample of another passage: the move is taken when
+    /// edge `e` keeps more than `target` in that passage (within [`SEPARATE`] of it,
+    /// and nearer it than the samples of the passages `away`), no edge the move
+    /// touches gets narrower, and the moved edges pass the checks.
+    fn try_move_at(
+        &mut self,
+        group: &[Station],
+        delta: Vector3<f64>,
+        e: usize,
+        target: Narrowest,
+        away: &[Point3<f64>],
+    ) -> bool {
+        let mut moved = self.steps.clone();
+        for s in group {
+            for st in &mut moved[s.first..=s.last] {
+                st.xi += delta;
+            }
+        }
+        let near = |p: &Point3<f64>| {
+            let d = (p - target.at).norm();
+            d <= SEPARATE && away.iter().all(|q| (p - q).norm() > d)
+        };
+        if self
+            .measure_where(e, &moved, target.clearance + GAIN, near)
+            .is_none()
+        {
+            return false;
+        }
+        let lo = group
+            .iter()
+            .map(|s| s.first)
+            .min()
+            .unwrap_or(0)
+            .saturating_sub(1);
+        let hi = group
+            .iter()
+            .map(|s| s.last)
+            .max()
+            .unwrap_or(0)
+            .min(self.narrow.len() - 1);
+        let mut new = Vec::new();
+        for k in lo..=hi {
+            match self.measure_above(k, &moved, self.narrow[k].clearance - 1e-9) {
+                Some(n) => new.push((k, n)),
+                None => return false,
+            }
+        }
+        if !(lo..=hi).all(|k| self.admissible(k, &moved)) {
+            return false;
+        }
+        for (k, n) in new {
+            self.narrow[k] = n;
+            self.stuck[k] = false;
+        }
+        self.steps = moved;
+        true
+    }
+
     /// Whether edge `e` of `moved` passes the search's checks, or, where the current
     /// edge `e` does not (the search gave way there), the smallest clearance's checks.
     fn admissible(&mut self, e: usize, moved: &[Step]) -> bool {
@@ -485,6 +628,17 @@ impl Widener<'_> {
 
     /// [`Self::measure`], giving up (`None`) at the first sample at or below `floor`.
     fn measure_above(&mut self, e: usize, steps: &[Step], floor: f64) -> Option<Narrowest> {
+        self.measure_where(e, steps, floor, |_| true)
+    }
+
+    /// [`Self::measure_above`] over the unit positions `keep` keeps.
+    fn measure_where(
+        &mut self,
+        e: usize,
+        steps: &[Step],
+        floor: f64,
+        keep: impl Fn(&Point3<f64>) -> bool,
+    ) -> Option<Narrowest> {
         self.spent += 1;
         let params = self.ctx.params();
         let (l, r_u) = (params.link_length as f64, params.unit_radius as f64);
@@ -499,7 +653,7 @@ impl Widener<'_> {
             let z = edge_sample(kind, &a, &b, j as f64 / n as f64);
             for p in positions_f64(l, [z[0], z[1], z[2]], &z[3..]) {
                 let lb = field.clearance_above(p, cap);
-                if lb < cap {
+                if lb < cap && keep(&p) {
                     bounds.push((lb, p));
                 }
             }
@@ -542,6 +696,12 @@ impl Widener<'_> {
         }
         Some(best)
     }
+}
+
+/// What widening aims for in a passage whose middle keeps `middle` (m): [`CENTRED`]
+/// of it, below the cap.
+fn aim(middle: f64) -> f64 {
+    (CENTRED * middle).min(CAP - GAIN)
 }
 
 /// The part of `v` across the unit direction `along` (all of it without one).
@@ -679,6 +839,75 @@ mod tests {
         let (b, rb) = widen(&ctx, &ctx, off_centre());
         assert!(ra.moves > 0);
         assert_eq!((a, ra), (b, rb));
+    }
+
+    /// A wall at x = 2 with an opening 0.5 m tall and 0.7 m wide centred at
+    /// y = z = 1, and 1 m further a second wall with a door 0.7 m wide centred at
+    /// y = 0.95 (z up to 1.8). A unit keeps 0.1 m in the opening's middle, and
+    /// 0.1 m anywhere within 0.1 m of it across; 0.2 m in the door's middle.
+    fn opening_and_door() -> CollisionContext {
+        let mut g = Grid::new(0.05, [-20, 0, 0], [120, 40, 40], Cell::Free, false).unwrap();
+        g.fill_box([2.01, 0.0, 0.0], [2.09, 2.0, 2.0], Cell::Occupied);
+        g.fill_box([2.01, 0.66, 0.76], [2.09, 1.34, 1.24], Cell::Free);
+        g.fill_box([3.01, 0.0, 0.0], [3.09, 2.0, 2.0], Cell::Occupied);
+        g.fill_box([3.01, 0.61, 0.0], [3.09, 1.29, 1.79], Cell::Free);
+        let field = Arc::new(DistanceField::new(g));
+        CollisionContext::new(field, ChainParams::new(3), 0.05).unwrap()
+    }
+
+    /// The smallest unit clearance of `steps` where units are within 0.3 m of the
+    /// wall at `x` (m), sampled every centimetre of the head's path.
+    fn clearance_at_wall(ctx: &CollisionContext, steps: &[Step], x: f64) -> f64 {
+        let r_u = ctx.params().unit_radius as f64;
+        let mut least = f64::INFINITY;
+        for w in steps.windows(2) {
+            let n = ((w[1].xi - w[0].xi).norm() / 0.01).ceil().max(1.0) as usize;
+            let eta: Vec<f64> = w[1].shape.as_slice().iter().map(|&v| v as f64).collect();
+            for j in 0..=n {
+                let head = w[0].xi + (w[1].xi - w[0].xi) * (j as f64 / n as f64);
+                for p in positions_f64(0.5, head, &eta) {
+                    if (p.x - x).abs() < 0.3 {
+                        least = least.min(distance(ctx, p) - r_u);
+                    }
+                }
+            }
+        }
+        least
+    }
+
+    /// One translation through the middle of the opening and 5 cm off the door's:
+    /// the edge's narrowest is in the opening, as wide as it gets there, so only the
+    /// second pass sees the door, and widens it without narrowing the opening.
+    #[test]
+    fn a_second_passage_on_the_same_translation_is_widened_too() {
+        let ctx = opening_and_door();
+        let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
+        let steps: Vec<Step> = [
+            [0.4, 1.0, 1.0],
+            [1.2, 1.0, 1.0],
+            [4.6, 1.0, 1.0],
+            [4.7, 1.0, 1.0],
+        ]
+        .map(|xi| step(xi, &straight))
+        .to_vec();
+        let mut check = Checker::new(ctx.clone(), None);
+        assert!(steps
+            .windows(2)
+            .all(|w| edge_passes(&mut check, &w[0], &w[1])));
+        let door_before = clearance_at_wall(&ctx, &steps, 3.05);
+        assert!(door_before < 0.16, "{door_before}");
+        let (out, report) = widen(&ctx, &ctx, steps);
+        assert!(out
+            .windows(2)
+            .all(|w| edge_passes(&mut check, &w[0], &w[1])));
+        let opening = clearance_at_wall(&ctx, &out, 2.05);
+        let door = clearance_at_wall(&ctx, &out, 3.05);
+        assert!(opening > 0.099, "opening {opening}");
+        assert!(
+            door >= TARGET_SHARE * 0.2,
+            "door {door}, before {door_before}"
+        );
+        assert!(report.moves > 0);
     }
 
     #[test]
