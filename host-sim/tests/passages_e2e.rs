@@ -32,6 +32,12 @@ fn half_metre_windows_at_45_degrees_and_tunnels_plan_for_5_and_6_units() {
         // Tunnels: a 1.2-1.5 m thick wall.
         ("passage:w=0.5,angle=30,wall=1.2", 5),
         ("passage:w=0.55,angle=-45,offset=0.2,wall=1.5", 6),
+        // A tunnel, then a 0.85 m door (0.79 m asked, widened to whole voxels) that
+        // the same straight translation crosses: widening judges each passage.
+        (
+            "passage:w=0.59,angle=-42,offset=0.12,wall=1.49,door=0.79,door_offset=0.09",
+            6,
+        ),
     ] {
         // Solvable by a witness that does not use the planner.
         let sc = scenarios::build(name).unwrap();
