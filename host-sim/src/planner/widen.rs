@@ -442,38 +442,46 @@ impl Widener<'_> {
     /// whose narrowest sample is below the old narrowest of them, and the moved edges
     /// pass the checks. Returns whether the move was taken.
     fn try_move(&mut self, group: &[Station], delta: Vector3<f64>, first: usize) -> bool {
+        let (moved, touched) = self.moved(group, delta);
+        let old = touched
+            .clone()
+            .map(|e| self.narrow[e].clearance)
+            .fold(f64::INFINITY, f64::min);
+        // The edge being widened first: most moves that fail, fail there.
+        let mut order: Vec<(usize, f64)> = touched.map(|k| (k, old + GAIN)).collect();
+        order.sort_by_key(|&(k, _)| k != first);
+        self.take_if_above(moved, &order)
+    }
+
+    /// The steps with the stations of `group` moved by `delta`, and the edges the move
+    /// touches.
+    fn moved(
+        &self,
+        group: &[Station],
+        delta: Vector3<f64>,
+    ) -> (Vec<Step>, std::ops::RangeInclusive<usize>) {
         let mut moved = self.steps.clone();
         for s in group {
             for st in &mut moved[s.first..=s.last] {
                 st.xi += delta;
             }
         }
-        let lo = group
-            .iter()
-            .map(|s| s.first)
-            .min()
-            .unwrap_or(0)
-            .saturating_sub(1);
-        let hi = group
-            .iter()
-            .map(|s| s.last)
-            .max()
-            .unwrap_or(0)
-            .min(self.narrow.len() - 1);
-        let old = (lo..=hi)
-            .map(|e| self.narrow[e].clearance)
-            .fold(f64::INFINITY, f64::min);
-        // The edge being widened first: most moves that fail, fail there.
-        let mut order: Vec<usize> = (lo..=hi).collect();
-        order.sort_by_key(|&k| k != first);
-        let mut new = Vec::with_capacity(order.len());
-        for &k in &order {
-            match self.measure_above(k, &moved, old + GAIN) {
+        let lo = group.iter().map(|s| s.first).min().unwrap_or(0);
+        let hi = group.iter().map(|s| s.last).max().unwrap_or(0);
+        (moved, lo.saturating_sub(1)..=hi.min(self.narrow.len() - 1))
+    }
+
+    /// Takes `moved` when each edge of `floors`, measured in that order, keeps more
+    /// than its floor and every one passes the checks ([`Self::admissible`]).
+    fn take_if_above(&mut self, moved: Vec<Step>, floors: &[(usize, f64)]) -> bool {
+        let mut new = Vec::with_capacity(floors.len());
+        for &(k, floor) in floors {
+            match self.measure_above(k, &moved, floor) {
                 Some(n) => new.push((k, n)),
                 None => return false,
             }
         }
-        if !(lo..=hi).all(|k| self.admissible(k, &moved)) {
+        if !floors.iter().all(|&(k, _)| self.admissible(k, &moved)) {
             return false;
         }
         for (k, n) in new {
@@ -561,12 +569,7 @@ impl Widener<'_> {
         target: Narrowest,
         away: &[Point3<f64>],
     ) -> bool {
-        let mut moved = self.steps.clone();
-        for s in group {
-            for st in &mut moved[s.first..=s.last] {
-                st.xi += delta;
-            }
-        }
+        let (moved, touched) = self.moved(group, delta);
         let near = |p: &Point3<f64>| {
             let d = (p - target.at).norm();
             d <= SEPARATE && away.iter().all(|q| (p - q).norm() > d)
@@ -577,34 +580,10 @@ impl Widener<'_> {
         {
             return false;
         }
-        let lo = group
-            .iter()
-            .map(|s| s.first)
-            .min()
-            .unwrap_or(0)
-            .saturating_sub(1);
-        let hi = group
-            .iter()
-            .map(|s| s.last)
-            .max()
-            .unwrap_or(0)
-            .min(self.narrow.len() - 1);
-        let mut new = Vec::new();
-        for k in lo..=hi {
-            match self.measure_above(k, &moved, self.narrow[k].clearance - 1e-9) {
-                Some(n) => new.push((k, n)),
-                None => return false,
-            }
-        }
-        if !(lo..=hi).all(|k| self.admissible(k, &moved)) {
-            return false;
-        }
-        for (k, n) in new {
-            self.narrow[k] = n;
-            self.stuck[k] = false;
-        }
-        self.steps = moved;
-        true
+        let floors: Vec<(usize, f64)> = touched
+            .map(|k| (k, self.narrow[k].clearance - 1e-9))
+            .collect();
+        self.take_if_above(moved, &floors)
     }
 
     /// Whether edge `e` of `moved` passes the search's checks, or, where the current
