@@ -365,14 +365,12 @@ impl ArcPlanner {
         if threading.narrowest_middle() >= THREAD_OPENING * super::widen::CAP {
             return None;
         }
-        let start = Step {
-            xi: query.start,
-            shape: query.start_shape,
-            source: super::Source::Start,
-            shape_change: false,
-        };
-        let (steps, checks) =
-            threading.follow(&self.ctx, &start, self.settings.follow_step, deadline)?;
+        let (steps, checks) = threading.follow(
+            &self.ctx,
+            &query.start_step(),
+            self.settings.follow_step,
+            deadline,
+        )?;
         let mut stats = Stats::default();
         super::construction::count_sources(&steps, &mut stats);
         stats.min_margin = self.ctx.clearance_margin();

@@ -93,12 +93,7 @@ impl<'p> Construction<'p> {
             to_go,
             banned: BTreeSet::new(),
             current,
-            steps: vec![Step {
-                xi: start.into(),
-                shape,
-                source: Source::Start,
-                shape_change: false,
-            }],
+            steps: vec![query.start_step()],
             stats: Stats::default(),
             stop,
             began,

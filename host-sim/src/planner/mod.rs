@@ -111,6 +111,16 @@ impl Query {
         Ok(())
     }
 
+    /// The plan's first step: the head at the start in the start shape.
+    pub(crate) fn start_step(&self) -> Step {
+        Step {
+            xi: self.start,
+            shape: self.start_shape,
+            source: Source::Start,
+            shape_change: false,
+        }
+    }
+
     /// The head's start and goal as the arrays the collision checks and the roadmaps
     /// take.
     pub(crate) fn ends(&self) -> ([f64; 3], [f64; 3]) {

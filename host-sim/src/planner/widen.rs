@@ -504,7 +504,7 @@ impl Widener<'_> {
         for e in 0..self.narrow.len() {
             let Some(along) = self.along(e) else { continue };
             while self.spent < BUDGET && self.narrow[e].clearance < CAP {
-                let Some((target, away)) = self.off_middle(e, along) else {
+                let Some((target, grad, away)) = self.off_middle(e, along) else {
                     break;
                 };
                 let (a, b) = (self.station(e), self.station(e + 1));
@@ -512,7 +512,6 @@ impl Widener<'_> {
                     .into_iter()
                     .filter(|g| g.iter().all(|&s| self.movable(s)))
                     .collect();
-                let grad = self.gradient(target.at);
                 let Some(d) = self.directions(grad, Some(along)).first().copied() else {
                     break;
                 };
@@ -533,12 +532,13 @@ impl Widener<'_> {
 
     /// The narrowest sample of translation `e` in a passage other than its
     /// narrowest's, when it keeps less than its passage's aim ([`aim`]), with the
-    /// samples of the other passages looked at before it.
+    /// clearance's gradient there and the samples of the other passages looked at
+    /// before it.
     fn off_middle(
         &mut self,
         e: usize,
         along: Vector3<f64>,
-    ) -> Option<(Narrowest, Vec<Point3<f64>>)> {
+    ) -> Option<(Narrowest, Vector3<f64>, Vec<Point3<f64>>)> {
         let steps = self.steps.clone();
         let mut away = vec![self.narrow[e].at];
         for _ in 0..OTHER_CANDIDATES {
@@ -547,9 +547,10 @@ impl Widener<'_> {
             if n.clearance >= CAP {
                 return None;
             }
-            if let Some(middle) = self.passage(n.at, self.gradient(n.at), Some(along)) {
+            let grad = self.gradient(n.at);
+            if let Some(middle) = self.passage(n.at, grad, Some(along)) {
                 if n.clearance < aim(middle) {
-                    return Some((n, away));
+                    return Some((n, grad, away));
                 }
             }
             away.push(n.at);

@@ -183,7 +183,9 @@ impl Regions {
                     let (ra, rb) = (self.segs[i], self.segs[j]);
                     if ra[0] <= rb[1] + 1 && rb[0] <= ra[1] + 1 {
                         let same = same_rows && same_x_block(ra, rb, b);
-                        if same || !same_rows || !self.goes_on_to(here.clone(), i, rb) {
+                        // In one block's rows, a pair that is not in one block meets
+                        // diagonally across an x boundary (see above).
+                        if !(same_rows && !same && self.goes_on_to(here.clone(), i, rb)) {
                             f(i, j, same);
                         }
                     }
