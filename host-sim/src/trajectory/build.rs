@@ -28,10 +28,12 @@
 //! until the whole passes. Without blends the chain is on the plan's own edges, resting
 //! on a sample at every waypoint, so only a plan that is itself inadmissible fails.
 
+use std::collections::HashSet;
+
 use aerial_chain_core::ChainParams;
 
 use super::check::{check_with_margin, Violation};
-use super::merge;
+use super::group;
 use super::{Plan, Settings, TrajectoryError, MAX_SAMPLES};
 use crate::map::Grid;
 use crate::sim::reference::{Reference, Scaling, Segment};
@@ -126,30 +128,32 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
         .iter()
         .map(|s| (s.delta[0].powi(2) + s.delta[1].powi(2) + s.delta[2].powi(2)).sqrt())
         .sum();
-    let mut demands = merge::Demands::new();
-    let mut merged = merge::candidates(&edges, l, settings.blend);
-    // blend[k]: the motion that starts with edge k is blended with the one before.
-    let mut blend: Vec<bool> = (0..edges.len()).map(|k| k > 0 && settings.blend).collect();
+    let mut demands = group::Demands::new();
+    let mut grouping = group::Grouping::new(&edges, l, settings.blend);
+    // The places where a motion starts whose blend with the one before was undone.
+    let mut unblended: HashSet<u64> = HashSet::new();
     // What the last round checked: its segments, and the first sample it found wrong.
     let mut last: Option<(Vec<Segment>, usize)> = None;
     loop {
-        let (motions, firsts, max_rates) =
-            merge::assemble(&edges, &mut demands, &merged, &limits, l);
-        let merged_m: Vec<bool> = firsts
+        let motions = grouping.assemble(&edges, &mut demands, &limits, l);
+        let starts: Vec<f64> = grouping.starts().collect();
+        let mut blend_m: Vec<bool> = starts
             .iter()
-            .map(|&k| merged.get(k + 1).copied().unwrap_or(false))
+            .enumerate()
+            .map(|(m, p)| m > 0 && settings.blend && !unblended.contains(&p.to_bits()))
             .collect();
-        let mut blend_m: Vec<bool> = firsts.iter().map(|&k| blend[k]).collect();
         let timing = Timing {
             settings,
-            edges: &motions,
-            max_rates,
+            edges: &motions.segments,
+            max_rates: motions.rates,
         };
         let segments = timing.segments(&mut blend_m);
-        firsts
-            .iter()
-            .zip(&blend_m)
-            .for_each(|(&k, &b)| blend[k] = b);
+        for (m, (p, b)) in starts.iter().zip(&blend_m).enumerate() {
+            if m > 0 && !b {
+                unblended.insert(p.to_bits());
+            }
+        }
+        let merged_m = motions.merged;
         let reference = Reference::from_segments(params.n(), &waypoints[0], segments);
         let (times, zetas) = sample(&reference, settings.dt);
         let windows = windows(reference.segments(), &blend_m, &merged_m, settings.dt);
@@ -166,6 +170,12 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
         let part = (&times[from..], &zetas[from..]);
         let rep = check_with_margin(grid, &params, lim, part, margin, &required);
         let Some(mut v) = rep.violation else {
+            // Corners of the plan flown blended: a motion that starts where an edge does.
+            let blended = starts
+                .iter()
+                .zip(&blend_m)
+                .filter(|(p, b)| **b && p.fract() == 0.0)
+                .count();
             return Ok(Trajectory {
                 params,
                 settings: *settings,
@@ -173,8 +183,8 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
                 times,
                 zetas,
                 corners: edges.len().saturating_sub(1),
-                blended: blend_m.iter().filter(|b| **b).count(),
-                merged: merged.iter().filter(|b| **b).count(),
+                blended,
+                merged: grouping.merged_corners(),
                 stop_go,
                 head_path,
             });
@@ -183,11 +193,10 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
         let segs = reference.segments();
         last = Some((segs.to_vec(), v.sample));
         if let Some(m) = corner_near(segs, &blend_m, &v, settings.dt) {
-            blend[firsts[m]] = false;
+            unblended.insert(starts[m].to_bits());
         } else if let Some(m) = merged_near(segs, &merged_m, &v, settings.dt) {
-            // Halve the merged motion (a pair comes apart).
-            let (first, last) = (firsts[m], merge::run_end(&merged, firsts[m]));
-            merged[first + (last - first).div_ceil(2)] = false;
+            // A run is halved, a pair flies less of its translation or comes apart.
+            grouping.undo(m, &edges);
         } else {
             return Err(TrajectoryError::Inadmissible(v));
         }

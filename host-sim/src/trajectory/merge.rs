@@ -29,7 +29,7 @@ const SPEED_SAMPLES: usize = 128;
 pub(super) const RUN_TOLERANCE: f64 = 0.02;
 
 /// Most edges one run joins.
-const MAX_RUN: usize = 64;
+pub(super) const MAX_RUN: usize = 64;
 
 /// What the rate of a motion depends on.
 #[derive(Clone, Copy, Debug, Default)]
@@ -102,95 +102,13 @@ pub(super) fn motion_speed(l: f64, d_head: &[f64], eta: &[f64], d_eta: &[f64]) -
     (best + l * curve / n).min(head + l * bound)
 }
 
-/// The demands of motions already measured, by their first and last edge: the
-/// generator assembles the motions again after every failed check, and most of them
-/// are the same.
-pub(super) type Demands = std::collections::HashMap<(usize, usize), Demand>;
-
-/// The edges with merged runs joined: each motion, the edge it starts with, and its
-/// largest rate of progress. `merged[k]`: edge `k` is flown together with edge `k - 1`.
-pub(super) fn assemble(
-    edges: &[Segment],
-    demands: &mut Demands,
-    merged: &[bool],
-    lim: &ReferenceLimits,
-    l: f64,
-) -> (Vec<Segment>, Vec<usize>, Vec<f64>) {
-    let (mut motions, mut firsts, mut rates) = (Vec::new(), Vec::new(), Vec::new());
-    let mut k = 0;
-    while k < edges.len() {
-        let end = run_end(merged, k);
-        let mut e = edges[k].clone();
-        for next in &edges[k + 1..=end] {
-            e.delta
-                .iter_mut()
-                .zip(&next.delta)
-                .for_each(|(a, b)| *a += b);
-            if next.kind == SegmentKind::ShapeChange {
-                e.kind = SegmentKind::ShapeChange;
-            }
-            e.to_waypoint = next.to_waypoint;
-        }
-        let demand = *demands.entry((k, end)).or_insert_with(|| Demand::of(&e, l));
-        motions.push(e);
-        firsts.push(k);
-        rates.push(demand.max_rate(lim));
-        k = end + 1;
-    }
-    (motions, firsts, rates)
-}
-
-/// The last edge of the motion that starts with edge `k`.
-pub(super) fn run_end(merged: &[bool], k: usize) -> usize {
-    let mut end = k;
-    while end + 1 < merged.len() && merged[end + 1] {
-        end += 1;
-    }
-    end
-}
-
-/// The merges worth trying, left to right: the longest run from each edge on (a run
-/// of one edge is none), else a translation next to a shape change; each edge in at
-/// most one motion.
-pub(super) fn candidates(edges: &[Segment], l: f64, on: bool) -> Vec<bool> {
-    let mut merged = vec![false; edges.len()];
-    if !on {
-        return merged;
-    }
-    let mixed = |a: SegmentKind, b: SegmentKind| {
-        matches!(
-            (a, b),
-            (SegmentKind::Translation, SegmentKind::ShapeChange)
-                | (SegmentKind::ShapeChange, SegmentKind::Translation)
-        )
-    };
-    let mut k = 0;
-    while k < edges.len() {
-        // Runs grow by whole follow-the-leader steps (a shape change and a translation)
-        // where a single edge more would end half way through one.
-        let mut end = k;
-        while let Some(next) = [end + 2, end + 1]
-            .into_iter()
-            .find(|&e| e < edges.len() && e - k < MAX_RUN && straight(&edges[k..=e], l))
-        {
-            end = next;
-        }
-        if end == k && k + 1 < edges.len() && mixed(edges[k].kind, edges[k + 1].kind) {
-            end = k + 1;
-        }
-        merged[k + 1..=end].iter_mut().for_each(|m| *m = true);
-        k = end + 1;
-    }
-    merged
-}
-
 /// Whether the straight move from the start of `run` to its end passes every inner
 /// waypoint within [`RUN_TOLERANCE`]: each unit's distance from where the plan has it,
 /// where the move has the head as far along as the plan has it there. Where the head
 /// moves, only the waypoints that end a translation are compared: a follow-the-leader
 /// step changes shape, then translates, and its straight version moves both at once,
 /// so the waypoint between the two is off any straight line by the step itself.
-fn straight(run: &[Segment], l: f64) -> bool {
+pub(super) fn straight(run: &[Segment], l: f64) -> bool {
     let dim = run[0].delta.len();
     let head = |d: &[f64]| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     let angles = |d: &[f64]| d[3..].iter().map(|a| a.abs()).sum::<f64>();
@@ -237,65 +155,6 @@ fn straight(run: &[Segment], l: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The edges of waypoints `(head, yaw of a straight chain of 4 units)`.
-    fn edges(points: &[([f64; 3], f64)]) -> Vec<Segment> {
-        let w: Vec<Vec<f64>> = points
-            .iter()
-            .map(|(h, yaw)| {
-                let mut z = h.to_vec();
-                z.push(*yaw);
-                for _ in 0..3 {
-                    z.extend([0.0, *yaw]);
-                }
-                z
-            })
-            .collect();
-        let lim = ReferenceLimits {
-            start_hold: 0.0,
-            ..Default::default()
-        };
-        crate::sim::reference::Reference::new(4, 0.5, &w, &lim)
-            .unwrap()
-            .segments()
-            .to_vec()
-    }
-
-    #[test]
-    fn runs_join_what_lies_on_a_line_and_stop_at_corners() {
-        // Three translations along x, then one along y: the first three are one run.
-        let e = edges(&[
-            ([0.0, 0.0, 1.0], 0.0),
-            ([0.1, 0.0, 1.0], 0.0),
-            ([0.2, 0.0, 1.0], 0.0),
-            ([0.3, 0.0, 1.0], 0.0),
-            ([0.3, 0.1, 1.0], 0.0),
-        ]);
-        assert_eq!(candidates(&e, 0.5, true), [false, true, true, false]);
-        assert_eq!(candidates(&e, 0.5, false), [false; 4]);
-        // A small turn of the chain between two translations along its axis: the
-        // straight move would swing the tail 1.5 * 0.1 rad off at the waypoint between,
-        // far past the tolerance, so only the pair (translation, turn) is merged.
-        let e = edges(&[
-            ([0.0, 0.0, 1.0], 0.0),
-            ([0.1, 0.0, 1.0], 0.0),
-            ([0.1, 0.0, 1.0], 0.1),
-            ([0.2, 0.0, 1.0], 0.1),
-        ]);
-        assert_eq!(candidates(&e, 0.5, true), [false, true, false]);
-        let (motions, firsts, _) = assemble(
-            &e,
-            &mut Demands::new(),
-            &candidates(&e, 0.5, true),
-            &ReferenceLimits::default(),
-            0.5,
-        );
-        assert_eq!(firsts, [0, 2]);
-        assert_eq!(motions[0].kind, SegmentKind::ShapeChange);
-        assert!(
-            (motions[0].delta[0] - 0.1).abs() < 1e-12 && (motions[0].delta[3] - 0.1).abs() < 1e-12
-        );
-    }
 
     #[test]
     fn motion_speed_bounds_every_unit_and_is_tight_for_a_rotation() {

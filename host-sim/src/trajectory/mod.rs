@@ -13,12 +13,14 @@
 //!
 //! - `build`: [`build`] and [`Trajectory`], the generator;
 //! - `check`: [`check_samples`], the exact check of sampled motion and its limits;
-//! - `merge`: a translation and a shape change flown at once, where admissible;
+//! - `group`: which edges fly together as one motion, and how a merge gives way;
+//! - `merge`: what a merged motion demands of the limits, and which edges lie on a line;
 //! - `file`: [`TrajectoryFile`], the `arc-trajectory/1` JSON file and its CSV form.
 
 mod build;
 mod check;
 mod file;
+mod group;
 mod merge;
 #[cfg(test)]
 mod tests;

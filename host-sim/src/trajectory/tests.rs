@@ -416,3 +416,41 @@ fn a_run_that_would_touch_the_map_is_halved() {
     );
     assert_respects_limits(&grid, &params, &s.limits, near.times(), near.zetas());
 }
+
+#[test]
+fn a_pair_that_would_touch_the_map_flies_less_of_its_translation() {
+    // 2 m along x, then the chain turns by 0.6 rad about its head, swinging its tail
+    // towards -y. Merged with the whole translation, the tail would start to swing at
+    // the start and pass a box beside the first metre of the head's track; merged with
+    // the last metre or half metre only, it swings clear of it.
+    let params = ChainParams::new(4);
+    let s = Settings::default();
+    let line = Shape::line(4, 0.0);
+    let plan = plan(
+        &params,
+        &[
+            ([2.0, 2.0, 1.0], line),
+            ([4.0, 2.0, 1.0], line),
+            ([4.0, 2.0, 1.0], line.rotated(0.6)),
+        ],
+    );
+    let mut grid = Grid::new(0.1, [0, 0, 0], [60, 40, 20], Cell::Free, true).unwrap();
+    let free = build(&plan, &grid, &s).unwrap();
+    assert_eq!((free.corners(), free.merged()), (1, 1));
+    grid.fill_box([1.0, 1.2, 0.8], [1.4, 1.45, 1.2], Cell::Occupied);
+    let near = build(&plan, &grid, &s).unwrap();
+    let apart = build(&plan, &grid, &Settings { blend: false, ..s }).unwrap();
+    assert_eq!(
+        near.merged(),
+        1,
+        "the pair is kept, on part of the translation"
+    );
+    assert!(
+        near.duration() < apart.duration() - 1.0 && near.duration() > free.duration(),
+        "{} s between {} and {} s",
+        near.duration(),
+        free.duration(),
+        apart.duration()
+    );
+    assert_respects_limits(&grid, &params, &s.limits, near.times(), near.zetas());
+}
