@@ -454,3 +454,21 @@ fn a_pair_that_would_touch_the_map_flies_less_of_its_translation() {
     );
     assert_respects_limits(&grid, &params, &s.limits, near.times(), near.zetas());
 }
+
+#[test]
+fn runs_of_short_steps_may_cut_their_corners_by_more() {
+    // A quarter turn of radius 0.6 m in 2 cm steps: the straight move through many of
+    // them passes their waypoints 2-6 cm off, which short steps allow and long edges
+    // do not (with 2 cm for these too, the turn took 5 motions).
+    let params = ChainParams::new(4);
+    let s = Settings::default();
+    let grid = room();
+    let tight = build(&arc_follow(&params, 0.6, 0.02, 47), &grid, &s).unwrap();
+    let motions = tight.corners() + 1 - tight.merged();
+    assert!(motions <= 2, "{motions} motions");
+    assert_respects_limits(&grid, &params, &s.limits, tight.times(), tight.zetas());
+    // The same turn in 3 steps of 0.3 m: no run joins two of them (each step's shape
+    // change and translation fly as a pair).
+    let long = build(&arc_follow(&params, 0.6, 0.3, 3), &grid, &s).unwrap();
+    assert_eq!(long.corners() + 1 - long.merged(), 3);
+}
