@@ -556,4 +556,53 @@ mod tests {
         assert_eq!(places(&g), [(0.0, 2.0, true), (2.0, 4.0, true)]);
         assert_eq!(g.merged_corners(), 2);
     }
+
+    proptest::proptest! {
+        /// Whatever fails, in any order: the motions keep covering every edge once,
+        /// in order, none empty; no motion's part of a translation is a sliver; and
+        /// the search ends, every motion at last the plan's own.
+        #[test]
+        fn giving_way_keeps_the_cover_and_ends(
+            kinds in proptest::collection::vec((0u8..3, 0.05f64..3.0), 1..24),
+            picks in proptest::collection::vec(0usize..1000, 0..400),
+        ) {
+            let mut points = vec![([0.0, 0.0, 1.0], 0.0)];
+            for (kind, size) in &kinds {
+                let (mut h, mut yaw) = *points.last().unwrap();
+                match kind {
+                    0 => h[0] += size,
+                    1 => yaw += size / 4.0,
+                    _ => h[1] += size,
+                }
+                points.push((h, yaw));
+            }
+            let e = edges(&points);
+            let mut g = Grouping::new(&e, 0.5, true);
+            covers(&g, e.len());
+            let corners = e.len() - 1;
+            let mut undone = 0;
+            for pick in picks.iter().chain(std::iter::repeat(&0)) {
+                let merged: Vec<usize> = (0..g.motions.len())
+                    .filter(|&m| g.motions[m].kind != Kind::Own)
+                    .collect();
+                if merged.is_empty() {
+                    break;
+                }
+                proptest::prop_assert!(g.undo(merged[pick % merged.len()], &e));
+                undone += 1;
+                proptest::prop_assert!(undone <= 8 * e.len(), "no end in sight");
+                covers(&g, e.len());
+                proptest::prop_assert!(g.merged_corners() <= corners);
+                for m in &g.motions {
+                    let k = m.start.floor() as usize;
+                    let part = m.end.min((k + 1) as f64) - m.start;
+                    let piece = part * head_length(&e[k].delta);
+                    let whole = part == 1.0 || m.start.fract() == 0.0 && m.end.fract() == 0.0;
+                    proptest::prop_assert!(whole || piece >= MIN_PIECE - 1e-9,
+                        "a sliver of {piece} m: {:?}", g.motions);
+                }
+            }
+            proptest::prop_assert_eq!(g.merged_corners(), 0);
+        }
+    }
 }
