@@ -16,16 +16,17 @@
 //! where they do not, the edge's cruise is lowered until they do.
 //!
 //! Before that, consecutive edges may be merged into one motion, straight in `zeta`,
-//! that moves head and shape at once (`super::merge`): a run of short edges that
-//! already lie nearly on a line in `zeta`, or a translation and the shape change beside
-//! it.
+//! that moves head and shape at once (`super::group`, `super::merge`): a run of short
+//! edges that already lie nearly on a line in `zeta`, or a shape change and (part of)
+//! the translation beside it.
 //!
 //! What a blend or a merge can break is the chain's validity (the map, self-collision,
 //! the bend limit) and the clearance the planner kept: the sampled trajectory is checked
 //! exactly ([`super::check_samples`]), and where the motion is not the plan's own every
 //! body must also keep `Settings::clearance` from the map. A blended corner where the
-//! check fails is unblended, else a merged motion there is halved, and the timing redone,
-//! until the whole passes. Without blends the chain is on the plan's own edges, resting
+//! check fails is unblended, else a merged motion there gives way a step (a run is
+//! halved, a pair flies less of its translation or comes apart), and the timing is
+//! redone, until the whole passes. Without blends the chain is on the plan's own edges, resting
 //! on a sample at every waypoint, so only a plan that is itself inadmissible fails.
 
 use std::collections::HashSet;

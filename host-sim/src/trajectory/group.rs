@@ -473,6 +473,18 @@ mod tests {
         assert_eq!(g.merged_corners(), 0);
         assert!(!g.undo(1, &e), "nothing left to undo");
         covers(&g, 4);
+        // A small turn of the chain between two translations along its axis: the
+        // straight move would swing the tail 1.5 * 0.1 rad off at the waypoint between,
+        // past even a short step's tolerance, so only the pair (translation, turn) is
+        // merged.
+        let e = edges(&[
+            ([0.0, 0.0, 1.0], 0.0),
+            ([0.1, 0.0, 1.0], 0.0),
+            ([0.1, 0.0, 1.0], 0.1),
+            ([0.2, 0.0, 1.0], 0.1),
+        ]);
+        let g = Grouping::new(&e, 0.5, true);
+        assert_eq!(places(&g), [(0.0, 2.0, true), (2.0, 3.0, false)]);
     }
 
     #[test]

@@ -29,12 +29,11 @@ const SPEED_SAMPLES: usize = 128;
 pub(super) const RUN_TOLERANCE: f64 = 0.02;
 
 /// The same for a run of short steps only (translations, none longer than
-/// [`SHORT_STEP`], and shape changes):
-/// a follow-the-leader path's steps cut one continuous motion into pieces, and their
-/// corners are where the cutting fell, not places the plan chose. Runs of them may cut
-/// those corners by more (a chain threaded through a bend then turns its links
-/// together, not one after another at the angular rate limit); the check still asks
-/// the whole move for the margin. Measured on `corridor` N = 6 (seed 2, threaded): 55 s
+/// [`SHORT_STEP`], and shape changes): a follow-the-leader path's steps cut one
+/// continuous motion into pieces, and their corners are where the cutting fell, not
+/// places the plan chose. Runs of them may cut those corners by more (a chain threaded
+/// through a bend then turns its links together, not one after another at the angular
+/// rate limit); the check still asks the whole move for the margin. Measured on `corridor` N = 6 (seed 2, threaded): 55 s
 /// of flight where 0.02 m gave 94 s.
 const STEP_RUN_TOLERANCE: f64 = 0.06;
 
@@ -117,8 +116,8 @@ pub(super) fn motion_speed(l: f64, d_head: &[f64], eta: &[f64], d_eta: &[f64]) -
 
 /// Whether the straight move from the start of `run` to its end passes every inner
 /// waypoint within [`RUN_TOLERANCE`] ([`STEP_RUN_TOLERANCE`] for short steps): each
-/// unit's distance from where the plan has it,
-/// where the move has the head as far along as the plan has it there. Where the head
+/// unit's distance from where the plan has it, where the move has the head as far
+/// along as the plan has it there. Where the head
 /// moves, only the waypoints that end a translation are compared: a follow-the-leader
 /// step changes shape, then translates, and its straight version moves both at once,
 /// so the waypoint between the two is off any straight line by the step itself.
