@@ -34,7 +34,7 @@ use std::collections::HashSet;
 use aerial_chain_core::ChainParams;
 
 use super::check::{check_with_margin, Violation};
-use super::group;
+use super::{group, merge};
 use super::{Plan, Settings, TrajectoryError, MAX_SAMPLES};
 use crate::map::Grid;
 use crate::sim::reference::{Reference, Scaling, Segment};
@@ -125,10 +125,7 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
     if steps > MAX_SAMPLES {
         return Err(TrajectoryError::TooLong(steps));
     }
-    let head_path = edges
-        .iter()
-        .map(|s| (s.delta[0].powi(2) + s.delta[1].powi(2) + s.delta[2].powi(2)).sqrt())
-        .sum();
+    let head_path = edges.iter().map(|s| merge::head_length(&s.delta)).sum();
     let mut demands = group::Demands::new();
     let mut grouping = group::Grouping::new(&edges, l, settings.blend);
     // The places where a motion starts whose blend with the one before was undone.

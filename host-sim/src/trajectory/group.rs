@@ -16,7 +16,7 @@
 //! steps, then flies alone. Every step leaves the merged motions shorter or fewer, so
 //! the search ends.
 
-use super::merge::{straight, Demand, MAX_RUN};
+use super::merge::{head_length, straight, Demand, MAX_RUN};
 use crate::sim::reference::{Segment, SegmentKind};
 use crate::sim::ReferenceLimits;
 
@@ -33,6 +33,16 @@ enum Side {
     Before,
     /// The translation starts where the shape change ends.
     After,
+}
+
+impl Side {
+    /// The side across the shape change.
+    fn other(self) -> Self {
+        match self {
+            Side::Before => Side::After,
+            Side::After => Side::Before,
+        }
+    }
 }
 
 /// What a motion is.
@@ -61,6 +71,13 @@ struct Motion {
     start: f64,
     end: f64,
     kind: Kind,
+}
+
+impl Motion {
+    /// Whether this is (part of) translation `t` flown as the plan has it.
+    fn own_part_of(&self, t: usize) -> bool {
+        self.kind == Kind::Own && self.start >= t as f64 && self.end <= (t + 1) as f64
+    }
 }
 
 /// The plan's edges cut into motions, which together cover every edge once, in order.
@@ -155,8 +172,7 @@ impl Grouping {
         let Some(&next) = self.motions.get(neighbour) else {
             return false;
         };
-        let within = next.start >= t as f64 && next.end <= (t + 1) as f64;
-        if edges[t].kind != SegmentKind::Translation || next.kind != Kind::Own || !within {
+        if edges[t].kind != SegmentKind::Translation || !next.own_part_of(t) {
             return false;
         }
         // A whole translation however short, else no sliver.
@@ -287,11 +303,7 @@ impl Grouping {
                 };
                 self.give_back(m, side, whole);
                 let at = self.find(shape);
-                let other = match side {
-                    Side::Before => Side::After,
-                    Side::After => Side::Before,
-                };
-                if !other_tried && self.pair(at, other, edges) {
+                if !other_tried && self.pair(at, side.other(), edges) {
                     if let Kind::Pair { other_tried, .. } = &mut self.motions[at].kind {
                         *other_tried = true;
                     }
@@ -319,15 +331,10 @@ impl Grouping {
         let Kind::Pair { shape, .. } = motion.kind else {
             return;
         };
-        let edge_of = |p: f64| p.floor();
         match side {
             Side::Before => {
                 let (from, to) = (motion.start, place);
-                let t = (shape - 1) as f64;
-                let joins = m > 0
-                    && self.motions[m - 1].kind == Kind::Own
-                    && self.motions[m - 1].end == from
-                    && edge_of(self.motions[m - 1].start) == t;
+                let joins = m > 0 && self.motions[m - 1].own_part_of(shape - 1);
                 self.motions[m].start = to;
                 if to >= shape as f64 {
                     self.motions[m].kind = Kind::Own;
@@ -345,10 +352,10 @@ impl Grouping {
             }
             Side::After => {
                 let (from, to) = (place, motion.end);
-                let t = (shape + 1) as f64;
-                let joins = self.motions.get(m + 1).is_some_and(|n| {
-                    n.kind == Kind::Own && n.start == to && n.end <= t + 1.0 && n.start >= t
-                });
+                let joins = self
+                    .motions
+                    .get(m + 1)
+                    .is_some_and(|n| n.own_part_of(shape + 1));
                 self.motions[m].end = from;
                 if from <= (shape + 1) as f64 {
                     self.motions[m].kind = Kind::Own;
@@ -366,11 +373,6 @@ impl Grouping {
             }
         }
     }
-}
-
-/// The head's displacement over a change of `zeta` (m).
-fn head_length(d: &[f64]) -> f64 {
-    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
 }
 
 /// The straight move from place `start` to place `end` along `edges`: the plan's

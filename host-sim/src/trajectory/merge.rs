@@ -60,7 +60,7 @@ impl Demand {
         Self {
             speed: match e.kind {
                 SegmentKind::ShapeChange => motion_speed(l, &d[..3], &e.from[3..], &d[3..]),
-                _ => (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(),
+                _ => head_length(d),
             },
             angle: max_angle(d),
         }
@@ -110,8 +110,12 @@ pub(super) fn motion_speed(l: f64, d_head: &[f64], eta: &[f64], d_eta: &[f64]) -
         curve += (dt.abs() + dp.abs()).powi(2);
         bound += (dt * dt + dp * dp).sqrt();
     }
-    let head = (d_head[0] * d_head[0] + d_head[1] * d_head[1] + d_head[2] * d_head[2]).sqrt();
-    (best + l * curve / n).min(head + l * bound)
+    (best + l * curve / n).min(head_length(d_head) + l * bound)
+}
+
+/// The head's displacement (m) over a change `d` of `zeta` (or of the head alone).
+pub(super) fn head_length(d: &[f64]) -> f64 {
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
 }
 
 /// Whether the straight move from the start of `run` to its end passes every inner
@@ -123,9 +127,8 @@ pub(super) fn motion_speed(l: f64, d_head: &[f64], eta: &[f64], d_eta: &[f64]) -
 /// so the waypoint between the two is off any straight line by the step itself.
 pub(super) fn straight(run: &[Segment], l: f64) -> bool {
     let dim = run[0].delta.len();
-    let head = |d: &[f64]| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     let angles = |d: &[f64]| d[3..].iter().map(|a| a.abs()).sum::<f64>();
-    let head_total: f64 = run.iter().map(|e| head(&e.delta)).sum();
+    let head_total: f64 = run.iter().map(|e| head_length(&e.delta)).sum();
     let angle_total: f64 = run.iter().map(|e| angles(&e.delta)).sum();
     let start = &run[0].from;
     let whole: Vec<f64> = (0..dim)
@@ -133,14 +136,17 @@ pub(super) fn straight(run: &[Segment], l: f64) -> bool {
         .collect();
     let mut at = start.clone();
     let (mut head_done, mut angle_done) = (0.0, 0.0);
-    let longest = run.iter().map(|e| head(&e.delta)).fold(0.0f64, f64::max);
+    let longest = run
+        .iter()
+        .map(|e| head_length(&e.delta))
+        .fold(0.0f64, f64::max);
     let tol = match longest > 0.0 && longest <= SHORT_STEP {
         true => STEP_RUN_TOLERANCE,
         false => RUN_TOLERANCE,
     };
     for e in &run[..run.len() - 1] {
         at.iter_mut().zip(&e.delta).for_each(|(a, d)| *a += d);
-        head_done += head(&e.delta);
+        head_done += head_length(&e.delta);
         angle_done += angles(&e.delta);
         let share = if head_total > 0.0 {
             if e.kind != SegmentKind::Translation {
