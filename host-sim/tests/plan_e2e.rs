@@ -287,6 +287,33 @@ fn follow_step_zero_is_the_papers_planner() {
     assert!(sources.iter().all(|w| w.as_str() != Some("follow")));
 }
 
+/// In the maze and the corridor the search's plans bend and unbend the chain round
+/// every wall end and through every door; post-processing flies most of the way in
+/// one compact library shape instead (carrying), with at most half the raw plan's
+/// shape motion (the flight issue's target), and the plan passes the exact verifier.
+#[test]
+fn maze_and_corridor_plans_are_carried_with_half_the_shape_motion() {
+    let dir = tmp();
+    for (scenario, units) in [("maze", 4), ("maze", 6), ("corridor", 5)] {
+        let (plan, _) = plan_verified(scenario, units, dir.path());
+        let refinement = &plan.stats["refinement"];
+        let carried = &refinement["carried"];
+        let shape = carried["shape"].as_str().unwrap_or_else(|| {
+            panic!("{scenario} N={units}: not carried: {refinement}");
+        });
+        let motion = |q: &serde_json::Value| q["shape_motion_rad"].as_f64().expect("motion");
+        let (raw, after) = (
+            motion(&refinement["before"]),
+            motion(&plan.stats["quality"]),
+        );
+        eprintln!(
+            "{scenario} N={units}: carried in {shape} for {:.2} m, shape motion {raw:.2} -> {after:.2} rad",
+            carried["head_path_m"].as_f64().unwrap_or(f64::NAN)
+        );
+        assert!(after <= 0.5 * raw, "{scenario} N={units}: {raw} -> {after}");
+    }
+}
+
 /// Refinement (the default) and `--no-smooth` both give plans the exact verifier
 /// accepts; the refined plan asks no more of the chain than the raw one and records
 /// the raw plan's quality beside its own.
@@ -315,7 +342,9 @@ fn refined_plans_verify_and_ask_less_of_the_chain() {
                 "{scenario}: the refined plan records the raw plan's {key}"
             );
         }
-        assert!(q(&refined, "head_path_m") <= q(&raw, "head_path_m") + 1e-9);
+        // A stretch flown in one shape (carrying, docs/postprocessing.md) may take the
+        // head round a wall end wider, by at most a quarter of its route and 1 m.
+        assert!(q(&refined, "head_path_m") <= 1.25 * q(&raw, "head_path_m") + 1.0);
         assert!(q(&refined, "shape_changes") <= q(&raw, "shape_changes"));
         assert!(
             refined.waypoints.len() < raw.waypoints.len(),

@@ -13,13 +13,14 @@
 //! - [`ArcPlanner`], the paper's ARCplanner (`arc`): a lazy head roadmap
 //!   (`roadmap`, `lattice`) and, per head edge, the cheapest shape that gets the
 //!   chain along it (`construction`, `connect`, `candidates`, `follow`,
-//!   `srs_connect`), then `refine`, `shorten`, `widen` and `thread`;
+//!   `srs_connect`), then `refine`, `shorten`, `carry`, `widen` and `thread`;
 //! - the full-state PRM baseline, [`crate::baseline::FullStatePrm`].
 //!
 //! Both search their roadmaps with the one lazy graph search of `graph`.
 
 pub(crate) mod arc;
 pub(crate) mod candidates;
+mod carry;
 mod checker;
 pub(crate) mod connect;
 pub(crate) mod construction;
@@ -43,6 +44,7 @@ use nalgebra::Point3;
 
 pub use arc::{ArcPlanner, Stats};
 pub use candidates::Source;
+pub use carry::Carried;
 pub(crate) use checker::Checker;
 pub use error::PlanError;
 pub use motion::{annotate_quality, source_label, to_plan};

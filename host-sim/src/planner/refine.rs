@@ -116,6 +116,9 @@ pub struct Refinement {
     pub widening: Widening,
     /// Whether the plan is the search's head route threaded (`super::thread`).
     pub threaded: bool,
+    /// The stretch of the plan flown in one library shape (`super::carry`), if any
+    /// (a threaded plan has none).
+    pub carried: Option<super::carry::Carried>,
     /// Time spent (s).
     pub time_s: f64,
 }
@@ -165,6 +168,14 @@ impl ArcPlanner {
                 chosen = (kept, ctx, Some(first.moves));
             }
         }
+        // The whole way in one library shape, where that moves the angles less.
+        let mut carrier = Checker::new(chosen.1.clone(), deadline);
+        let carried = super::carry::carried(&mut carrier, &self.tables.lsc, &chosen.0);
+        let carried = carried.map(|(steps, carried)| {
+            chosen.0 = steps;
+            chosen.2 = None;
+            carried
+        });
         let (steps, ctx, first_moves) = chosen;
         // Where neither the widened plan was taken nor refinement changed the search's
         // plan, the last widening would repeat the first, move for move.
@@ -191,6 +202,7 @@ impl ArcPlanner {
                 ..last
             },
             threaded,
+            carried: carried.filter(|_| !threaded),
             time_s: began.elapsed().as_secs_f64(),
         };
         (Solution { steps, stats }, report)

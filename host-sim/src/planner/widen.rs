@@ -1,7 +1,7 @@
 //! Widening: post-processing moves the plan's stations (the head positions where it
 //! stops, with every shape change made there) towards the middle of narrow passages,
 //! so that a plan keeps as much clearance through an opening as the opening allows,
-//! not just the margin the search checked at (docs/postprocessing.md, stage 3; it runs
+//! not just the margin the search checked at (docs/postprocessing.md, stage 4; it runs
 //! on the search's plan and again after refinement and shortening).
 //!
 //! The search checks at the preferred clearance (`--clearance`, 0.05 m); through a

@@ -389,5 +389,12 @@ fn print_quality(report: &Report, q: &Quality, refinement: Option<&Refinement>) 
                 "  threaded: the chain follows its head along the route, straightened through the middle of each passage"
             ));
         }
+        if let Some(c) = r.carried {
+            report.line(format_args!(
+                "  carried: the chain flies {:.2} m of head path in one shape ({}), on a route of its own",
+                c.head_path_m,
+                c.kind.name()
+            ));
+        }
     }
 }

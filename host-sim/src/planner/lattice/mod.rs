@@ -55,6 +55,7 @@ mod search;
 mod tests;
 
 pub use crate::collision::exact::exact_clearance;
+pub(in crate::planner) use nodes::KeyHasher;
 pub use regions::Regions;
 
 use super::dist;

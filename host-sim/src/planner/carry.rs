@@ -1,0 +1,528 @@
+//! Carrying: a stretch of the plan flown in one library shape, where that moves the
+//! angles less than the plan does there.
+//!
+//! The search gives every head edge the cheapest shape that passes it, and the later
+//! stages only shorten the changes between those shapes along the search's own head
+//! route. In a maze of bays and U-turns that route hugs wall ends, and the chain
+//! bends and unbends around every one. A compact library shape (the serpentine folded
+//! in the vertical plane, SV, is 1.25 m long and 0.3 m wide at N = 6) may instead fly
+//! the stretch rigidly, on a head route of its own that keeps its body clear of the
+//! bays' walls and the gaps' ends: one change into it, one back (none at the goal).
+//!
+//! Every library shape at eight headings, the start's head yaw held
+//! (`super::shorten`), is a candidate. For each:
+//! 1. **Span.** The first waypoint `i` where the chain can change into it, and the
+//!    last `j` after `i` where it can change back to the plan's shape (or the goal),
+//!    such that flying it from `i` to `j` would move the angles less than the plan
+//!    does there.
+//! 2. **Fit.** Along the plan's head route from `i` to `j` (every 0.3 m, tightest
+//!    first), the chain in that shape must fit with some unit within a map resolution
+//!    of the route: a carried body passes every passage the head passed. Most
+//!    candidates are turned away here, before any search.
+//!
+//! Then, largest saving first, within fixed budgets of placements:
+//!
+//! 3. **Search.** An A* over head positions on a lattice (spacing: twice the map's
+//!    resolution) from `i`'s head to `j`'s, through positions where the chain in that
+//!    shape is clear, and clear half way along the step to them (a step past a corner
+//!    can clip it between two clear positions). It is guided by the plan's route,
+//!    shifted so that the shape's middle follows it, and keeps within 1 m of it.
+//! 4. **Taut.** The lattice path is pulled taut by the planner's translation checks,
+//!    which are what makes the result admissible (the lattice only guides). A path
+//!    more than 25 % (plus 1 m) longer than the route it replaces is refused: a long
+//!    detour costs more flight than the changes it saves.
+//!
+//! The first candidate that passes is taken. Every check counts towards fixed
+//! budgets, not time, so the result is deterministic.
+
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap};
+use std::hash::BuildHasherDefault;
+
+use aerial_chain_core::kinematics::offsets;
+use aerial_chain_core::lsc::{LscEntry, LscKind};
+use aerial_chain_core::Shape;
+use nalgebra::{Point3, Vector3};
+
+use super::candidates::{headings, Source};
+use super::lattice::KeyHasher;
+use super::refine::{shape_motion, Quality};
+use super::{Checker, Step};
+
+/// Plans with fewer shape changes are left as they are: carrying replaces changes by
+/// at most two, and shortening already makes one or two changes as small as they go.
+const MIN_CHANGES: usize = 3;
+
+/// Headings tried per library shape.
+const HEADINGS: usize = 8;
+
+/// Placements a shape's search may check.
+const SEARCH_POINTS: usize = 25_000;
+
+/// Placements all shapes' searches together may check.
+const TOTAL_POINTS: usize = 60_000;
+
+/// The search keeps within this distance (m) of its guide.
+const TUBE: f64 = 1.0;
+
+/// Lattice spacing, in map resolutions.
+const SPACING: f64 = 2.0;
+
+/// Weight of the guide in the search (above 1: fewer points, a path at most that
+/// much longer than the shortest).
+const GREED: f64 = 2.0;
+
+/// The fit is tested at route points at least this far apart (m).
+const FIT_SPACING: f64 = 0.3;
+
+/// How far (map resolutions, each way) the fit test looks around a tight point.
+const FIT_REACH: i32 = 1;
+
+/// Angles closer than this (rad) are the same shape, as in refinement.
+const SAME_SHAPE: f32 = 1e-6;
+
+/// Motion (rad) carrying must save to be taken.
+const SAVING: f64 = 1e-3;
+
+/// A carried plan's head path may be at most this much longer than the plan's (m,
+/// and share): a long detour costs more flight than the shape changes it saves.
+const DETOUR: (f64, f64) = (1.0, 1.25);
+
+/// A stretch of a plan flown in one library shape.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Carried {
+    /// The library shape.
+    pub kind: LscKind,
+    /// Length of the head's path flown in it (m).
+    pub head_path_m: f64,
+}
+
+/// The plan `steps` with a stretch of it flown in one library shape, if that moves
+/// the angles less (see the module docs); checks by `checker`.
+pub(super) fn carried(
+    checker: &mut Checker,
+    library: &[LscEntry],
+    steps: &[Step],
+) -> Option<(Vec<Step>, Carried)> {
+    if Quality::of(steps).shape_changes < MIN_CHANGES {
+        return None;
+    }
+    let start = steps[0].shape;
+    let h = SPACING * checker.ctx.field().grid().resolution();
+    // Shape motion of the plan up to each waypoint.
+    let mut upto = vec![0.0; steps.len()];
+    for k in 1..steps.len() {
+        upto[k] = upto[k - 1] + shape_motion(&steps[k - 1].shape, &steps[k].shape);
+    }
+    // Every shape that could take over somewhere and fits the tight spots there, the
+    // largest saving first; then the searches, in that order, within the budgets.
+    let mut tried: Vec<(f64, usize, usize, Shape, LscKind)> = Vec::new();
+    for (x, kind) in shapes(library, &start) {
+        let Some((i, j, saving)) = span(checker, steps, &upto, &x) else {
+            continue;
+        };
+        let route = head_route(&steps[i..=j]);
+        if fits_along(checker, &route, &x) {
+            tried.push((saving, i, j, x, kind));
+        }
+    }
+    tried.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut spent = 0;
+    for (_, i, j, x, kind) in tried {
+        if spent >= TOTAL_POINTS {
+            break;
+        }
+        let route = head_route(&steps[i..=j]);
+        let guide = Guide::new(&route, middle(checker, &x));
+        let budget = SEARCH_POINTS.min(TOTAL_POINTS - spent);
+        let (path, used) = search(checker, &guide, &x, h, budget);
+        spent += used;
+        let Some(path) = path.and_then(|p| taut(checker, &p, &x)) else {
+            continue;
+        };
+        let length = |p: &[Point3<f64>]| p.windows(2).map(|w| (w[1] - w[0]).norm()).sum::<f64>();
+        let head_path_m = length(&path);
+        if head_path_m > DETOUR.0 + DETOUR.1 * length(&route) {
+            continue;
+        }
+        let carried = Carried { kind, head_path_m };
+        return Some((splice(steps, i, j, &path, x, Source::Lsc(kind)), carried));
+    }
+    None
+}
+
+/// Where shape `x` can take over from the plan: the first waypoint `i` at which the
+/// chain can change into it, and the last `j` after it at which it can change back
+/// to the plan's shape (or the goal), if flying `x` from `i` to `j` would save motion.
+fn span(
+    checker: &mut Checker,
+    steps: &[Step],
+    upto: &[f64],
+    x: &Shape,
+) -> Option<(usize, usize, f64)> {
+    let last = steps.len() - 1;
+    let into = |k: usize| shape_motion(&steps[k].shape, x);
+    let back = |k: usize| {
+        if k == last {
+            0.0
+        } else {
+            shape_motion(x, &steps[k].shape)
+        }
+    };
+    // A change at `i` can only pay where the rest of the plan moves more than it.
+    let i = (0..last).find(|&i| {
+        into(i) + SAVING < upto[last] - upto[i]
+            && checker.placement(steps[i].xi, x)
+            && checker.shape_change(steps[i].xi, &steps[i].shape, x)
+    })?;
+    let j = (i + 1..=last).rev().find(|&j| {
+        into(i) + back(j) + SAVING < upto[j] - upto[i]
+            && checker.placement(steps[j].xi, x)
+            && (j == last || checker.shape_change(steps[j].xi, x, &steps[j].shape))
+    })?;
+    Some((i, j, upto[j] - upto[i] - into(i) - back(j)))
+}
+
+/// The plan with waypoints `i..=j` replaced by: the change into `x` at `i`, the
+/// translations of `path` (from `i`'s head position to `j`'s), and the change back to
+/// the plan's shape at `j` (none at the goal).
+fn splice(
+    steps: &[Step],
+    i: usize,
+    j: usize,
+    path: &[Point3<f64>],
+    x: Shape,
+    source: Source,
+) -> Vec<Step> {
+    let differs = |a: &Shape, b: &Shape| a.max_angle_diff(b) > SAME_SHAPE;
+    let mut out = steps[..=i].to_vec();
+    let step = |xi, shape_change| Step {
+        xi,
+        shape: x,
+        source,
+        shape_change,
+    };
+    if differs(&steps[i].shape, &x) {
+        out.push(step(path[0], true));
+    }
+    out.extend(path[1..].iter().map(|&xi| step(xi, false)));
+    if j + 1 < steps.len() {
+        if differs(&x, &steps[j].shape) {
+            out.push(Step {
+                shape_change: true,
+                ..steps[j]
+            });
+        }
+        out.extend_from_slice(&steps[j + 1..]);
+    }
+    out
+}
+
+/// The head's positions along the plan, without repeats.
+fn head_route(steps: &[Step]) -> Vec<Point3<f64>> {
+    let mut route: Vec<Point3<f64>> = Vec::with_capacity(steps.len());
+    for s in steps {
+        if route.last().is_none_or(|p| (s.xi - p).norm() > 1e-9) {
+            route.push(s.xi);
+        }
+    }
+    route
+}
+
+/// The library's shapes at every heading, the start's head yaw held, least motion
+/// from `start` first (ties keep the library's order), each once.
+fn shapes(library: &[LscEntry], start: &Shape) -> Vec<(Shape, LscKind)> {
+    let mut out: Vec<(f64, Shape, LscKind)> = Vec::new();
+    for e in library {
+        for h in headings(0.0, HEADINGS) {
+            let mut x = e
+                .shape
+                .rotated(aerial_chain_core::angle::diff(e.shape.head_yaw(), h));
+            x.set_head_yaw(start.head_yaw());
+            let same = out.iter().any(|o| o.1.max_angle_diff(&x) <= 1e-5);
+            if !same {
+                out.push((shape_motion(start, &x), x, e.kind));
+            }
+        }
+    }
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    out.into_iter().map(|(_, x, s)| (x, s)).collect()
+}
+
+/// The middle of the shape's bounding box, from the head (m).
+fn middle(checker: &Checker, x: &Shape) -> Vector3<f64> {
+    let p = offsets(checker.ctx.params(), x);
+    let (mut lo, mut hi) = (Vector3::repeat(f64::MAX), Vector3::repeat(f64::MIN));
+    for q in p.iter().take(x.units()) {
+        let q = q.cast::<f64>();
+        lo = lo.inf(&q);
+        hi = hi.sup(&q);
+    }
+    (lo + hi) / 2.0
+}
+
+/// Whether the chain in shape `x` can be at every point of the route, [`FIT_SPACING`]
+/// apart (the tightest, where the head is nearest the map, first): some unit within
+/// a map resolution of the point, the rest of the body clear. A carried chain takes
+/// its body through every passage the route takes its head through; this turns
+/// away, before any search, a shape that is too wide for one.
+fn fits_along(checker: &mut Checker, route: &[Point3<f64>], x: &Shape) -> bool {
+    let r_v = checker.ctx.field().grid().resolution();
+    let mut samples: Vec<(f64, Point3<f64>)> = Vec::new();
+    for w in route.windows(2) {
+        let n = ((w[1] - w[0]).norm() / r_v).ceil().max(1.0) as usize;
+        for k in 0..n {
+            let p = w[0] + (w[1] - w[0]) * (k as f64 / n as f64);
+            samples.push((checker.ctx.clearance(p), p));
+        }
+    }
+    samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let units = offsets(checker.ctx.params(), x);
+    let mut tested: Vec<Point3<f64>> = Vec::new();
+    for &(_, p) in &samples {
+        if tested.iter().any(|t| (t - p).norm() < FIT_SPACING) {
+            continue;
+        }
+        tested.push(p);
+        let fits = units.iter().take(x.units()).any(|u| {
+            let head = p - u.cast::<f64>();
+            lattice_ball(FIT_REACH).any(|d| checker.placement(head + d * r_v, x))
+        });
+        if !fits {
+            return false;
+        }
+    }
+    true
+}
+
+/// Lattice offsets within `r` steps each way, the centre first.
+fn lattice_ball(r: i32) -> impl Iterator<Item = Vector3<f64>> {
+    std::iter::once(Vector3::zeros()).chain((-r..=r).flat_map(move |i| {
+        (-r..=r).flat_map(move |j| {
+            (-r..=r)
+                .filter(move |&k| (i, j, k) != (0, 0, 0))
+                .map(move |k| Vector3::new(i as f64, j as f64, k as f64))
+        })
+    }))
+}
+
+/// The plan's head route with the shape's middle on it: the start and the goal stay
+/// (the head must be there), every point between is shifted by `-centre`.
+struct Guide {
+    points: Vec<Point3<f64>>,
+    /// Length of the guide from each point to its end.
+    rest: Vec<f64>,
+}
+
+impl Guide {
+    fn new(route: &[Point3<f64>], centre: Vector3<f64>) -> Self {
+        let last = route.len() - 1;
+        let points: Vec<Point3<f64>> = route
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| if k == 0 || k == last { p } else { p - centre })
+            .collect();
+        let mut rest = vec![0.0; points.len()];
+        for k in (0..last).rev() {
+            rest[k] = rest[k + 1] + (points[k + 1] - points[k]).norm();
+        }
+        Self { points, rest }
+    }
+
+    fn goal(&self) -> Point3<f64> {
+        self.points[self.points.len() - 1]
+    }
+
+    /// Estimated way left from `p`: to the nearest point of the guide, then along the
+    /// guide to its end; `None` beyond [`TUBE`] from the guide.
+    fn estimate(&self, p: &Point3<f64>) -> Option<f64> {
+        // (distance to the guide, way left from there)
+        let mut best = ((self.goal() - p).norm(), 0.0);
+        for (k, w) in self.points.windows(2).enumerate() {
+            let d = w[1] - w[0];
+            let len2 = d.norm_squared();
+            let t = if len2 > 0.0 {
+                ((p - w[0]).dot(&d) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let near = (w[0] + d * t - p).norm();
+            if near < best.0 {
+                best = (near, self.rest[k + 1] + (1.0 - t) * len2.sqrt());
+            }
+        }
+        (best.0 <= TUBE).then_some(best.0 + best.1)
+    }
+}
+
+/// What the search knows of one lattice point.
+struct Point {
+    /// Cost of the best way found to it (micrometres).
+    g: u64,
+    /// The guide's estimate from it, weighted (micrometres).
+    estimate: u64,
+    /// Where the best way came from.
+    from: [i32; 3],
+    /// Whether the chain is clear there (`None`: not checked yet).
+    clear: Option<bool>,
+    /// Expanded.
+    done: bool,
+}
+
+/// A lattice index packed into one key (21 bits per axis).
+fn pack(k: [i32; 3]) -> u64 {
+    const OFF: i64 = 1 << 20;
+    let f = |v: i32| ((v as i64 + OFF) as u64) & 0x1F_FFFF;
+    (f(k[0]) << 42) | (f(k[1]) << 21) | f(k[2])
+}
+
+/// An A* over head positions `start + h k` (k in Z^3, 26 neighbours) at which the chain
+/// in shape `x` is clear, from the start to a point from which the goal is one
+/// translation away; the path (start and goal included) and the placements checked.
+/// Points are checked when they are reached, not when they are first seen, so the
+/// work follows the search's front rather than its whole frontier.
+fn search(
+    checker: &mut Checker,
+    guide: &Guide,
+    x: &Shape,
+    h: f64,
+    budget: usize,
+) -> (Option<Vec<Point3<f64>>>, usize) {
+    let origin = guide.points[0];
+    let goal = guide.goal();
+    let at = |k: [i32; 3]| origin + Vector3::new(k[0] as f64, k[1] as f64, k[2] as f64) * h;
+    // Costs in micrometres, so that the heap orders integers.
+    let scale = 1e6;
+    let mut points: HashMap<u64, Point, BuildHasherDefault<KeyHasher>> = HashMap::default();
+    let mut open = BinaryHeap::new();
+    let start = Point {
+        g: 0,
+        estimate: 0,
+        from: [0; 3],
+        clear: Some(true),
+        done: false,
+    };
+    points.insert(pack([0; 3]), start);
+    open.push(Reverse((0u64, 0u64, [0i32; 3])));
+    let mut checked = 0;
+    while let Some(Reverse((_, g, k))) = open.pop() {
+        let pt = points.get_mut(&pack(k)).expect("pushed points are known");
+        if pt.done || pt.g < g {
+            continue;
+        }
+        let p = at(k);
+        let from = pt.from;
+        if pt.clear.is_none() {
+            if checked >= budget {
+                return (None, checked);
+            }
+            checked += 1;
+            pt.clear = Some(checker.placement(p, x));
+        }
+        if pt.clear == Some(false) {
+            continue;
+        }
+        if k != [0; 3] {
+            // A step past an obstacle's corner can clip it between two clear points:
+            // half way along it must be clear too (another step may reach the point).
+            checked += 1;
+            if !checker.placement(nalgebra::center(&at(from), &p), x) {
+                pt.g = u64::MAX;
+                continue;
+            }
+        }
+        pt.done = true;
+        if (goal - p).norm() <= 1.5 * h && checker.translation(p, goal, x) {
+            let mut path = vec![goal, p];
+            let mut c = k;
+            while c != [0; 3] {
+                c = points[&pack(c)].from;
+                path.push(at(c));
+            }
+            path.reverse();
+            return (Some(path), checked);
+        }
+        for n in neighbours(k) {
+            let step = ((n[0] - k[0]).abs() + (n[1] - k[1]).abs() + (n[2] - k[2]).abs()) as f64;
+            let cost = g + (step.sqrt() * h * scale) as u64;
+            let pt = points.entry(pack(n)).or_insert_with(|| {
+                let estimate = guide.estimate(&at(n));
+                Point {
+                    g: u64::MAX,
+                    estimate: estimate.map_or(0, |e| (GREED * e * scale) as u64),
+                    from: k,
+                    // Beyond the tube round the guide: left alone, as if blocked.
+                    clear: estimate.is_none().then_some(false),
+                    done: false,
+                }
+            });
+            if pt.done || pt.clear == Some(false) || pt.g <= cost {
+                continue;
+            }
+            pt.g = cost;
+            pt.from = k;
+            open.push(Reverse((cost + pt.estimate, cost, n)));
+        }
+    }
+    (None, checked)
+}
+
+/// The 26 lattice neighbours of `k`.
+fn neighbours(k: [i32; 3]) -> impl Iterator<Item = [i32; 3]> {
+    (-1..=1).flat_map(move |i| {
+        (-1..=1).flat_map(move |j| {
+            (-1..=1)
+                .filter(move |&l| (i, j, l) != (0, 0, 0))
+                .map(move |l| [k[0] + i, k[1] + j, k[2] + l])
+        })
+    })
+}
+
+/// The path pulled taut: from each point, straight to the farthest later one the
+/// chain in shape `x` can translate to; `None` where a step of the path itself fails.
+fn taut(checker: &mut Checker, path: &[Point3<f64>], x: &Shape) -> Option<Vec<Point3<f64>>> {
+    let mut out = vec![path[0]];
+    let mut i = 0;
+    let last = path.len() - 1;
+    while i < last {
+        // Gallop ahead while jumps pass, then bisect between the last pass and the
+        // first failure.
+        let mut good = None;
+        let mut stride = 1;
+        let mut bad = None;
+        while i + stride <= last {
+            if checker.translation(path[i], path[i + stride], x) {
+                good = Some(i + stride);
+                stride *= 2;
+            } else {
+                bad = Some(i + stride);
+                break;
+            }
+        }
+        let mut lo = good?;
+        if good != Some(last) && bad.is_none() {
+            if checker.translation(path[i], path[last], x) {
+                lo = last;
+            } else {
+                bad = Some(last);
+            }
+        }
+        if let Some(mut hi) = bad {
+            while hi - lo > 1 {
+                let mid = (lo + hi) / 2;
+                if checker.translation(path[i], path[mid], x) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+        }
+        out.push(path[lo]);
+        i = lo;
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+#[path = "carry_tests.rs"]
+mod tests;

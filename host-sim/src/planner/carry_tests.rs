@@ -1,0 +1,173 @@
+use std::sync::Arc;
+
+use aerial_chain_core::lsc::library;
+use aerial_chain_core::ChainParams;
+
+use super::*;
+use crate::collision::CollisionContext;
+use crate::map::grid::{Cell, Grid};
+use crate::map::DistanceField;
+
+/// A free box 6 m x 4 m x 3 m at 0.1 m, with a 0.2 m wall across x at x = 3 and a
+/// 0.6 m square window in it centred at y = 2, z = 1.5 (no wall when `wall` is false).
+fn room(wall: bool) -> CollisionContext {
+    let mut g = Grid::new(0.1, [0, 0, 0], [60, 40, 30], Cell::Free, true).unwrap();
+    if wall {
+        g.fill_box([3.01, 0.0, 0.0], [3.19, 4.0, 3.0], Cell::Occupied);
+        g.fill_box([3.01, 1.71, 1.21], [3.19, 2.29, 1.79], Cell::Free);
+    }
+    let field = Arc::new(DistanceField::new(g));
+    CollisionContext::new(field, ChainParams::new(4), 0.05).unwrap()
+}
+
+fn step(x: f64, shape: Shape, shape_change: bool) -> Step {
+    Step {
+        xi: Point3::new(x, 2.0, 1.5),
+        shape,
+        source: Source::Start,
+        shape_change,
+    }
+}
+
+/// A line trailing along -x, its links' yaws turned by `bend` alternately.
+fn wiggle(bend: f32) -> Shape {
+    let mut s = Shape::line(4, 0.0);
+    for k in 0..3 {
+        s.set_link(k, 0.0, if k % 2 == 0 { bend } else { -bend });
+    }
+    s
+}
+
+/// A plan along y = 2, z = 1.5 from x = 2 to x = 5 that bends and unbends three times.
+fn restless_plan() -> Vec<Step> {
+    let line = Shape::line(4, 0.0);
+    let mut steps = vec![step(2.0, line, false)];
+    for (k, x) in [2.5, 3.5, 4.5].into_iter().enumerate() {
+        let bend = 0.2 + 0.1 * k as f32;
+        steps.push(step(x - 0.5, wiggle(bend), true));
+        steps.push(step(x, wiggle(bend), false));
+        steps.push(step(x, line, true));
+        steps.push(step(x + 0.5, line, false));
+    }
+    steps
+}
+
+#[test]
+fn a_restless_plan_in_open_space_is_flown_in_its_start_shape() {
+    let ctx = room(false);
+    let lsc = library(ctx.params()).entries;
+    let mut checker = Checker::new(ctx.clone(), None);
+    let steps = restless_plan();
+    assert!(Quality::of(&steps).shape_changes >= MIN_CHANGES);
+    let (out, carried) = carried(&mut checker, &lsc, &steps).expect("the line flies it all");
+    assert_eq!(carried.kind, LscKind::Li);
+    // No change at all: the line is the start shape, and the goal needs none.
+    assert_eq!(Quality::of(&out).shape_changes, 0);
+    assert_eq!(out[0], steps[0]);
+    assert_eq!(out.last().map(|s| s.xi), steps.last().map(|s| s.xi));
+    // Open space: one straight translation.
+    assert_eq!(out.len(), 2);
+    assert!((carried.head_path_m - 3.0).abs() < 1e-9);
+}
+
+#[test]
+fn a_carried_plan_passes_the_checks_through_a_window() {
+    let ctx = room(true);
+    let lsc = library(ctx.params()).entries;
+    let mut checker = Checker::new(ctx.clone(), None);
+    let steps = restless_plan();
+    let (out, _) = carried(&mut checker, &lsc, &steps).expect("a line passes the window");
+    let before = Quality::of(&steps).shape_motion_rad;
+    assert!(Quality::of(&out).shape_motion_rad + SAVING < before);
+    for w in out.windows(2) {
+        let ok = if w[1].shape_change {
+            assert_eq!(w[0].xi, w[1].xi);
+            ctx.check_shape_change(w[0].xi, &w[0].shape, &w[1].shape)
+        } else {
+            assert_eq!(w[0].shape, w[1].shape);
+            ctx.check_translation(w[0].xi, w[1].xi, &w[1].shape)
+        };
+        assert!(ok.is_ok(), "{w:?}: {ok:?}");
+    }
+}
+
+#[test]
+fn plans_with_few_changes_are_left_alone() {
+    let ctx = room(false);
+    let lsc = library(ctx.params()).entries;
+    let mut checker = Checker::new(ctx, None);
+    let line = Shape::line(4, 0.0);
+    let steps = vec![
+        step(2.0, line, false),
+        step(2.0, wiggle(0.3), true),
+        step(3.0, wiggle(0.3), false),
+        step(3.0, line, true),
+        step(4.0, line, false),
+    ];
+    assert!(carried(&mut checker, &lsc, &steps).is_none());
+}
+
+#[test]
+fn a_shape_across_the_window_does_not_fit_and_one_along_it_does() {
+    let ctx = room(true);
+    let mut checker = Checker::new(ctx, None);
+    let route = [Point3::new(2.0, 2.0, 1.5), Point3::new(4.5, 2.0, 1.5)];
+    // Trailing along -x passes end first; trailing along -y lies across the window.
+    assert!(fits_along(&mut checker, &route, &Shape::line(4, 0.0)));
+    let across = Shape::line(4, std::f32::consts::FRAC_PI_2);
+    assert!(!fits_along(&mut checker, &route, &across));
+}
+
+#[test]
+fn the_guide_estimates_the_way_left_within_its_tube() {
+    let route = [
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(2.0, 0.0, 0.0),
+        Point3::new(2.0, 2.0, 0.0),
+        Point3::new(4.0, 2.0, 0.0),
+    ];
+    // The middle of a shape 0.5 m behind its head along -x.
+    let guide = Guide::new(&route, Vector3::new(-0.5, 0.0, 0.0));
+    // The start and the goal stay; the points between follow the shape's middle.
+    assert_eq!(guide.points[0], route[0]);
+    assert_eq!(guide.points[3], route[3]);
+    assert_eq!(guide.points[1], Point3::new(2.5, 0.0, 0.0));
+    let e = |p: [f64; 3]| guide.estimate(&p.into());
+    assert_eq!(e([4.0, 2.0, 0.0]), Some(0.0));
+    let total = guide.rest[0];
+    assert!((e([0.0, 0.0, 0.0]).unwrap() - total).abs() < 1e-12);
+    // Nearer the goal along the guide, less is left.
+    assert!(e([2.5, 1.0, 0.0]).unwrap() < e([1.0, 0.0, 0.0]).unwrap());
+    // Off to the side by more than the tube: not searched.
+    assert_eq!(e([1.0, -1.5, 0.0]), None);
+    assert!(e([1.0, -0.9, 0.0]).is_some());
+}
+
+#[test]
+fn lattice_keys_are_distinct_around_the_origin() {
+    let mut keys: Vec<u64> = neighbours([0, 0, 0]).map(pack).collect();
+    keys.push(pack([0, 0, 0]));
+    keys.push(pack([-1_000, 2_000, -3_000]));
+    keys.push(pack([1_000, -2_000, 3_000]));
+    let n = keys.len();
+    keys.sort_unstable();
+    keys.dedup();
+    assert_eq!(keys.len(), n);
+}
+
+#[test]
+fn library_shapes_come_once_each_least_motion_first() {
+    let params = ChainParams::new(4);
+    let lsc = library(&params).entries;
+    let start = Shape::line(4, 0.3);
+    let shapes = shapes(&lsc, &start);
+    let motion: Vec<f64> = shapes.iter().map(|s| shape_motion(&start, &s.0)).collect();
+    assert!(motion.windows(2).all(|w| w[0] <= w[1]));
+    assert!(shapes.iter().all(|s| s.0.head_yaw() == start.head_yaw()));
+    for (a, x) in shapes.iter().enumerate() {
+        assert!(shapes[a + 1..]
+            .iter()
+            .all(|y| y.0.max_angle_diff(&x.0) > 1e-5));
+    }
+    assert!(shapes.len() > lsc.len());
+}
