@@ -138,8 +138,9 @@ fn differs(a: &Shape, b: &Shape) -> bool {
 
 impl ArcPlanner {
     /// Refines a solved query's plan (see the module docs), then shortens its shape
-    /// motion (`super::shorten`), both within `CHECK_BUDGET` checks, then widens its
-    /// narrow passages (`super::widen`). The result starts and
+    /// motion (`super::shorten`), both within `CHECK_BUDGET` checks, then flies a
+    /// stretch of it in one library shape where that moves the angles less
+    /// (`super::carry`), then widens its narrow passages (`super::widen`). The result starts and
     /// ends where the solution does and passes the same checks. Past `deadline` (the
     /// query's time limit) refinement stops and keeps what it has; only then can two
     /// runs differ.
@@ -168,14 +169,14 @@ impl ArcPlanner {
                 chosen = (kept, ctx, Some(first.moves));
             }
         }
-        // The whole way in one library shape, where that moves the angles less.
+        // A stretch flown in one library shape, where that moves the angles less.
         let mut carrier = Checker::new(chosen.1.clone(), deadline);
-        let carried = super::carry::carried(&mut carrier, &self.tables.lsc, &chosen.0);
-        let carried = carried.map(|(steps, carried)| {
-            chosen.0 = steps;
-            chosen.2 = None;
-            carried
-        });
+        let carried = super::carry::carried(&mut carrier, &self.tables.lsc, &chosen.0).map(
+            |(steps, carried)| {
+                chosen.0 = steps;
+                carried
+            },
+        );
         let (steps, ctx, first_moves) = chosen;
         // Where neither the widened plan was taken nor refinement changed the search's
         // plan, the last widening would repeat the first, move for move.
