@@ -294,7 +294,7 @@ fn follow_step_zero_is_the_papers_planner() {
 #[test]
 fn maze_and_corridor_plans_are_carried_with_half_the_shape_motion() {
     let dir = tmp();
-    for (scenario, units) in [("maze", 4), ("maze", 6), ("corridor", 5)] {
+    for (scenario, units) in [("maze", 4), ("maze", 6), ("corridor", 5), ("corridor", 6)] {
         let (plan, _) = plan_verified(scenario, units, dir.path());
         let refinement = &plan.stats["refinement"];
         let carried = &refinement["carried"];

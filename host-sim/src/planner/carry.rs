@@ -27,6 +27,8 @@
 //!    shape is clear, and clear half way along the step to them (a step past a corner
 //!    can clip it between two clear positions). It is guided by the plan's route,
 //!    shifted so that the shape's middle follows it, and keeps within 1 m of it.
+//!    Candidates whose search found no way at all on that lattice are searched again
+//!    at the map's resolution, once no candidate got through on the coarse one.
 //! 4. **Taut.** The lattice path is pulled taut by the planner's translation checks,
 //!    which are what makes the result admissible (the lattice only guides). A path
 //!    more than 25 % (plus 1 m) longer than the route it replaces is refused: a long
@@ -60,13 +62,13 @@ const HEADINGS: usize = 8;
 const SEARCH_POINTS: usize = 25_000;
 
 /// Placements all shapes' searches together may check.
-const TOTAL_POINTS: usize = 60_000;
+const TOTAL_POINTS: usize = 80_000;
 
 /// The search keeps within this distance (m) of its guide.
 const TUBE: f64 = 1.0;
 
-/// Lattice spacing, in map resolutions.
-const SPACING: f64 = 2.0;
+/// Lattice spacings tried, in map resolutions: coarse, then fine.
+const SPACINGS: [f64; 2] = [2.0, 1.0];
 
 /// Weight of the guide in the search (above 1: fewer points, a path at most that
 /// much longer than the shortest).
@@ -108,7 +110,6 @@ pub(super) fn carried(
         return None;
     }
     let start = steps[0].shape;
-    let h = SPACING * checker.ctx.field().grid().resolution();
     // Shape motion of the plan up to each waypoint.
     let mut upto = vec![0.0; steps.len()];
     for k in 1..steps.len() {
@@ -127,26 +128,40 @@ pub(super) fn carried(
         }
     }
     tried.sort_by(|a, b| b.0.total_cmp(&a.0));
+    // The coarse lattice first; where it found no way at all (rather than running out
+    // of placements), the fine one may pass a spot the coarse one steps over.
+    let r_v = checker.ctx.field().grid().resolution();
     let mut spent = 0;
-    for (_, i, j, x, kind) in tried {
-        if spent >= TOTAL_POINTS {
-            break;
+    for spacing in SPACINGS {
+        let h = spacing * r_v;
+        let mut closed = Vec::new();
+        for (saving, i, j, x, kind) in tried {
+            let route = head_route(&steps[i..=j]);
+            let guide = Guide::new(&route, middle(checker, &x));
+            let budget = SEARCH_POINTS.min(TOTAL_POINTS.saturating_sub(spent));
+            let (found, used) = search(checker, &guide, &x, h, budget);
+            spent += used;
+            let path = match found {
+                Found::Path(path) => path,
+                Found::Closed => {
+                    closed.push((saving, i, j, x, kind));
+                    continue;
+                }
+                Found::OutOfBudget => continue,
+            };
+            let Some(path) = taut(checker, &path, &x) else {
+                continue;
+            };
+            let length =
+                |p: &[Point3<f64>]| p.windows(2).map(|w| (w[1] - w[0]).norm()).sum::<f64>();
+            let head_path_m = length(&path);
+            if head_path_m > DETOUR.0 + DETOUR.1 * length(&route) {
+                continue;
+            }
+            let carried = Carried { kind, head_path_m };
+            return Some((splice(steps, i, j, &path, x, Source::Lsc(kind)), carried));
         }
-        let route = head_route(&steps[i..=j]);
-        let guide = Guide::new(&route, middle(checker, &x));
-        let budget = SEARCH_POINTS.min(TOTAL_POINTS - spent);
-        let (path, used) = search(checker, &guide, &x, h, budget);
-        spent += used;
-        let Some(path) = path.and_then(|p| taut(checker, &p, &x)) else {
-            continue;
-        };
-        let length = |p: &[Point3<f64>]| p.windows(2).map(|w| (w[1] - w[0]).norm()).sum::<f64>();
-        let head_path_m = length(&path);
-        if head_path_m > DETOUR.0 + DETOUR.1 * length(&route) {
-            continue;
-        }
-        let carried = Carried { kind, head_path_m };
-        return Some((splice(steps, i, j, &path, x, Source::Lsc(kind)), carried));
+        tried = closed;
     }
     None
 }
@@ -355,6 +370,16 @@ impl Guide {
     }
 }
 
+/// How a search ended.
+enum Found {
+    /// A path of lattice points, from the start to the goal.
+    Path(Vec<Point3<f64>>),
+    /// Every lattice point the search could reach was expanded: no way on this lattice.
+    Closed,
+    /// The search ran out of placements.
+    OutOfBudget,
+}
+
 /// What the search knows of one lattice point.
 struct Point {
     /// Cost of the best way found to it (micrometres).
@@ -378,7 +403,8 @@ fn pack(k: [i32; 3]) -> u64 {
 
 /// An A* over head positions `start + h k` (k in Z^3, 26 neighbours) at which the chain
 /// in shape `x` is clear, from the start to a point from which the goal is one
-/// translation away; the path (start and goal included) and the placements checked.
+/// translation away: how it ended (a path includes the start and the goal), and the
+/// placements checked.
 /// Points are checked when they are reached, not when they are first seen, so the
 /// work follows the search's front rather than its whole frontier.
 fn search(
@@ -387,7 +413,7 @@ fn search(
     x: &Shape,
     h: f64,
     budget: usize,
-) -> (Option<Vec<Point3<f64>>>, usize) {
+) -> (Found, usize) {
     let origin = guide.points[0];
     let goal = guide.goal();
     let at = |k: [i32; 3]| origin + Vector3::new(k[0] as f64, k[1] as f64, k[2] as f64) * h;
@@ -414,7 +440,7 @@ fn search(
         let from = pt.from;
         if pt.clear.is_none() {
             if checked >= budget {
-                return (None, checked);
+                return (Found::OutOfBudget, checked);
             }
             checked += 1;
             pt.clear = Some(checker.placement(p, x));
@@ -440,7 +466,7 @@ fn search(
                 path.push(at(c));
             }
             path.reverse();
-            return (Some(path), checked);
+            return (Found::Path(path), checked);
         }
         for n in neighbours(k) {
             let step = ((n[0] - k[0]).abs() + (n[1] - k[1]).abs() + (n[2] - k[2]).abs()) as f64;
@@ -464,7 +490,7 @@ fn search(
             open.push(Reverse((cost + pt.estimate, cost, n)));
         }
     }
-    (None, checked)
+    (Found::Closed, checked)
 }
 
 /// The 26 lattice neighbours of `k`.

@@ -171,3 +171,35 @@ fn library_shapes_come_once_each_least_motion_first() {
     }
     assert!(shapes.len() > lsc.len());
 }
+
+/// A wall at x = 3.0..3.1 with a 0.5 m square hole whose middle (y = 2.05, z = 1.5) is
+/// on the lattice through (2, 1.9, 1.5) at 0.05 m but not at 0.1 m: a unit passes it
+/// only within 5 cm of the middle, at the 0.05 m margin.
+fn slot() -> CollisionContext {
+    let mut g = Grid::new(0.05, [0, 0, 0], [120, 80, 60], Cell::Free, true).unwrap();
+    g.fill_box([3.01, 0.0, 0.0], [3.09, 4.0, 3.0], Cell::Occupied);
+    g.fill_box([3.01, 1.81, 1.26], [3.09, 2.29, 1.74], Cell::Free);
+    let field = Arc::new(DistanceField::new(g));
+    CollisionContext::new(field, ChainParams::new(2), 0.05).unwrap()
+}
+
+#[test]
+fn a_slot_between_coarse_lattice_points_is_closed_there_and_found_on_the_fine_one() {
+    let ctx = slot();
+    let mut checker = Checker::new(ctx.clone(), None);
+    let line = Shape::line(2, 0.0);
+    let route = [Point3::new(2.0, 1.9, 1.5), Point3::new(4.5, 2.05, 1.5)];
+    let guide = Guide::new(&route, Vector3::zeros());
+    let (coarse, _) = search(&mut checker, &guide, &line, 0.1, SEARCH_POINTS);
+    assert!(matches!(coarse, Found::Closed));
+    let (fine, _) = search(&mut checker, &guide, &line, 0.05, SEARCH_POINTS);
+    let Found::Path(path) = fine else {
+        panic!("the fine lattice passes the slot");
+    };
+    assert_eq!(path[0], route[0]);
+    assert_eq!(path[path.len() - 1], route[1]);
+    let path = taut(&mut checker, &path, &line).expect("its steps pass the checks");
+    for w in path.windows(2) {
+        assert!(ctx.check_translation(w[0], w[1], &line).is_ok());
+    }
+}
