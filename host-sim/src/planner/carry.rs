@@ -99,6 +99,17 @@ pub struct Carried {
     pub head_path_m: f64,
 }
 
+/// A candidate: flying shape `x` (library kind `kind`) from waypoint `i` to `j` would
+/// save `saving` rad of shape motion.
+#[derive(Clone, Copy)]
+struct Takeover {
+    saving: f64,
+    i: usize,
+    j: usize,
+    x: Shape,
+    kind: LscKind,
+}
+
 /// The plan `steps` with a stretch of it flown in one library shape, if that moves
 /// the angles less (see the module docs); checks by `checker`.
 pub(super) fn carried(
@@ -109,47 +120,31 @@ pub(super) fn carried(
     if Quality::of(steps).shape_changes < MIN_CHANGES {
         return None;
     }
-    let start = steps[0].shape;
-    // Shape motion of the plan up to each waypoint.
-    let mut upto = vec![0.0; steps.len()];
-    for k in 1..steps.len() {
-        upto[k] = upto[k - 1] + shape_motion(&steps[k - 1].shape, &steps[k].shape);
-    }
-    // Every shape that could take over somewhere and fits the tight spots there, the
-    // largest saving first; then the searches, in that order, within the budgets.
-    let mut tried: Vec<(f64, usize, usize, Shape, LscKind)> = Vec::new();
-    for (x, kind) in shapes(library, &start) {
-        let Some((i, j, saving)) = span(checker, steps, &upto, &x) else {
-            continue;
-        };
-        let route = head_route(&steps[i..=j]);
-        if fits_along(checker, &route, &x) {
-            tried.push((saving, i, j, x, kind));
-        }
-    }
-    tried.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut tried = takeovers(checker, library, steps);
     // The coarse lattice first; where it found no way at all (rather than running out
     // of placements), the fine one may pass a spot the coarse one steps over.
     let r_v = checker.ctx.field().grid().resolution();
     let mut spent = 0;
     for spacing in SPACINGS {
-        let h = spacing * r_v;
         let mut closed = Vec::new();
-        for (saving, i, j, x, kind) in tried {
-            let route = head_route(&steps[i..=j]);
-            let guide = Guide::new(&route, middle(checker, &x));
-            let budget = SEARCH_POINTS.min(TOTAL_POINTS.saturating_sub(spent));
-            let (found, used) = search(checker, &guide, &x, h, budget);
+        for t in tried {
+            if spent >= TOTAL_POINTS {
+                return None;
+            }
+            let route = head_route(&steps[t.i..=t.j]);
+            let guide = Guide::new(&route, middle(checker, &t.x));
+            let budget = SEARCH_POINTS.min(TOTAL_POINTS - spent);
+            let (found, used) = search(checker, &guide, &t.x, spacing * r_v, budget);
             spent += used;
             let path = match found {
                 Found::Path(path) => path,
                 Found::Closed => {
-                    closed.push((saving, i, j, x, kind));
+                    closed.push(t);
                     continue;
                 }
                 Found::OutOfBudget => continue,
             };
-            let Some(path) = taut(checker, &path, &x) else {
+            let Some(path) = taut(checker, &path, &t.x) else {
                 continue;
             };
             let length =
@@ -158,12 +153,44 @@ pub(super) fn carried(
             if head_path_m > DETOUR.0 + DETOUR.1 * length(&route) {
                 continue;
             }
-            let carried = Carried { kind, head_path_m };
-            return Some((splice(steps, i, j, &path, x, Source::Lsc(kind)), carried));
+            let carried = Carried {
+                kind: t.kind,
+                head_path_m,
+            };
+            let source = Source::Lsc(t.kind);
+            return Some((splice(steps, t.i, t.j, &path, t.x, source), carried));
         }
         tried = closed;
     }
     None
+}
+
+/// Every library shape that could take over somewhere in the plan and fits along the
+/// route there, the largest saving first.
+fn takeovers(checker: &mut Checker, library: &[LscEntry], steps: &[Step]) -> Vec<Takeover> {
+    // Shape motion of the plan up to each waypoint.
+    let mut upto = vec![0.0; steps.len()];
+    for k in 1..steps.len() {
+        upto[k] = upto[k - 1] + shape_motion(&steps[k - 1].shape, &steps[k].shape);
+    }
+    let mut out = Vec::new();
+    for (x, kind) in shapes(library, &steps[0].shape) {
+        let Some((i, j, saving)) = span(checker, steps, &upto, &x) else {
+            continue;
+        };
+        if fits_along(checker, &head_route(&steps[i..=j]), &x) {
+            out.push(Takeover {
+                saving,
+                i,
+                j,
+                x,
+                kind,
+            });
+        }
+    }
+    // Stable: equal savings keep the order of `shapes`.
+    out.sort_by(|a, b| b.saving.total_cmp(&a.saving));
+    out
 }
 
 /// Where shape `x` can take over from the plan: the first waypoint `i` at which the
