@@ -70,8 +70,9 @@ const TUBE: f64 = 1.0;
 /// Lattice spacings tried, in map resolutions: coarse, then fine.
 const SPACINGS: [f64; 2] = [2.0, 1.0];
 
-/// Weight of the guide in the search (above 1: fewer points, a path at most that
-/// much longer than the shortest).
+/// Weight of the guide's estimate in the search: above 1, the search heads along the
+/// guide and checks fewer points, for a path that may be longer (the taut pull and
+/// the detour bound deal with that).
 const GREED: f64 = 2.0;
 
 /// The fit is tested at route points at least this far apart (m).
