@@ -47,8 +47,8 @@ use aerial_chain_core::Shape;
 use nalgebra::{Point3, Vector3};
 
 use super::candidates::{headings, Source};
-use super::lattice::KeyHasher;
-use super::refine::{shape_motion, Quality};
+use super::lattice::{offsets26, KeyHasher};
+use super::refine::{differs, shape_motion, Quality};
 use super::{Checker, Step};
 
 /// Plans with fewer shape changes are left as they are: carrying replaces changes by
@@ -77,12 +77,6 @@ const GREED: f64 = 2.0;
 
 /// The fit is tested at route points at least this far apart (m).
 const FIT_SPACING: f64 = 0.3;
-
-/// How far (map resolutions, each way) the fit test looks around a tight point.
-const FIT_REACH: i32 = 1;
-
-/// Angles closer than this (rad) are the same shape, as in refinement.
-const SAME_SHAPE: f32 = 1e-6;
 
 /// Motion (rad) carrying must save to be taken.
 const SAVING: f64 = 1e-3;
@@ -237,7 +231,6 @@ fn splice(
     x: Shape,
     source: Source,
 ) -> Vec<Step> {
-    let differs = |a: &Shape, b: &Shape| a.max_angle_diff(b) > SAME_SHAPE;
     let mut out = steps[..=i].to_vec();
     let step = |xi, shape_change| Step {
         xi,
@@ -305,8 +298,9 @@ fn middle(checker: &Checker, x: &Shape) -> Vector3<f64> {
 }
 
 /// Whether the chain in shape `x` can be at every point of the route, [`FIT_SPACING`]
-/// apart (the tightest, where the head is nearest the map, first): some unit within
-/// a map resolution of the point, the rest of the body clear. A carried chain takes
+/// apart (the tightest, where the head is nearest the map, first): some unit at the
+/// point or one map resolution from it along or across the axes, the rest of the body
+/// clear. A carried chain takes
 /// its body through every passage the route takes its head through; this turns
 /// away, before any search, a shape that is too wide for one.
 fn fits_along(checker: &mut Checker, route: &[Point3<f64>], x: &Shape) -> bool {
@@ -329,24 +323,16 @@ fn fits_along(checker: &mut Checker, route: &[Point3<f64>], x: &Shape) -> bool {
         tested.push(p);
         let fits = units.iter().take(x.units()).any(|u| {
             let head = p - u.cast::<f64>();
-            lattice_ball(FIT_REACH).any(|d| checker.placement(head + d * r_v, x))
+            std::iter::once([0; 3])
+                .chain(offsets26())
+                .map(|o| Vector3::new(o[0] as f64, o[1] as f64, o[2] as f64) * r_v)
+                .any(|d| checker.placement(head + d, x))
         });
         if !fits {
             return false;
         }
     }
     true
-}
-
-/// Lattice offsets within `r` steps each way, the centre first.
-fn lattice_ball(r: i32) -> impl Iterator<Item = Vector3<f64>> {
-    std::iter::once(Vector3::zeros()).chain((-r..=r).flat_map(move |i| {
-        (-r..=r).flat_map(move |j| {
-            (-r..=r)
-                .filter(move |&k| (i, j, k) != (0, 0, 0))
-                .map(move |k| Vector3::new(i as f64, j as f64, k as f64))
-        })
-    }))
 }
 
 /// The plan's head route with the shape's middle on it: the start and the goal stay
@@ -523,13 +509,9 @@ fn search(
 
 /// The 26 lattice neighbours of `k`.
 fn neighbours(k: [i32; 3]) -> impl Iterator<Item = [i32; 3]> {
-    (-1..=1).flat_map(move |i| {
-        (-1..=1).flat_map(move |j| {
-            (-1..=1)
-                .filter(move |&l| (i, j, l) != (0, 0, 0))
-                .map(move |l| [k[0] + i, k[1] + j, k[2] + l])
-        })
-    })
+    offsets26()
+        .into_iter()
+        .map(move |o| [0, 1, 2].map(|a| k[a] + o[a] as i32))
 }
 
 /// The path pulled taut: from each point, straight to the farthest later one the

@@ -80,6 +80,17 @@ fn a_carried_plan_passes_the_checks_through_a_window() {
     assert_carried_plan_holds(&ctx, &steps, &out);
 }
 
+/// Whether the edge from `w[0]` to `w[1]` (a shape change or a translation) passes
+/// the planner's checks.
+fn edge_passes(ctx: &CollisionContext, w: &[Step]) -> bool {
+    if w[1].shape_change {
+        ctx.check_shape_change(w[0].xi, &w[0].shape, &w[1].shape)
+            .is_ok()
+    } else {
+        ctx.check_translation(w[0].xi, w[1].xi, &w[1].shape).is_ok()
+    }
+}
+
 /// Checks what every carried plan must be, by the planner's checks: the start and the
 /// goal kept, each edge a shape change in place or a translation in one shape that
 /// passes, and less shape motion than the plan it replaces.
@@ -87,14 +98,12 @@ fn assert_carried_plan_holds(ctx: &CollisionContext, steps: &[Step], out: &[Step
     assert_eq!(out[0], steps[0]);
     assert_eq!(out.last().map(|s| s.xi), steps.last().map(|s| s.xi));
     for w in out.windows(2) {
-        let ok = if w[1].shape_change {
+        if w[1].shape_change {
             assert_eq!(w[0].xi, w[1].xi);
-            ctx.check_shape_change(w[0].xi, &w[0].shape, &w[1].shape)
         } else {
             assert_eq!(w[0].shape, w[1].shape);
-            ctx.check_translation(w[0].xi, w[1].xi, &w[1].shape)
-        };
-        assert!(ok.is_ok(), "{w:?}: {ok:?}");
+        }
+        assert!(edge_passes(ctx, w), "{w:?}");
     }
     let motion = |s: &[Step]| Quality::of(s).shape_motion_rad;
     assert!(motion(out) + SAVING < motion(steps));
@@ -146,13 +155,7 @@ proptest::proptest! {
         before.sort_by(|a, b| a.0.total_cmp(&b.0));
         after.sort_by(|a, b| a.0.total_cmp(&b.0));
         let steps = bent_plan(y, &before, &after);
-        let valid = steps.windows(2).all(|w| {
-            if w[1].shape_change {
-                ctx.check_shape_change(w[0].xi, &w[0].shape, &w[1].shape).is_ok()
-            } else {
-                ctx.check_translation(w[0].xi, w[1].xi, &w[1].shape).is_ok()
-            }
-        });
+        let valid = steps.windows(2).all(|w| edge_passes(&ctx, w));
         proptest::prop_assume!(valid);
         let lsc = library(ctx.params()).entries;
         let mut checker = Checker::new(ctx.clone(), None);

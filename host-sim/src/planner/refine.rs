@@ -132,7 +132,7 @@ pub fn shape_motion(a: &Shape, b: &Shape) -> f64 {
         .sum()
 }
 
-fn differs(a: &Shape, b: &Shape) -> bool {
+pub(super) fn differs(a: &Shape, b: &Shape) -> bool {
     a.max_angle_diff(b) > SAME_SHAPE
 }
 

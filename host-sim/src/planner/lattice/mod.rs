@@ -57,6 +57,7 @@ mod tests;
 pub use crate::collision::exact::exact_clearance;
 pub(in crate::planner) use nodes::KeyHasher;
 pub use regions::Regions;
+pub(in crate::planner) use search::offsets26;
 
 use super::dist;
 use crate::collision::{CollisionContext, FK_TOLERANCE};

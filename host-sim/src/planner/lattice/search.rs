@@ -57,7 +57,7 @@ impl PartialOrd for Open {
 }
 
 /// The 26 neighbour offsets.
-pub(super) fn offsets26() -> [[i64; 3]; 26] {
+pub(in crate::planner) fn offsets26() -> [[i64; 3]; 26] {
     let mut o = [[0i64; 3]; 26];
     let mut n = 0;
     for dz in -1..=1 {
