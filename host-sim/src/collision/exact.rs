@@ -12,6 +12,7 @@ use super::OutOfBounds;
 use crate::map::blocks::BLOCK;
 use crate::map::distance::DistanceField;
 use crate::map::grid::Grid;
+use crate::map::row_gaps::FAR;
 
 /// Distance from point `p` to the closed box `lo..hi`.
 pub fn point_box_distance(p: Point3<f64>, lo: Point3<f64>, hi: Point3<f64>) -> f64 {
@@ -386,8 +387,10 @@ pub fn check_config_exact(
 
 /// The exact distance from `p` to the nearest obstacle voxel cube of the field's grid,
 /// when it is above `stop` and below `cap`; otherwise some value `<= stop` (the first
-/// cube found within `stop`) or `>= cap`. The voxels are visited in rings around the
-/// one holding `p`, nearest first, so a blocked point is settled after a few.
+/// cube found within `stop`) or `>= cap`. The grid's rows along x are visited in rings
+/// around the one holding `p`, nearest first, so a blocked point is settled after a
+/// few; of each row only the obstacle voxels nearest `p` on either side are measured
+/// (`crate::map::row_gaps`), one lookup finding them.
 pub fn exact_clearance(
     field: &DistanceField,
     p: impl Into<Point3<f64>>,
@@ -402,36 +405,41 @@ pub fn exact_clearance(
     let half = Vector3::repeat(r / 2.0);
     let mut best = cap;
     for k in 0..=rings {
-        // Every cube of ring k is at least (k - 1) r away.
+        // Every cube of a row in ring k is at least (k - 1) r away.
         if (k - 1) as f64 * r >= best {
             break;
         }
         for dz in -k..=k {
-            for dy in -k..=k {
-                // On the ring's faces in z or y every x belongs to the ring; inside
-                // them only its two x faces do (the shell, not the whole cube).
-                let face = dz.abs() == k || dy.abs() == k;
-                let step = if face { 1 } else { (2 * k).max(1) };
-                // The row is looked up once; its voxels are then read directly.
-                let row = g.raw_row(c0[1] + dy, c0[2] + dz);
-                for dx in (-k..=k).step_by(step as usize) {
-                    let i = [c0[0] + dx, c0[1] + dy, c0[2] + dz];
-                    let raw = row.and_then(|(cells, x0)| {
-                        usize::try_from(i[0] - x0)
-                            .ok()
-                            .and_then(|x| cells.get(x).copied())
-                    });
-                    if !g.is_obstacle_raw(raw) {
+            // On the ring's faces in z every y belongs to the ring; inside them only
+            // its two y faces do.
+            let step = if dz.abs() == k { 1 } else { (2 * k).max(1) };
+            for dy in (-k..=k).step_by(step as usize) {
+                let (y, z) = (c0[1] + dy, c0[2] + dz);
+                let row = g.raw_row(y, z);
+                let candidates = row_candidates(field, [c0[0], y, z], row);
+                if let Candidates::Beyond(gap) = candidates {
+                    if gap as f64 * r >= best {
                         continue;
                     }
-                    let c = g.voxel_center(i);
-                    let d = point_box_distance(p, c - half, c + half);
-                    if d < best {
-                        best = d;
-                        if d <= stop {
-                            return d;
-                        }
+                }
+                let mut measure = |x: i32| {
+                    let raw = row.and_then(|(cells, x0)| {
+                        usize::try_from(x - x0)
+                            .ok()
+                            .and_then(|i| cells.get(i).copied())
+                    });
+                    if g.is_obstacle_raw(raw) {
+                        let c = g.voxel_center([x, y, z]);
+                        best = best.min(point_box_distance(p, c - half, c + half));
                     }
+                    best <= stop
+                };
+                let found = match candidates {
+                    Candidates::Two(a, b) => measure(a) || measure(b),
+                    Candidates::Beyond(_) => (-rings..=rings).any(|dx| measure(c0[0] + dx)),
+                };
+                if found {
+                    return best;
                 }
             }
         }
@@ -439,10 +447,58 @@ pub fn exact_clearance(
     best
 }
 
+/// Where the obstacle cubes of a row nearest a point across from lattice voxel `c`
+/// can be.
+enum Candidates {
+    /// At these lattice x (each may be free: then the row has none).
+    Two(i32, i32),
+    /// Farther along x than this many voxels (the row's gaps saturate): read the row.
+    Beyond(u8),
+}
+
+/// The candidates of lattice voxel `c`'s row, `row` (from [`Grid::raw_row`], `None`
+/// outside the grid).
+fn row_candidates(field: &DistanceField, c: [i32; 3], row: Option<(&[u8], i32)>) -> Candidates {
+    let g = field.grid();
+    let (Some((cells, x0)), Some(l)) = (row, g.local([g.origin()[0], c[1], c[2]])) else {
+        // Outside the grid every voxel is unknown: the one across from `p` is the
+        // nearest obstacle, if unknown space is one.
+        return Candidates::Two(c[0], c[0]);
+    };
+    let last = x0 + cells.len() as i32 - 1;
+    if (c[0] < x0 || c[0] > last) && g.unknown_is_occupied() {
+        return Candidates::Two(c[0], c[0]);
+    }
+    // Off the row's ends with unknown space free, the row's nearest obstacle to `p`
+    // is the one nearest its end.
+    let x = c[0].clamp(x0, last);
+    let n = field.row_gap([(x - x0) as usize, l[1], l[2]]);
+    if n == FAR {
+        // A cube 255 voxels along or more is at least 254 voxels away along x.
+        Candidates::Beyond(FAR - 1)
+    } else {
+        Candidates::Two(x - n as i32, x + n as i32)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn exact_clearance_reads_rows_whose_gaps_saturate() {
+        use crate::map::grid::Cell;
+        // A row longer than the gaps' 255 voxels: the obstacle 290 voxels away is
+        // found by reading the row.
+        let mut g = Grid::new(0.01, [0, 0, 0], [300, 1, 1], Cell::Free, false).unwrap();
+        g.set([0, 0, 0], Cell::Occupied);
+        let field = DistanceField::new(g);
+        let p = Point3::new(2.905, 0.005, 0.005);
+        assert!((exact_clearance(&field, p, 0.0, 3.0) - 2.895).abs() < 1e-9);
+        // Within a cap below the saturated gap, it is not looked for.
+        assert_eq!(exact_clearance(&field, p, 0.0, 2.0), 2.0);
+    }
 
     #[test]
     fn box_distances_by_hand() {

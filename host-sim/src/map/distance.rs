@@ -335,6 +335,9 @@ pub struct DistanceField {
     grid: Grid,
     /// `r G(n)` per voxel (m), rounded down; `f32::INFINITY` when there is no obstacle.
     lb: Vec<f32>,
+    /// Per voxel, how far along its row the nearest obstacle voxel lies
+    /// ([`super::row_gaps`]): for exact distances.
+    row_gaps: Vec<u8>,
 }
 
 impl DistanceField {
@@ -352,7 +355,8 @@ impl DistanceField {
                 }
             })
             .collect();
-        DistanceField { grid, lb }
+        let row_gaps = super::row_gaps::row_gaps(&grid);
+        DistanceField { grid, lb, row_gaps }
     }
 
     /// The grid the field was built from.
@@ -486,9 +490,17 @@ impl DistanceField {
         &self.lb[start..start + self.grid.dims()[0]]
     }
 
+    /// How many voxels along its row the nearest obstacle voxel of grid-local voxel
+    /// `l` lies, either way ([`super::row_gaps`]; [`super::row_gaps::FAR`]: that many
+    /// or more, or none).
+    #[inline]
+    pub(crate) fn row_gap(&self, l: [usize; 3]) -> u8 {
+        self.row_gaps[self.grid.linear(l)]
+    }
+
     /// Bytes held by the grid and the field.
     pub fn memory_bytes(&self) -> usize {
-        self.lb.len() * 4 + self.grid.dims().iter().product::<usize>()
+        self.lb.len() * 4 + self.row_gaps.len() + self.grid.dims().iter().product::<usize>()
     }
 }
 

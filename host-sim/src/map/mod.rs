@@ -3,6 +3,7 @@ pub(crate) mod blocks;
 pub(crate) mod distance;
 pub(crate) mod grid;
 pub(crate) mod octomap;
+pub(crate) mod row_gaps;
 
 pub use distance::DistanceField;
 pub use grid::{Cell, Grid, GridError};

@@ -26,6 +26,7 @@ use std::time::Instant;
 
 use aerial_chain_core::angle;
 use aerial_chain_core::cost::transition_cost;
+use aerial_chain_core::lsc::LscEntry;
 use aerial_chain_core::Shape;
 
 use super::candidates::Source;
@@ -150,34 +151,30 @@ impl ArcPlanner {
         deadline: Option<Instant>,
     ) -> (Solution<Stats>, Refinement) {
         let began = Instant::now();
-        // As before widening existed: shortcuts and smaller shape changes at the
-        // search's margin.
-        let (steps, mut checks) = self.shortcut(&self.ctx, &solution.steps, deadline);
-        // The steps, their context, and the first widening's moves when its plan is taken.
-        let mut chosen = (steps, self.ctx.clone(), None);
-        // Widen the search's plan first, where it has the most stations to move; then
-        // refine and shorten without giving back what that won (`keep_margin`). The
-        // result is taken unless it asks for more shape motion (where a narrow door
-        // keeps the margin up, fewer shortcuts may pass).
-        let (widened, first) =
-            super::widen::widen(&self.ctx, &self.ctx_min, solution.steps.clone());
-        if let Some(ctx) = self.keep_margin(first.in_passages) {
-            let (kept, spent) = self.shortcut(&ctx, &widened, deadline);
-            checks += spent;
-            let motion = |s: &[Step]| Quality::of(s).shape_motion_rad;
-            if motion(&kept) <= motion(&chosen.0) * KEEP_MOTION + 1e-9 {
-                chosen = (kept, ctx, Some(first.moves));
-            }
-        }
-        // A stretch flown in one library shape, where that moves the angles less.
-        let mut carrier = Checker::new(chosen.1.clone(), deadline);
-        let carried = super::carry::carried(&mut carrier, &self.tables.lsc, &chosen.0).map(
-            |(steps, carried)| {
-                chosen.0 = steps;
-                carried
-            },
+        let raw = &solution.steps;
+        let post = Post {
+            ctx: &self.ctx,
+            ctx_min: &self.ctx_min,
+            lsc: &self.tables.lsc,
+            follow_step: self.settings.follow_step,
+        };
+        // Threading depends on the search's plan alone until it is compared with the
+        // other stages' result, so it is made beside them (rayon: on another core
+        // where one is free). Made whether or not it will be compared: the result is
+        // the same, and the wait is shorter.
+        let (chosen, threading) = rayon::join(
+            || post.refined_and_carried(raw, deadline),
+            || post.threading(raw, deadline),
         );
-        let (steps, ctx, first_moves) = chosen;
+        let Chosen {
+            steps,
+            ctx,
+            first_moves,
+            widened,
+            first,
+            carried,
+            checks,
+        } = chosen;
         // Where neither the widened plan was taken nor refinement changed the search's
         // plan, the last widening would repeat the first, move for move.
         let (steps, last) = if first_moves.is_none() && steps == solution.steps {
@@ -185,8 +182,7 @@ impl ArcPlanner {
         } else {
             super::widen::widen(&ctx, &self.ctx_min, steps)
         };
-        let (steps, last, threaded) =
-            self.threaded_if_better(&solution.steps, steps, last, deadline);
+        let (steps, last, threaded) = post.threaded_if_better(threading, steps, last);
         let mut stats = solution.stats.clone();
         super::construction::count_sources(&steps, &mut stats);
         let report = Refinement {
@@ -208,7 +204,18 @@ impl ArcPlanner {
         };
         (Solution { steps, stats }, report)
     }
+}
 
+/// What post-processing reads of the planner (which itself is not shared between
+/// threads): the contexts it checks in, the library shapes, the follow step.
+struct Post<'a> {
+    ctx: &'a CollisionContext,
+    ctx_min: &'a CollisionContext,
+    lsc: &'a [LscEntry],
+    follow_step: f64,
+}
+
+impl Post<'_> {
     /// Refinement's shortcuts and smaller changes, then shortening, over `poses`, with
     /// the checks of `ctx`; the steps and the checks spent.
     fn shortcut(
@@ -228,31 +235,87 @@ impl ArcPlanner {
         (steps, pass.checks)
     }
 
-    /// The search's head route threaded (`super::thread`), where `steps` passes some
-    /// pinch of the route off its middle (below the share widening aims for) and the
-    /// threaded plan passes every pinch nearer its middle ([`THREAD_GAIN`],
-    /// [`THREAD_SHARE`]) for little more shape motion ([`THREAD_MOTION`]). Whether
-    /// the threaded plan was taken is the last of the three.
+    /// Refinement's shortcuts at the search's margin, beside widening the search's
+    /// plan first (where it has the most stations to move) and then refining and
+    /// shortening it without giving back what that won (`keep_margin`); the widened
+    /// result is taken unless it asks for more shape motion (where a narrow door keeps
+    /// the margin up, fewer shortcuts may pass). Then a stretch flown in one library
+    /// shape, where that moves the angles less (`super::carry`).
+    fn refined_and_carried(&self, raw: &[Step], deadline: Option<Instant>) -> Chosen {
+        let ((plain, mut checks), (widened, first, kept)) = rayon::join(
+            || self.shortcut(self.ctx, raw, deadline),
+            || {
+                let (widened, first) = super::widen::widen(self.ctx, self.ctx_min, raw.to_vec());
+                let kept = self.keep_margin(first.in_passages).map(|ctx| {
+                    let (steps, spent) = self.shortcut(&ctx, &widened, deadline);
+                    (steps, spent, ctx)
+                });
+                (widened, first, kept)
+            },
+        );
+        let mut chosen = (plain, self.ctx.clone(), None);
+        if let Some((kept, spent, ctx)) = kept {
+            checks += spent;
+            let motion = |s: &[Step]| Quality::of(s).shape_motion_rad;
+            if motion(&kept) <= motion(&chosen.0) * KEEP_MOTION + 1e-9 {
+                chosen = (kept, ctx, Some(first.moves));
+            }
+        }
+        let mut carrier = Checker::new(chosen.1.clone(), deadline);
+        let carried =
+            super::carry::carried(&mut carrier, self.lsc, &chosen.0).map(|(steps, carried)| {
+                chosen.0 = steps;
+                carried
+            });
+        let (steps, ctx, first_moves) = chosen;
+        Chosen {
+            steps,
+            ctx,
+            first_moves,
+            widened,
+            first,
+            carried,
+            checks,
+        }
+    }
+
+    /// The search's head route threaded (`super::thread`) and how the threaded plan
+    /// passes the route's pinches; `None` where the route has no pinch or the chain
+    /// cannot follow it.
+    fn threading(&self, raw: &[Step], deadline: Option<Instant>) -> Option<Threaded> {
+        let threading = super::thread::Threading::of(self.ctx, raw)?;
+        let (steps, _) = threading.follow(self.ctx, &raw[0], self.follow_step, deadline)?;
+        let passing = threading.measure(self.ctx, &steps, true);
+        Some(Threaded {
+            threading,
+            steps,
+            passing,
+        })
+    }
+
+    /// The threaded plan, where `steps` passes some pinch of the route off its middle
+    /// (below the share widening aims for) and the threaded plan passes every pinch
+    /// nearer its middle ([`THREAD_GAIN`], [`THREAD_SHARE`]) for little more shape
+    /// motion ([`THREAD_MOTION`]); else `steps`. Whether the threaded plan was taken
+    /// is the last of the three.
     fn threaded_if_better(
         &self,
-        raw: &[Step],
+        threaded: Option<Threaded>,
         steps: Vec<Step>,
         widening: Widening,
-        deadline: Option<Instant>,
     ) -> (Vec<Step>, Widening, bool) {
-        let Some(threading) = super::thread::Threading::of(&self.ctx, raw) else {
-            return (steps, widening, false);
-        };
-        let share = threading.measure(&self.ctx, &steps, false).share;
-        if share >= super::widen::CENTRED {
-            return (steps, widening, false);
-        }
-        let Some((t, _)) =
-            threading.follow(&self.ctx, &raw[0], self.settings.follow_step, deadline)
+        let Some(Threaded {
+            threading,
+            steps: t,
+            passing,
+        }) = threaded
         else {
             return (steps, widening, false);
         };
-        let passing = threading.measure(&self.ctx, &t, true);
+        let share = threading.measure(self.ctx, &steps, false).share;
+        if share >= super::widen::CENTRED {
+            return (steps, widening, false);
+        }
         let links = self.ctx.params().links() as f64;
         let motion = |s: &[Step]| Quality::of(s).shape_motion_rad;
         let affordable = motion(&t) <= motion(&steps) + links * THREAD_MOTION;
@@ -286,6 +349,29 @@ impl ArcPlanner {
         c.set_min_step(self.ctx.min_step());
         Some(c)
     }
+}
+
+/// The other stages' result, before the last widening: the steps and the context
+/// they were checked in, with what led to them.
+struct Chosen {
+    steps: Vec<Step>,
+    ctx: CollisionContext,
+    /// The first widening's moves, when its plan was taken.
+    first_moves: Option<usize>,
+    /// The search's plan widened, and what that did.
+    widened: Vec<Step>,
+    first: Widening,
+    carried: Option<super::carry::Carried>,
+    /// Collision checks the shortcuts spent.
+    checks: u64,
+}
+
+/// The search's head route threaded (`super::thread`): the route, the plan that
+/// follows it, and how that plan passes the route's pinches.
+struct Threaded {
+    threading: super::thread::Threading,
+    steps: Vec<Step>,
+    passing: super::thread::Passing,
 }
 
 /// One refinement pass over a plan's poses.
