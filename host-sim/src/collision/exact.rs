@@ -404,6 +404,13 @@ pub fn exact_clearance(
     let rings = (cap / r).ceil() as i32 + 1;
     let half = Vector3::repeat(r / 2.0);
     let mut best = cap;
+    // How far `v` lies from the slab of voxels `i` along axis `a`, as
+    // `point_box_distance` measures it (so that a row skipped by it holds no cube
+    // nearer than `best`, to the bit).
+    let slab = |a: usize, i: i32| {
+        let c = (i as f64 + 0.5) * r;
+        ((c - r / 2.0) - p[a]).max(p[a] - (c + r / 2.0)).max(0.0)
+    };
     for k in 0..=rings {
         // Every cube of a row in ring k is at least (k - 1) r away.
         if (k - 1) as f64 * r >= best {
@@ -413,8 +420,13 @@ pub fn exact_clearance(
             // On the ring's faces in z every y belongs to the ring; inside them only
             // its two y faces do.
             let step = if dz.abs() == k { 1 } else { (2 * k).max(1) };
+            let gz = slab(2, c0[2] + dz);
             for dy in (-k..=k).step_by(step as usize) {
                 let (y, z) = (c0[1] + dy, c0[2] + dz);
+                let gy = slab(1, y);
+                if (gy * gy + gz * gz).sqrt() >= best {
+                    continue;
+                }
                 let row = g.raw_row(y, z);
                 let candidates = row_candidates(field, [c0[0], y, z], row);
                 if let Candidates::Beyond(gap) = candidates {
