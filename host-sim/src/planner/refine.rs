@@ -166,21 +166,13 @@ impl ArcPlanner {
             || post.refined_and_carried(raw, deadline),
             || post.threading(raw, deadline),
         );
-        let Chosen {
-            steps,
-            ctx,
-            first_moves,
-            widened,
-            first,
-            carried,
-            checks,
-        } = chosen;
+        let first = chosen.first;
         // Where neither the widened plan was taken nor refinement changed the search's
         // plan, the last widening would repeat the first, move for move.
-        let (steps, last) = if first_moves.is_none() && steps == solution.steps {
-            (widened, first)
+        let (steps, last) = if chosen.first_moves.is_none() && chosen.steps == solution.steps {
+            (chosen.widened, first)
         } else {
-            super::widen::widen(&ctx, &self.ctx_min, steps)
+            super::widen::widen(&chosen.ctx, &self.ctx_min, chosen.steps)
         };
         let (steps, last, threaded) = post.threaded_if_better(threading, steps, last);
         let mut stats = solution.stats.clone();
@@ -188,18 +180,18 @@ impl ArcPlanner {
         let report = Refinement {
             before: Quality::of(&solution.steps),
             after: Quality::of(&steps),
-            checks,
+            checks: chosen.checks,
             widening: Widening {
                 before: first.before,
                 moves: if threaded {
                     last.moves
                 } else {
-                    first_moves.unwrap_or(0) + last.moves
+                    chosen.first_moves.unwrap_or(0) + last.moves
                 },
                 ..last
             },
             threaded,
-            carried: carried.filter(|_| !threaded),
+            carried: chosen.carried.filter(|_| !threaded),
             time_s: began.elapsed().as_secs_f64(),
         };
         (Solution { steps, stats }, report)
