@@ -403,6 +403,8 @@ pub fn exact_clearance(
     let c0 = g.lattice_index(p);
     let rings = (cap / r).ceil() as i32 + 1;
     let half = Vector3::repeat(r / 2.0);
+    // Lattice x of every row's first voxel.
+    let x0 = g.origin()[0];
     let mut best = cap;
     // How far `v` lies from the slab of voxels `i` along axis `a`, as
     // `point_box_distance` measures it (so that a row skipped by it holds no cube
@@ -427,15 +429,18 @@ pub fn exact_clearance(
                 if (gy * gy + gz * gz).sqrt() >= best {
                     continue;
                 }
-                let row = g.raw_row(y, z);
-                let candidates = row_candidates(field, [c0[0], y, z], row);
+                // The row's raw states and gaps; `None` outside the grid.
+                let row = g
+                    .row_start(y, z)
+                    .map(|start| (g.raw_row_at(start), field.row_gaps_at(start)));
+                let candidates = row_candidates(g, c0[0], row);
                 if let Candidates::Beyond(gap) = candidates {
                     if gap as f64 * r >= best {
                         continue;
                     }
                 }
                 let mut measure = |x: i32| {
-                    let raw = row.and_then(|(cells, x0)| {
+                    let raw = row.and_then(|(cells, _)| {
                         usize::try_from(x - x0)
                             .ok()
                             .and_then(|i| cells.get(i).copied())
@@ -459,8 +464,7 @@ pub fn exact_clearance(
     best
 }
 
-/// Where the obstacle cubes of a row nearest a point across from lattice voxel `c`
-/// can be.
+/// Where the obstacle cubes of a row nearest a point in lattice column `x` can be.
 enum Candidates {
     /// At these lattice x (each may be free: then the row has none).
     Two(i32, i32),
@@ -468,23 +472,23 @@ enum Candidates {
     Beyond(u8),
 }
 
-/// The candidates of lattice voxel `c`'s row, `row` (from [`Grid::raw_row`], `None`
-/// outside the grid).
-fn row_candidates(field: &DistanceField, c: [i32; 3], row: Option<(&[u8], i32)>) -> Candidates {
-    let g = field.grid();
-    let (Some((cells, x0)), Some(l)) = (row, g.local([g.origin()[0], c[1], c[2]])) else {
-        // Outside the grid every voxel is unknown: the one across from `p` is the
-        // nearest obstacle, if unknown space is one.
-        return Candidates::Two(c[0], c[0]);
+/// The candidates of a row of grid `g`, given as its raw states and gaps
+/// ([`Grid::raw_row_at`], [`DistanceField::row_gaps_at`]; `None` outside the grid),
+/// for a point in lattice column `x`.
+fn row_candidates(g: &Grid, x: i32, row: Option<(&[u8], &[u8])>) -> Candidates {
+    let Some((cells, gaps)) = row else {
+        // Outside the grid every voxel is unknown: the one across from the point is
+        // the nearest obstacle, if unknown space is one.
+        return Candidates::Two(x, x);
     };
-    let last = x0 + cells.len() as i32 - 1;
-    if (c[0] < x0 || c[0] > last) && g.unknown_is_occupied() {
-        return Candidates::Two(c[0], c[0]);
+    let (first, last) = (g.origin()[0], g.origin()[0] + cells.len() as i32 - 1);
+    if (x < first || x > last) && g.unknown_is_occupied() {
+        return Candidates::Two(x, x);
     }
-    // Off the row's ends with unknown space free, the row's nearest obstacle to `p`
-    // is the one nearest its end.
-    let x = c[0].clamp(x0, last);
-    let n = field.row_gap([(x - x0) as usize, l[1], l[2]]);
+    // Off the row's ends with unknown space free, the row's nearest obstacle to the
+    // point is the one nearest its end.
+    let x = x.clamp(first, last);
+    let n = gaps[(x - first) as usize];
     if n == FAR {
         // A cube 255 voxels along or more is at least 254 voxels away along x.
         Candidates::Beyond(FAR - 1)

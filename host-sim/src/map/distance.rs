@@ -490,12 +490,12 @@ impl DistanceField {
         &self.lb[start..start + self.grid.dims()[0]]
     }
 
-    /// How many voxels along its row the nearest obstacle voxel of grid-local voxel
-    /// `l` lies, either way ([`super::row_gaps`]; [`super::row_gaps::FAR`]: that many
-    /// or more, or none).
+    /// For each voxel of the row starting at `start` ([`Grid::row_start`]), how many
+    /// voxels along the row its nearest obstacle voxel lies, either way
+    /// ([`super::row_gaps`]; [`super::row_gaps::FAR`]: that many or more, or none).
     #[inline]
-    pub(crate) fn row_gap(&self, l: [usize; 3]) -> u8 {
-        self.row_gaps[self.grid.linear(l)]
+    pub(crate) fn row_gaps_at(&self, start: usize) -> &[u8] {
+        &self.row_gaps[start..start + self.grid.dims()[0]]
     }
 
     /// Bytes held by the grid and the field.

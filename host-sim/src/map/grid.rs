@@ -369,18 +369,23 @@ impl Grid {
         self.is_obstacle(self.lattice_index(p))
     }
 
-    /// The raw states of the row of lattice voxels `(y, z)` and the lattice x of its
-    /// first voxel; `None` when the row lies outside the grid (all unknown). Read with
-    /// [`Self::is_obstacle_raw`].
+    /// Where the row of lattice voxels `(y, z)` starts in the grid's layout (x
+    /// fastest, as [`Self::linear`]); `None` when the row lies outside the grid (all
+    /// unknown). Its first voxel is at lattice x `origin()[0]`.
     #[inline]
-    pub(crate) fn raw_row(&self, y: i32, z: i32) -> Option<(&[u8], i32)> {
-        let l = self.local([self.origin[0], y, z])?;
-        let start = self.linear(l);
-        Some((&self.cells[start..start + self.dims[0]], self.origin[0]))
+    pub(crate) fn row_start(&self, y: i32, z: i32) -> Option<usize> {
+        self.local([self.origin[0], y, z]).map(|l| self.linear(l))
     }
 
-    /// Whether a voxel of raw state `v` (from [`Self::raw_row`]; `None`: outside the
-    /// grid) is an obstacle.
+    /// The raw states of the row starting at `start` ([`Self::row_start`]). Read with
+    /// [`Self::is_obstacle_raw`].
+    #[inline]
+    pub(crate) fn raw_row_at(&self, start: usize) -> &[u8] {
+        &self.cells[start..start + self.dims[0]]
+    }
+
+    /// Whether a voxel of raw state `v` (from [`Self::raw_row_at`]; `None`: outside
+    /// the grid) is an obstacle.
     #[inline]
     pub(crate) fn is_obstacle_raw(&self, v: Option<u8>) -> bool {
         match v.map(Cell::from_u8) {

@@ -12,7 +12,7 @@
 
 use rayon::prelude::*;
 
-use super::grid::{Cell, Grid};
+use super::grid::Grid;
 
 /// Gaps of this many voxels or more (or rows without obstacles) are stored as this.
 pub(crate) const FAR: u8 = u8::MAX;
@@ -24,11 +24,6 @@ pub(crate) const FAR: u8 = u8::MAX;
 pub(crate) fn row_gaps(grid: &Grid) -> Vec<u8> {
     let [nx, ny, _] = grid.dims();
     let walls = grid.unknown_is_occupied();
-    let obstacle = |c: Cell| match c {
-        Cell::Occupied => true,
-        Cell::Free => false,
-        Cell::Unknown => walls,
-    };
     let mut gaps = vec![FAR; grid.dims().iter().product()];
     if nx == 0 {
         return gaps;
@@ -36,21 +31,24 @@ pub(crate) fn row_gaps(grid: &Grid) -> Vec<u8> {
     gaps.par_chunks_exact_mut(nx)
         .enumerate()
         .for_each(|(k, row)| {
-            let (y, z) = (k % ny, k / ny);
-            let at = |x: usize| obstacle(grid.cell_local([x, y, z]));
             // The obstacle last seen on the left (-1: beyond the row's start).
             let mut last: Option<i64> = walls.then_some(-1);
-            for (x, g) in row.iter_mut().enumerate() {
-                if at(x) {
+            for (x, (g, obstacle)) in row
+                .iter_mut()
+                .zip(grid.obstacle_row(k % ny, k / ny))
+                .enumerate()
+            {
+                if obstacle {
                     last = Some(x as i64);
                 }
                 if let Some(o) = last {
                     *g = gap(x as i64 - o);
                 }
             }
+            // Right to left: the obstacles are the voxels the first pass set to 0.
             let mut next: Option<i64> = walls.then_some(nx as i64);
             for x in (0..nx).rev() {
-                if at(x) {
+                if row[x] == 0 {
                     next = Some(x as i64);
                 }
                 if let Some(o) = next {
@@ -68,6 +66,7 @@ fn gap(d: i64) -> u8 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::grid::Cell;
     use super::*;
 
     #[test]

@@ -300,9 +300,8 @@ fn middle(checker: &Checker, x: &Shape) -> Vector3<f64> {
 /// Whether the chain in shape `x` can be at every point of the route, [`FIT_SPACING`]
 /// apart (the tightest, where the head is nearest the map, first): some unit at the
 /// point or one map resolution from it along or across the axes, the rest of the body
-/// clear. A carried chain takes
-/// its body through every passage the route takes its head through; this turns
-/// away, before any search, a shape that is too wide for one.
+/// clear. A carried chain takes its body through every passage the route takes its
+/// head through; this turns away, before any search, a shape that is too wide for one.
 fn fits_along(checker: &mut Checker, route: &[Point3<f64>], x: &Shape) -> bool {
     let r_v = checker.ctx.field().grid().resolution();
     let mut samples: Vec<(f64, Point3<f64>)> = Vec::new();

@@ -141,8 +141,10 @@ impl ArcPlanner {
     /// Refines a solved query's plan (see the module docs), then shortens its shape
     /// motion (`super::shorten`), both within `CHECK_BUDGET` checks, then flies a
     /// stretch of it in one library shape where that moves the angles less
-    /// (`super::carry`), then widens its narrow passages (`super::widen`). The result starts and
-    /// ends where the solution does and passes the same checks. Past `deadline` (the
+    /// (`super::carry`), then widens its narrow passages (`super::widen`), and takes
+    /// the search's route threaded instead where that passes them nearer their middle
+    /// (`super::thread`). The result starts and ends where the solution does and
+    /// passes the same checks. Past `deadline` (the
     /// query's time limit) refinement stops and keeps what it has; only then can two
     /// runs differ.
     pub fn refine(
