@@ -26,7 +26,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::{Checker, Step};
+use super::Step;
 use crate::collision::exact::{exact_clearance, positions_f64};
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
 use crate::collision::CollisionContext;
@@ -118,8 +118,7 @@ pub(super) fn widen(
 ) -> (Vec<Step>, Widening) {
     let mut w = Widener {
         ctx,
-        check: Checker::new(ctx.clone(), None),
-        check_min: Checker::new(ctx_min.clone(), None),
+        ctx_min,
         narrow: Vec::new(),
         steps,
         spent: 0,
@@ -128,7 +127,10 @@ pub(super) fn widen(
     };
     let start = w.steps.clone();
     w.narrow = (0..start.len().saturating_sub(1))
-        .map(|e| w.measure(e, &start))
+        .map(|e| {
+            w.spent += 1;
+            w.measure_whole(e, &start)
+        })
         .collect();
     w.stuck = vec![false; w.narrow.len()];
     let before = w.narrowest();
@@ -157,8 +159,7 @@ pub(super) fn widen(
 
 struct Widener<'a> {
     ctx: &'a CollisionContext,
-    check: Checker,
-    check_min: Checker,
+    ctx_min: &'a CollisionContext,
     steps: Vec<Step>,
     /// Per edge `e` (steps `e` to `e + 1`), its narrowest sample.
     narrow: Vec<Narrowest>,
@@ -328,8 +329,10 @@ impl Widener<'_> {
         };
         let (p, q) = (at(lo), at(hi));
         self.steps.splice(e + 1..e + 1, [p, q]);
-        let steps = self.steps.clone();
-        let fresh: Vec<Narrowest> = (e..e + 3).map(|k| self.measure(k, &steps)).collect();
+        let fresh: Vec<Narrowest> = (e..e + 3)
+            .map(|k| self.measure_whole(k, &self.steps))
+            .collect();
+        self.spent += 3;
         self.narrow.splice(e..=e, fresh);
         self.stuck.splice(e..=e, [false; 3]);
         self.splits += 1;
@@ -474,15 +477,22 @@ impl Widener<'_> {
     /// Takes `moved` when each edge of `floors`, measured in that order, keeps more
     /// than its floor and every one passes the checks ([`Self::admissible`]).
     fn take_if_above(&mut self, moved: Vec<Step>, floors: &[(usize, f64)]) -> bool {
-        let mut new = Vec::with_capacity(floors.len());
         for &(k, floor) in floors {
-            match self.measure_above(k, &moved, floor) {
-                Some(n) => new.push((k, n)),
-                None => return false,
+            self.spent += 1;
+            if !self.keeps_above(k, &moved, floor) {
+                return false;
             }
         }
         if !floors.iter().all(|&(k, _)| self.admissible(k, &moved)) {
             return false;
+        }
+        // Taken: the narrowest of each edge it changed.
+        let mut new = Vec::with_capacity(floors.len());
+        for &(k, floor) in floors {
+            match self.measure(k, &moved, floor, |_| true) {
+                Some(n) => new.push((k, n)),
+                None => return false,
+            }
         }
         for (k, n) in new {
             self.narrow[k] = n;
@@ -539,11 +549,11 @@ impl Widener<'_> {
         e: usize,
         along: Vector3<f64>,
     ) -> Option<(Narrowest, Vector3<f64>, Vec<Point3<f64>>)> {
-        let steps = self.steps.clone();
         let mut away = vec![self.narrow[e].at];
         for _ in 0..OTHER_CANDIDATES {
             let far = |p: &Point3<f64>| away.iter().all(|q| (p - q).norm() > SEPARATE);
-            let n = self.measure_where(e, &steps, f64::NEG_INFINITY, far)?;
+            self.spent += 1;
+            let n = self.measure(e, &self.steps, f64::NEG_INFINITY, far)?;
             if n.clearance >= CAP {
                 return None;
             }
@@ -575,8 +585,9 @@ impl Widener<'_> {
             let d = (p - target.at).norm();
             d <= SEPARATE && away.iter().all(|q| (p - q).norm() > d)
         };
+        self.spent += 1;
         if self
-            .measure_where(e, &moved, target.clearance + GAIN, near)
+            .measure(e, &moved, target.clearance + GAIN, near)
             .is_none()
         {
             return false;
@@ -589,61 +600,41 @@ impl Widener<'_> {
 
     /// Whether edge `e` of `moved` passes the search's checks, or, where the current
     /// edge `e` does not (the search gave way there), the smallest clearance's checks.
-    fn admissible(&mut self, e: usize, moved: &[Step]) -> bool {
-        if edge_passes(&mut self.check, &moved[e], &moved[e + 1]) {
+    fn admissible(&self, e: usize, moved: &[Step]) -> bool {
+        if edge_passes(self.ctx, &moved[e], &moved[e + 1]) {
             return true;
         }
-        !edge_passes(&mut self.check, &self.steps[e], &self.steps[e + 1])
-            && edge_passes(&mut self.check_min, &moved[e], &moved[e + 1])
+        !edge_passes(self.ctx, &self.steps[e], &self.steps[e + 1])
+            && edge_passes(self.ctx_min, &moved[e], &moved[e + 1])
     }
 
     /// The narrowest unit clearance of edge `e` of `steps`, exactly, at the verifier's
-    /// samples (capped at [`CAP`]). The distance field's proven lower bound picks the
-    /// samples that can hold the minimum (the exact distance exceeds the bound by at
-    /// most `r_v sqrt(3)`); only those are measured exactly, lowest bound first.
-    fn measure(&mut self, e: usize, steps: &[Step]) -> Narrowest {
-        self.measure_above(e, steps, f64::NEG_INFINITY)
+    /// samples (capped at [`CAP`]): [`Self::measure`] over every sample.
+    fn measure_whole(&self, e: usize, steps: &[Step]) -> Narrowest {
+        self.measure(e, steps, f64::NEG_INFINITY, |_| true)
             .expect("no clearance is at or below minus infinity")
     }
 
-    /// [`Self::measure`], giving up (`None`) at the first sample at or below `floor`.
-    fn measure_above(&mut self, e: usize, steps: &[Step], floor: f64) -> Option<Narrowest> {
-        self.measure_where(e, steps, floor, |_| true)
-    }
-
-    /// [`Self::measure_above`] over the unit positions `keep` keeps.
-    fn measure_where(
-        &mut self,
+    /// The narrowest unit clearance of edge `e` of `steps` over the unit positions
+    /// `keep` keeps, exactly, at the verifier's samples (capped at [`CAP`]); `None` at
+    /// the first sample at or below `floor`. The distance field's proven lower bound
+    /// picks the samples that can hold the minimum (the exact distance exceeds the
+    /// bound by at most `r_v sqrt(3)`); only those are measured exactly, lowest bound
+    /// first. One measurement of widening's [`BUDGET`]; the caller counts it.
+    fn measure(
+        &self,
         e: usize,
         steps: &[Step],
         floor: f64,
         keep: impl Fn(&Point3<f64>) -> bool,
     ) -> Option<Narrowest> {
-        self.spent += 1;
-        let params = self.ctx.params();
-        let (l, r_u) = (params.link_length as f64, params.unit_radius as f64);
-        let (a, b) = (zeta(&steps[e]), zeta(&steps[e + 1]));
-        let kind = classify_edge(&a, &b);
-        let field = self.ctx.field();
-        let r_v = field.grid().resolution();
-        let cap = CAP + r_u;
-        let n = edge_intervals(kind, l, &a, &b, SAMPLE_SPACING * r_v).max(1);
-        let mut bounds: Vec<(f64, Point3<f64>)> = Vec::new();
-        for j in 0..=n {
-            let z = edge_sample(kind, &a, &b, j as f64 / n as f64);
-            for p in positions_f64(l, [z[0], z[1], z[2]], &z[3..]) {
-                let lb = field.clearance_above(p, cap);
-                if lb < cap && keep(&p) {
-                    bounds.push((lb, p));
-                }
-            }
-        }
-        bounds.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let r_u = self.ctx.params().unit_radius as f64;
+        let r_v = self.ctx.field().grid().resolution();
+        let (bounds, within) = self.bounds(e, steps, keep);
         let mut best = Narrowest {
             clearance: CAP,
             at: Point3::from(steps[e].xi),
         };
-        let within = bounds.first().map_or(0.0, |f| f.0 + r_v * 3f64.sqrt());
         for (lb, p) in bounds {
             // A bound within a micrometre of the best is as good as equal: the samples
             // along a flat face all share it.
@@ -676,6 +667,66 @@ impl Widener<'_> {
         }
         Some(best)
     }
+
+    /// Whether [`Self::measure`] over every unit position finds edge `e` of `steps`
+    /// above `floor`, without finding its narrowest: only the samples whose bound
+    /// allows `floor` are measured, each only as far as `floor`. Moves are judged by
+    /// this, and most fail, so the narrowest is measured only for the moves taken.
+    /// (It can differ from `measure` only where a sample is within a micrometre of
+    /// the narrowest, which `measure` counts as equal.)
+    fn keeps_above(&self, e: usize, steps: &[Step], floor: f64) -> bool {
+        let r_u = self.ctx.params().unit_radius as f64;
+        let field = self.ctx.field();
+        let r_v = field.grid().resolution();
+        let (bounds, within) = self.bounds(e, steps, |_| true);
+        // A unit keeps at most `floor` where its centre is within `reach` of the map.
+        let reach = floor + r_u;
+        for (lb, p) in bounds {
+            // The bound is a lower bound: from here on every sample keeps more.
+            if lb > reach || lb > within {
+                break;
+            }
+            // As `measure` takes the bound near the cap.
+            if lb - r_u >= CAP - r_v || exact_clearance(field, p, reach, reach + 1e-9) <= reach {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// The unit positions of edge `e` of `steps` that `keep` keeps, at the samples
+    /// [`Self::measure`] looks at, with the distance field's lower bound on their
+    /// distance to the map, lowest first (those within `CAP + r_u`); and the largest
+    /// bound that may still hold the narrowest (the lowest plus what the bound can
+    /// lose, `r_v sqrt(3)`).
+    fn bounds(
+        &self,
+        e: usize,
+        steps: &[Step],
+        keep: impl Fn(&Point3<f64>) -> bool,
+    ) -> (Vec<(f64, Point3<f64>)>, f64) {
+        let params = self.ctx.params();
+        let (l, r_u) = (params.link_length as f64, params.unit_radius as f64);
+        let (a, b) = (zeta(&steps[e]), zeta(&steps[e + 1]));
+        let kind = classify_edge(&a, &b);
+        let field = self.ctx.field();
+        let r_v = field.grid().resolution();
+        let cap = CAP + r_u;
+        let n = edge_intervals(kind, l, &a, &b, SAMPLE_SPACING * r_v).max(1);
+        let mut bounds: Vec<(f64, Point3<f64>)> = Vec::new();
+        for j in 0..=n {
+            let z = edge_sample(kind, &a, &b, j as f64 / n as f64);
+            for p in positions_f64(l, [z[0], z[1], z[2]], &z[3..]) {
+                let lb = field.clearance_above(p, cap);
+                if lb < cap && keep(&p) {
+                    bounds.push((lb, p));
+                }
+            }
+        }
+        bounds.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let within = bounds.first().map_or(0.0, |f| f.0 + r_v * 3f64.sqrt());
+        (bounds, within)
+    }
 }
 
 /// What widening aims for in a passage whose middle keeps `middle` (m): [`CENTRED`]
@@ -692,12 +743,13 @@ fn across(v: Vector3<f64>, along: Option<Vector3<f64>>) -> Vector3<f64> {
     }
 }
 
-/// Whether the edge from `a` to `b` passes `check` (a translation or a shape change).
-fn edge_passes(check: &mut Checker, a: &Step, b: &Step) -> bool {
+/// Whether the edge from `a` to `b` passes the checks of `ctx` (a translation or a
+/// shape change).
+fn edge_passes(ctx: &CollisionContext, a: &Step, b: &Step) -> bool {
     if a.xi != b.xi {
-        check.translation(a.xi, b.xi, &b.shape)
+        ctx.check_translation(a.xi, b.xi, &b.shape).is_ok()
     } else {
-        check.shape_change(a.xi, &a.shape, &b.shape)
+        ctx.check_shape_change(a.xi, &a.shape, &b.shape).is_ok()
     }
 }
 
@@ -768,18 +820,13 @@ mod tests {
     /// (0.1 m is the most it can keep). Returns the plan.
     fn widened_in_the_window(steps: &[Step]) -> Vec<Step> {
         let ctx = window();
-        let mut check = Checker::new(ctx.clone(), None);
-        assert!(steps
-            .windows(2)
-            .all(|w| edge_passes(&mut check, &w[0], &w[1])));
+        assert!(steps.windows(2).all(|w| edge_passes(&ctx, &w[0], &w[1])));
         let (out, report) = widen(&ctx, &ctx, steps.to_vec());
         let (first, last) = (&steps[0], &steps[steps.len() - 1]);
         assert_eq!((out[0].xi, out[out.len() - 1].xi), (first.xi, last.xi));
         assert!(out.iter().all(|s| s.shape == first.shape));
         assert!(report.before < 0.065 && report.after > 0.09, "{report:?}");
-        assert!(out
-            .windows(2)
-            .all(|w| edge_passes(&mut check, &w[0], &w[1])));
+        assert!(out.windows(2).all(|w| edge_passes(&ctx, &w[0], &w[1])));
         out
     }
 
@@ -870,16 +917,11 @@ mod tests {
         ]
         .map(|xi| step(xi, &straight))
         .to_vec();
-        let mut check = Checker::new(ctx.clone(), None);
-        assert!(steps
-            .windows(2)
-            .all(|w| edge_passes(&mut check, &w[0], &w[1])));
+        assert!(steps.windows(2).all(|w| edge_passes(&ctx, &w[0], &w[1])));
         let door_before = clearance_at_wall(&ctx, &steps, 3.05);
         assert!(door_before < 0.16, "{door_before}");
         let (out, report) = widen(&ctx, &ctx, steps);
-        assert!(out
-            .windows(2)
-            .all(|w| edge_passes(&mut check, &w[0], &w[1])));
+        assert!(out.windows(2).all(|w| edge_passes(&ctx, &w[0], &w[1])));
         let opening = clearance_at_wall(&ctx, &out, 2.05);
         let door = clearance_at_wall(&ctx, &out, 3.05);
         assert!(opening > 0.099, "opening {opening}");
@@ -888,6 +930,40 @@ mod tests {
             "door {door}, before {door_before}"
         );
         assert!(report.moves > 0);
+    }
+
+    /// Moves are judged by `keeps_above`, which must agree with `measure` at every
+    /// floor: here translations through the window and past its frame, at floors
+    /// just below, at and just above each one's narrowest, and further off.
+    #[test]
+    fn keeps_above_agrees_with_measure() {
+        let ctx = window();
+        let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
+        let turned = Shape::from_slice(3, &[0.4, 0.0, 0.3, 0.1, -0.2]).unwrap();
+        let w = Widener {
+            ctx: &ctx,
+            ctx_min: &ctx,
+            steps: Vec::new(),
+            narrow: Vec::new(),
+            stuck: Vec::new(),
+            spent: 0,
+            splits: 0,
+        };
+        let mut checked = 0;
+        for (k, (y, z)) in [(1.0, 1.0), (1.04, 0.97), (1.09, 1.08), (0.8, 1.3)]
+            .into_iter()
+            .enumerate()
+        {
+            let shape = if k % 2 == 0 { straight } else { turned };
+            let steps = [step([1.2, y, z], &shape), step([3.6, y, z], &shape)];
+            let narrowest = w.measure_whole(0, &steps).clearance;
+            for floor in [-1.0, -1e-3, -1e-5, 0.0, 1e-5, 1e-3, 0.02, 1.0].map(|d| narrowest + d) {
+                let measured = w.measure(0, &steps, floor, |_| true).is_some();
+                assert_eq!(w.keeps_above(0, &steps, floor), measured, "{k} {floor}");
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 32);
     }
 
     #[test]
