@@ -13,15 +13,26 @@
 //! is its displacement over the interval's time, and the head's (or an angle's)
 //! acceleration at a sample is the second divided difference of its neighbours. Both are
 //! averages of the true derivative, so a smooth motion within a limit passes exactly.
+//!
+//! The intervals are checked in runs of [`CHUNK`] side by side (rayon), and the runs'
+//! findings are put together in order up to the first problem: the report is the one a
+//! check from the first sample to the last would make.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use aerial_chain_core::validity::Body;
 use aerial_chain_core::ChainParams;
 use nalgebra::Point3;
+use rayon::prelude::*;
 
 use super::Limits;
 use crate::collision::exact::{check_config_exact, positions_f64, ExactViolation};
 use crate::collision::verify::{wrap, zeta_delta, MAX_INTERVALS};
 use crate::map::Grid;
+
+/// Intervals between samples checked as one run (see the module docs): a few
+/// milliseconds of work, enough to outweigh handing it to another thread.
+const CHUNK: usize = 32;
 
 /// A limit holds when the measured value is at most `limit * (1 + LIMIT_TOLERANCE)`:
 /// room for the rounding of differences, far below any real excess.
@@ -181,7 +192,27 @@ pub(super) fn check_with_margin(
     limits: &Limits,
     (times, zetas): (&[f64], &[Vec<f64>]),
     horizon: f64,
-    required: &dyn Fn(f64) -> f64,
+    required: &(dyn Fn(f64) -> f64 + Sync),
+) -> CheckReport {
+    check_in_runs(
+        grid,
+        params,
+        limits,
+        (times, zetas),
+        (horizon, required),
+        CHUNK,
+    )
+}
+
+/// [`check_with_margin`] with the intervals checked in runs of `run` (a check in one
+/// run for `usize::MAX`: what the runs' report must equal).
+fn check_in_runs(
+    grid: &Grid,
+    params: &ChainParams,
+    limits: &Limits,
+    (times, zetas): (&[f64], &[Vec<f64>]),
+    (horizon, required): (f64, &(dyn Fn(f64) -> f64 + Sync)),
+    run: usize,
 ) -> CheckReport {
     let mut c = Checker {
         grid,
@@ -189,14 +220,8 @@ pub(super) fn check_with_margin(
         limits,
         horizon,
         required,
-        rep: CheckReport {
-            ok: false,
-            configurations: 0,
-            min_clearance: horizon.max(0.0),
-            min_clearance_at: None,
-            peaks: Peaks::default(),
-            violation: None,
-        },
+        run,
+        rep: CheckReport::empty(horizon),
     };
     if let Err(v) = c.run(times, zetas) {
         c.rep.violation = Some(v);
@@ -205,13 +230,45 @@ pub(super) fn check_with_margin(
     c.rep
 }
 
+impl CheckReport {
+    /// The report of a check that has tested nothing yet.
+    fn empty(horizon: f64) -> Self {
+        Self {
+            ok: false,
+            configurations: 0,
+            min_clearance: horizon.max(0.0),
+            min_clearance_at: None,
+            peaks: Peaks::default(),
+            violation: None,
+        }
+    }
+
+    /// Adds what a check of the samples after these found (up to its first problem).
+    fn extend(&mut self, later: Self) {
+        self.configurations += later.configurations;
+        if let Some(at) = later.min_clearance_at {
+            if self.min_clearance_at.is_none() || later.min_clearance < self.min_clearance {
+                self.min_clearance = later.min_clearance;
+                self.min_clearance_at = Some(at);
+            }
+        }
+        let (p, q) = (&mut self.peaks, later.peaks);
+        p.speed = p.speed.max(q.speed);
+        p.accel = p.accel.max(q.accel);
+        p.angular_rate = p.angular_rate.max(q.angular_rate);
+        p.angular_accel = p.angular_accel.max(q.angular_accel);
+    }
+}
+
 /// The state of one check.
 struct Checker<'a> {
     grid: &'a Grid,
     params: &'a ChainParams,
     limits: &'a Limits,
     horizon: f64,
-    required: &'a dyn Fn(f64) -> f64,
+    required: &'a (dyn Fn(f64) -> f64 + Sync),
+    /// Intervals per run.
+    run: usize,
     rep: CheckReport,
 }
 
@@ -239,17 +296,62 @@ impl Checker<'_> {
                 return Err(at(j, problem));
             }
         }
-        let l = self.params.link_length as f64;
-        let units: Vec<Vec<Point3<f64>>> = zetas
-            .iter()
-            .map(|z| positions_f64(l, [z[0], z[1], z[2]], &z[3..]))
-            .collect();
         if let (Some(z), Some(&t)) = (zetas.first(), times.first()) {
             self.configuration(z, t).map_err(|p| at(0, p))?;
         }
-        for j in 0..zetas.len().saturating_sub(1) {
+        let intervals = zetas.len().saturating_sub(1);
+        // The first run that found a problem: runs after it need not finish.
+        let first_bad = AtomicUsize::new(usize::MAX);
+        let runs: Vec<(CheckReport, Result<(), Violation>)> = (0..intervals.div_ceil(self.run))
+            .into_par_iter()
+            .map(|c| {
+                let mut run = Checker {
+                    rep: CheckReport::empty(self.horizon),
+                    ..*self
+                };
+                let span = c * self.run..(c * self.run).saturating_add(self.run).min(intervals);
+                let found = run.intervals(times, zetas, span, &|| {
+                    first_bad.load(Ordering::Relaxed) < c
+                });
+                if found.is_err() {
+                    first_bad.fetch_min(c, Ordering::Relaxed);
+                }
+                (run.rep, found)
+            })
+            .collect();
+        for (rep, found) in runs {
+            self.rep.extend(rep);
+            found?;
+        }
+        Ok(())
+    }
+
+    /// The intervals `span` (from sample `j` to `j + 1` for `j` in it): limits and
+    /// configurations, up to the first problem. Stops early, with no problem, once
+    /// `abandon` says a problem was found before the span.
+    fn intervals(
+        &mut self,
+        times: &[f64],
+        zetas: &[Vec<f64>],
+        span: std::ops::Range<usize>,
+        abandon: &dyn Fn() -> bool,
+    ) -> Result<(), Violation> {
+        let at = |sample: usize, problem: Problem| Violation {
+            sample,
+            t: times[sample],
+            fraction: 0.0,
+            problem,
+        };
+        let l = self.params.link_length as f64;
+        let units = |z: &[f64]| positions_f64(l, [z[0], z[1], z[2]], &z[3..]);
+        let mut here = units(&zetas[span.start]);
+        for j in span {
+            if abandon() {
+                return Ok(());
+            }
+            let next = units(&zetas[j + 1]);
             let dt = times[j + 1] - times[j];
-            self.rates(&units[j], &units[j + 1], &zetas[j], &zetas[j + 1], dt)
+            self.rates(&here, &next, &zetas[j], &zetas[j + 1], dt)
                 .map_err(|p| at(j, p))?;
             if j > 0 {
                 self.accelerations(&times[j - 1..j + 2], &zetas[j - 1..j + 2])
@@ -260,6 +362,7 @@ impl Checker<'_> {
                     fraction,
                     ..at(j, problem)
                 })?;
+            here = next;
         }
         Ok(())
     }
@@ -386,4 +489,68 @@ fn exceeds(value: f64, limit: f64) -> bool {
 
 fn dist(a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::map::Cell;
+
+    /// A straight chain of 3 flying along a corridor 1 m wide, 0.15 m past a pillar
+    /// (at t = 7.5 s), for `n` samples 0.1 s apart; sample `bump` (if any) jumps 5 cm
+    /// sideways, faster than the speed limit.
+    fn flight(n: usize, bump: Option<usize>) -> (Vec<f64>, Vec<Vec<f64>>) {
+        let times: Vec<f64> = (0..n).map(|j| j as f64 * 0.1).collect();
+        let zetas = (0..n)
+            .map(|j| {
+                let y = if Some(j) == bump { 0.55 } else { 0.5 };
+                let mut z = vec![1.5 + 0.02 * j as f64, y, 1.0];
+                z.extend([0.0; 5]);
+                z
+            })
+            .collect();
+        (times, zetas)
+    }
+
+    fn corridor() -> Grid {
+        let mut g = Grid::new(0.05, [0, 0, 0], [140, 20, 40], Cell::Free, true).unwrap();
+        g.fill_box([3.0, 0.0, 0.0], [3.1, 0.2, 2.0], Cell::Occupied);
+        g
+    }
+
+    /// The report of runs side by side is the report of one run from the first sample
+    /// to the last: for a valid flight, and for flights whose first problem lies in a
+    /// later run while runs after it find others (too fast from sample 40 on; too
+    /// near the pillar for a margin of 0.2 m after 6 s).
+    #[test]
+    fn runs_side_by_side_report_what_one_run_does() {
+        let (grid, params) = (corridor(), ChainParams::new(3));
+        let limits = Limits::default();
+        let none = |_: f64| 0.0;
+        let near = |t: f64| if t > 6.0 { 0.2 } else { 0.0 };
+        let mut cases = vec![
+            flight(200, None),
+            flight(200, Some(70)),
+            flight(200, Some(150)),
+        ];
+        // Too fast from sample 40 on: every run after it finds a problem too.
+        let (mut t, z) = flight(200, None);
+        t.iter_mut()
+            .skip(40)
+            .for_each(|x| *x = 4.0 + (*x - 4.0) * 0.01);
+        cases.push((t, z));
+        for (k, (t, z)) in cases.iter().enumerate() {
+            for required in [&none as &(dyn Fn(f64) -> f64 + Sync), &near] {
+                let side = (0.3, required);
+                let one = check_in_runs(&grid, &params, &limits, (t, z), side, usize::MAX);
+                for run in [1, 7, CHUNK] {
+                    let runs = check_in_runs(&grid, &params, &limits, (t, z), side, run);
+                    assert_eq!(runs, one, "case {k}, runs of {run}");
+                }
+                assert!(one.configurations > 0);
+                let valid = k == 0 && std::ptr::eq(required, &none as &_);
+                assert_eq!(one.ok, valid, "case {k}: {:?}", one.violation);
+            }
+        }
+    }
 }
