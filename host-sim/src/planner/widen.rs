@@ -100,7 +100,7 @@ pub struct Widening {
     /// After.
     pub after: f64,
     /// After, over the edges whose narrowest unit is in a passage (obstacles on both
-    /// sides, see `Widener::passage`); `None` when there is none, or when the plan
+    /// sides, see `Widener::middles`); `None` when there is none, or when the plan
     /// is threaded (`super::thread`), which widening does not measure.
     pub in_passages: Option<f64>,
     /// Moves taken: stations moved, and translations split.
@@ -179,14 +179,7 @@ impl Widener<'_> {
     fn narrowest_in_passages(&self) -> Option<f64> {
         (0..self.narrow.len())
             .filter(|&e| self.narrow[e].clearance < CAP)
-            .filter(|&e| {
-                self.passage(
-                    self.narrow[e].at,
-                    self.gradient(self.narrow[e].at),
-                    self.along(e),
-                )
-                .is_some()
-            })
+            .filter(|&e| self.in_passage(self.narrow[e].at, self.along(e)))
             .map(|e| self.narrow[e].clearance)
             .min_by(f64::total_cmp)
     }
@@ -245,10 +238,9 @@ impl Widener<'_> {
         let along = self.along(e);
         let narrow = self.narrow[e];
         let grad = self.gradient(narrow.at);
-        match self.passage(narrow.at, grad, along) {
-            Some(best) if narrow.clearance < aim(best) => {}
+        if !self.below_aim(narrow.at, grad, along, narrow.clearance) {
             // Open on one side, or as wide as the passage allows.
-            _ => return false,
+            return false;
         }
         if !groups.is_empty() && self.try_groups(e, &groups, grad, along) {
             return true;
@@ -377,22 +369,48 @@ impl Widener<'_> {
         gradient(self.ctx, p)
     }
 
-    /// The clearance a unit would keep in the middle of the passage at `p`: over the
-    /// lines through `p` across `along` (the projected gradient `grad` and the axes),
-    /// the shortest free chord with obstacles on both sides, halved, less the unit's
-    /// radius. `None` when no line meets obstacles on both sides within reach: open
-    /// space, or a passage wider than [`CAP`] allows to matter.
-    fn passage(
+    /// Whether a unit keeping `clearance` at `p` keeps less than widening aims for
+    /// ([`aim`]) in the middle of the passage there ([`Self::middles`] over the
+    /// projected gradient `grad` and the axes, the shortest chord counting); false where
+    /// there is no passage. Stops at the first chord whose middle the unit already
+    /// keeps its aim of.
+    fn below_aim(
         &self,
         p: Point3<f64>,
         grad: Vector3<f64>,
         along: Option<Vector3<f64>>,
-    ) -> Option<f64> {
+        clearance: f64,
+    ) -> bool {
+        let lines = across_all(&[grad, Vector3::x(), Vector3::y(), Vector3::z()], along);
+        let mut middles = self.middles(p, &lines, along).peekable();
+        middles.peek().is_some() && middles.all(|m| clearance < aim(m))
+    }
+
+    /// Whether `p` lies in a passage ([`Self::middles`] over the gradient there and
+    /// the axes finds a chord): the axes first, the gradient only where they find none.
+    fn in_passage(&self, p: Point3<f64>, along: Option<Vector3<f64>>) -> bool {
+        let axes = across_all(&[Vector3::x(), Vector3::y(), Vector3::z()], along);
+        if self.middles(p, &axes, along).next().is_some() {
+            return true;
+        }
+        let grad = across_all(&[self.gradient(p)], along);
+        let found = self.middles(p, &grad, along).next().is_some();
+        found
+    }
+
+    /// The clearance a unit would keep in the middle of the passage at `p` along each
+    /// of the unit directions `lines` (across `along`): for each line through `p` that
+    /// meets obstacles on both sides within reach, the free chord halved, less the
+    /// unit's radius; the passage's middle is the shortest. None where no line does:
+    /// open space, or a passage wider than [`CAP`] allows to matter. Lazy: each chord
+    /// costs two sphere traces.
+    fn middles<'b>(
+        &'b self,
+        p: Point3<f64>,
+        lines: &'b [Vector3<f64>],
+        along: Option<Vector3<f64>>,
+    ) -> impl Iterator<Item = f64> + 'b {
         let r_u = self.ctx.params().unit_radius as f64;
-        let lines: Vec<Vector3<f64>> = [grad, Vector3::x(), Vector3::y(), Vector3::z()]
-            .iter()
-            .filter_map(|&v| across(v, along).try_normalize(1e-6))
-            .collect();
         // A unit about to enter an opening is narrowest in front of it: the passage's
         // cross-section lies a little further along.
         let shifts: &[f64] = match along {
@@ -402,11 +420,10 @@ impl Widener<'_> {
         let u_along = along.unwrap_or_else(Vector3::zeros);
         shifts
             .iter()
-            .map(|&s| p + u_along * s)
-            .flat_map(|q| lines.iter().map(move |&u| (q, u)))
-            .filter_map(|(q, u)| Some(self.free_run(q, u)? + self.free_run(q, -u)?))
-            .map(|chord| chord / 2.0 - r_u)
-            .min_by(f64::total_cmp)
+            .map(move |&s| p + u_along * s)
+            .flat_map(move |q| lines.iter().map(move |&u| (q, u)))
+            .filter_map(move |(q, u)| Some(self.free_run(q, u)? + self.free_run(q, -u)?))
+            .map(move |chord| chord / 2.0 - r_u)
     }
 
     /// How far from `p` along `u` the first obstacle lies, within the widest passage
@@ -558,10 +575,8 @@ impl Widener<'_> {
                 return None;
             }
             let grad = self.gradient(n.at);
-            if let Some(middle) = self.passage(n.at, grad, Some(along)) {
-                if n.clearance < aim(middle) {
-                    return Some((n, grad, away));
-                }
+            if self.below_aim(n.at, grad, Some(along), n.clearance) {
+                return Some((n, grad, away));
             }
             away.push(n.at);
         }
@@ -733,6 +748,14 @@ impl Widener<'_> {
 /// of it, below the cap.
 fn aim(middle: f64) -> f64 {
     (CENTRED * middle).min(CAP - GAIN)
+}
+
+/// The directions of `vs` across `along` ([`across`]), as unit vectors, those with
+/// any part across.
+fn across_all(vs: &[Vector3<f64>], along: Option<Vector3<f64>>) -> Vec<Vector3<f64>> {
+    vs.iter()
+        .filter_map(|&v| across(v, along).try_normalize(1e-6))
+        .collect()
 }
 
 /// The part of `v` across the unit direction `along` (all of it without one).
