@@ -164,18 +164,15 @@ impl ArcPlanner {
         // other stages' result, so it is made beside them (rayon: on another core
         // where one is free). Made whether or not it will be compared: the result is
         // the same, and the wait is shorter.
-        let (chosen, threading) = rayon::join(
-            || post.refined_and_carried(raw, deadline),
+        let ((chosen, steps, last), threading) = rayon::join(
+            || {
+                let mut chosen = post.refined_and_carried(raw, deadline);
+                let (steps, last) = post.widened_again(&mut chosen, raw);
+                (chosen, steps, last)
+            },
             || post.threading(raw, deadline),
         );
         let first = chosen.first;
-        // Where neither the widened plan was taken nor refinement changed the search's
-        // plan, the last widening would repeat the first, move for move.
-        let (steps, last) = if chosen.first_moves.is_none() && chosen.steps == solution.steps {
-            (chosen.widened, first)
-        } else {
-            super::widen::widen(&chosen.ctx, &self.ctx_min, chosen.steps)
-        };
         let (steps, last, threaded) = post.threaded_if_better(threading, steps, last);
         let mut stats = solution.stats.clone();
         super::construction::count_sources(&steps, &mut stats);
@@ -236,8 +233,9 @@ impl Post<'_> {
     /// the margin up, fewer shortcuts may pass). Then a stretch flown in one library
     /// shape, where that moves the angles less (`super::carry`).
     fn refined_and_carried(&self, raw: &[Step], deadline: Option<Instant>) -> Chosen {
-        let ((plain, mut checks), (widened, first, kept)) = rayon::join(
-            || self.shortcut(self.ctx, raw, deadline),
+        // The longer first: the plain shortcuts wait to be taken by a core that is
+        // free (or run after it).
+        let ((widened, first, kept), (plain, mut checks)) = rayon::join(
             || {
                 let (widened, first) = super::widen::widen(self.ctx, self.ctx_min, raw.to_vec());
                 let kept = self.keep_margin(first.in_passages).map(|ctx| {
@@ -246,6 +244,7 @@ impl Post<'_> {
                 });
                 (widened, first, kept)
             },
+            || self.shortcut(self.ctx, raw, deadline),
         );
         let mut chosen = (plain, self.ctx.clone(), None);
         if let Some((kept, spent, ctx)) = kept {
@@ -270,6 +269,18 @@ impl Post<'_> {
             first,
             carried,
             checks,
+        }
+    }
+
+    /// The last widening, of the other stages' result (taking its steps): where
+    /// neither the widened plan was taken nor refinement changed the search's plan
+    /// `raw`, it would repeat the first move for move, whose result is taken.
+    fn widened_again(&self, chosen: &mut Chosen, raw: &[Step]) -> (Vec<Step>, Widening) {
+        let steps = std::mem::take(&mut chosen.steps);
+        if chosen.first_moves.is_none() && steps == raw {
+            (std::mem::take(&mut chosen.widened), chosen.first)
+        } else {
+            super::widen::widen(&chosen.ctx, self.ctx_min, steps)
         }
     }
 
@@ -348,6 +359,7 @@ impl Post<'_> {
 /// The other stages' result, before the last widening: the steps and the context
 /// they were checked in, with what led to them.
 struct Chosen {
+    /// Taken by the last widening (`Post::widened_again`), as is `widened`.
     steps: Vec<Step>,
     ctx: CollisionContext,
     /// The first widening's moves, when its plan was taken.
