@@ -103,6 +103,17 @@ struct Narrowest {
     at: Point3<f64>,
 }
 
+/// The unit positions at an edge's samples, with the distance field's lower bound on
+/// their distance to the map, lowest first (those within `CAP + r_u`).
+struct Samples {
+    bounds: Vec<(f64, Point3<f64>)>,
+    /// The largest bound that may still hold the narrowest: the lowest plus what the
+    /// bound can lose, `r_v sqrt(3)`.
+    within: f64,
+    /// The edge's first head position, where an edge wider than the cap is placed.
+    start: Point3<f64>,
+}
+
 /// What widening did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Widening {
@@ -517,19 +528,22 @@ impl Widener<'_> {
     /// Takes `moved` when each edge of `floors`, measured in that order, keeps more
     /// than its floor and every one passes the checks ([`Self::admissible`]).
     fn take_if_above(&mut self, moved: Vec<Step>, floors: &[(usize, f64)]) -> bool {
+        let mut samples = Vec::with_capacity(floors.len());
         for &(k, floor) in floors {
             self.spent += 1;
-            if !self.keeps_above(k, &moved, floor) {
+            let s = self.samples(k, &moved, |_| true);
+            if !self.keeps_above(&s, floor) {
                 return false;
             }
+            samples.push(s);
         }
         if !floors.iter().all(|&(k, _)| self.admissible(k, &moved)) {
             return false;
         }
         // Taken: the narrowest of each edge it changed.
         let mut new = Vec::with_capacity(floors.len());
-        for &(k, floor) in floors {
-            match self.measure(k, &moved, floor, |_| true) {
+        for (&(k, floor), s) in floors.iter().zip(&samples) {
+            match self.narrowest_of(s, floor) {
                 Some(n) => new.push((k, n)),
                 None => return false,
             }
@@ -666,17 +680,21 @@ impl Widener<'_> {
         floor: f64,
         keep: impl Fn(&Point3<f64>) -> bool,
     ) -> Option<Narrowest> {
+        self.narrowest_of(&self.samples(e, steps, keep), floor)
+    }
+
+    /// [`Self::measure`] of an edge's `samples`.
+    fn narrowest_of(&self, samples: &Samples, floor: f64) -> Option<Narrowest> {
         let r_u = self.ctx.params().unit_radius as f64;
         let r_v = self.ctx.field().grid().resolution();
-        let (bounds, within) = self.bounds(e, steps, keep);
         let mut best = Narrowest {
             clearance: CAP,
-            at: Point3::from(steps[e].xi),
+            at: samples.start,
         };
-        for (lb, p) in bounds {
+        for &(lb, p) in &samples.bounds {
             // A bound within a micrometre of the best is as good as equal: the samples
             // along a flat face all share it.
-            if lb - r_u + 1e-6 >= best.clearance || lb > within {
+            if lb - r_u + 1e-6 >= best.clearance || lb > samples.within {
                 break;
             }
             // Near the cap the bound is close enough: the exact measure there costs
@@ -706,22 +724,21 @@ impl Widener<'_> {
         Some(best)
     }
 
-    /// Whether [`Self::measure`] over every unit position finds edge `e` of `steps`
-    /// above `floor`, without finding its narrowest: only the samples whose bound
-    /// allows `floor` are measured, each only as far as `floor`. Moves are judged by
-    /// this, and most fail, so the narrowest is measured only for the moves taken.
-    /// (It can differ from `measure` only where a sample is within a micrometre of
-    /// the narrowest, which `measure` counts as equal.)
-    fn keeps_above(&self, e: usize, steps: &[Step], floor: f64) -> bool {
+    /// Whether [`Self::narrowest_of`] finds an edge's `samples` above `floor`,
+    /// without finding its narrowest: only the samples whose bound allows `floor` are
+    /// measured, each only as far as `floor`. Moves are judged by this, and most fail,
+    /// so the narrowest is measured only for the moves taken. (It can differ from
+    /// `narrowest_of` only where a sample is within a micrometre of the narrowest,
+    /// which that counts as equal.)
+    fn keeps_above(&self, samples: &Samples, floor: f64) -> bool {
         let r_u = self.ctx.params().unit_radius as f64;
         let field = self.ctx.field();
         let r_v = field.grid().resolution();
-        let (bounds, within) = self.bounds(e, steps, |_| true);
         // A unit keeps at most `floor` where its centre is within `reach` of the map.
         let reach = floor + r_u;
-        for (lb, p) in bounds {
+        for &(lb, p) in &samples.bounds {
             // The bound is a lower bound: from here on every sample keeps more.
-            if lb > reach || lb > within {
+            if lb > reach || lb > samples.within {
                 break;
             }
             // As `measure` takes the bound near the cap.
@@ -733,16 +750,8 @@ impl Widener<'_> {
     }
 
     /// The unit positions of edge `e` of `steps` that `keep` keeps, at the samples
-    /// [`Self::measure`] looks at, with the distance field's lower bound on their
-    /// distance to the map, lowest first (those within `CAP + r_u`); and the largest
-    /// bound that may still hold the narrowest (the lowest plus what the bound can
-    /// lose, `r_v sqrt(3)`).
-    fn bounds(
-        &self,
-        e: usize,
-        steps: &[Step],
-        keep: impl Fn(&Point3<f64>) -> bool,
-    ) -> (Vec<(f64, Point3<f64>)>, f64) {
+    /// [`Self::measure`] looks at ([`Samples`]).
+    fn samples(&self, e: usize, steps: &[Step], keep: impl Fn(&Point3<f64>) -> bool) -> Samples {
         let params = self.ctx.params();
         let (l, r_u) = (params.link_length as f64, params.unit_radius as f64);
         let (a, b) = (zeta(&steps[e]), zeta(&steps[e + 1]));
@@ -763,7 +772,11 @@ impl Widener<'_> {
         }
         bounds.sort_by(|x, y| x.0.total_cmp(&y.0));
         let within = bounds.first().map_or(0.0, |f| f.0 + r_v * 3f64.sqrt());
-        (bounds, within)
+        Samples {
+            bounds,
+            within,
+            start: Point3::from(steps[e].xi),
+        }
     }
 }
 
@@ -1005,7 +1018,11 @@ mod tests {
             let narrowest = w.measure_whole(0, &steps).clearance;
             for floor in [-1.0, -1e-3, -1e-5, 0.0, 1e-5, 1e-3, 0.02, 1.0].map(|d| narrowest + d) {
                 let measured = w.measure(0, &steps, floor, |_| true).is_some();
-                assert_eq!(w.keeps_above(0, &steps, floor), measured, "{k} {floor}");
+                assert_eq!(
+                    w.keeps_above(&w.samples(0, &steps, |_| true), floor),
+                    measured,
+                    "{k} {floor}"
+                );
                 checked += 1;
             }
         }
