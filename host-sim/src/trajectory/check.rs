@@ -30,8 +30,8 @@ use crate::collision::exact::{check_config_exact, positions_f64, ExactViolation}
 use crate::collision::verify::{wrap, zeta_delta, MAX_INTERVALS};
 use crate::map::Grid;
 
-/// Intervals between samples checked as one run (see the module docs): a few
-/// milliseconds of work, enough to outweigh handing it to another thread.
+/// Intervals between samples checked as one run (see the module docs): some tens of
+/// configurations, enough work to outweigh handing it to another thread.
 const CHUNK: usize = 32;
 
 /// A limit holds when the measured value is at most `limit * (1 + LIMIT_TOLERANCE)`:
