@@ -28,6 +28,7 @@
 //! ([`BUDGET`]), not time, so the result is deterministic.
 
 use nalgebra::{Point3, Vector3};
+use rayon::prelude::*;
 
 use super::Step;
 use crate::collision::exact::positions_f64;
@@ -129,13 +130,11 @@ pub(super) fn widen(
         splits: 0,
         stuck: Vec::new(),
     };
-    let start = w.steps.clone();
-    w.narrow = (0..start.len().saturating_sub(1))
-        .map(|e| {
-            w.spent += 1;
-            measure_whole(ctx, e, &start)
-        })
+    let edges = w.steps.len().saturating_sub(1);
+    w.narrow = (0..edges)
+        .map(|e| measure_whole(ctx, e, &w.steps))
         .collect();
+    w.spent += edges;
     w.stuck = vec![false; w.narrow.len()];
     let before = w.narrowest();
     let mut moves = 0;
@@ -425,19 +424,21 @@ impl Widener<'_> {
             }
             judged.push(s);
         }
-        if !floors.iter().all(|&(k, _)| self.admissible(k, &moved)) {
+        // Taken when every edge passes the checks: their narrowest, each edge beside
+        // the others (rayon: the checks of a long translation take milliseconds).
+        let verdicts: Vec<(bool, Option<Narrowest>)> = floors
+            .par_iter()
+            .zip(&judged)
+            .map(|(&(k, floor), s)| {
+                let checked = self.admissible(k, &moved);
+                (checked, narrowest_of(self.ctx, s, floor))
+            })
+            .collect();
+        if verdicts.iter().any(|(checked, n)| !checked || n.is_none()) {
             return false;
         }
-        // Taken: the narrowest of each edge it changed.
-        let mut new = Vec::with_capacity(floors.len());
-        for (&(k, floor), s) in floors.iter().zip(&judged) {
-            match narrowest_of(self.ctx, s, floor) {
-                Some(n) => new.push((k, n)),
-                None => return false,
-            }
-        }
-        for (k, n) in new {
-            self.narrow[k] = n;
+        for (&(k, _), (_, n)) in floors.iter().zip(verdicts) {
+            self.narrow[k] = n.expect("every edge measured");
             self.stuck[k] = false;
         }
         self.steps = moved;
