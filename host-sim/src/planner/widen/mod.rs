@@ -121,21 +121,17 @@ pub(super) fn widen(
     ctx_min: &CollisionContext,
     steps: Vec<Step>,
 ) -> (Vec<Step>, Widening) {
+    let edges = steps.len().saturating_sub(1);
+    let narrow: Vec<Narrowest> = (0..edges).map(|e| measure_whole(ctx, e, &steps)).collect();
     let mut w = Widener {
         ctx,
         ctx_min,
-        narrow: Vec::new(),
+        stuck: vec![false; edges],
+        narrow,
         steps,
-        spent: 0,
+        spent: edges,
         splits: 0,
-        stuck: Vec::new(),
     };
-    let edges = w.steps.len().saturating_sub(1);
-    w.narrow = (0..edges)
-        .map(|e| measure_whole(ctx, e, &w.steps))
-        .collect();
-    w.spent += edges;
-    w.stuck = vec![false; w.narrow.len()];
     let before = w.narrowest();
     let mut moves = 0;
     while w.spent < BUDGET {

@@ -36,13 +36,11 @@ pub(super) fn in_passage(
     p: Point3<f64>,
     along: Option<Vector3<f64>>,
 ) -> bool {
-    let axes = across_all(&[Vector3::x(), Vector3::y(), Vector3::z()], along);
-    if middles(ctx, p, &axes, along).next().is_some() {
-        return true;
-    }
-    let grad = across_all(&[gradient(ctx, p)], along);
-    let found = middles(ctx, p, &grad, along).next().is_some();
-    found
+    let finds = |lines: &[Vector3<f64>]| middles(ctx, p, lines, along).next().is_some();
+    finds(&across_all(
+        &[Vector3::x(), Vector3::y(), Vector3::z()],
+        along,
+    )) || finds(&across_all(&[gradient(ctx, p)], along))
 }
 
 /// The clearance a unit would keep in the middle of the passage at `p` along each of
