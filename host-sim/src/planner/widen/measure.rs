@@ -17,17 +17,27 @@ use crate::planner::Step;
 /// unit moves); `arc verify` reports the exact figure.
 const SAMPLE_SPACING: f64 = 2.0;
 
-/// The narrowest sample of an edge: its clearance and where (unit centre).
+/// The narrowest sample of an edge: its clearance and where (unit centre, and which
+/// unit at which sample).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Narrowest {
     pub(super) clearance: f64,
     pub(super) at: Point3<f64>,
+    pub(super) spot: Spot,
+}
+
+/// A unit at one of an edge's samples: the sample's parameter along the edge (0 at
+/// its start, 1 at its end) and the unit's index.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct Spot {
+    pub(super) t: f64,
+    pub(super) unit: usize,
 }
 
 /// The unit positions at an edge's samples, with the distance field's lower bound on
 /// their distance to the map, lowest first (those within `CAP + r_u`).
 pub(super) struct Samples {
-    bounds: Vec<(f64, Point3<f64>)>,
+    bounds: Vec<(f64, Point3<f64>, Spot)>,
     /// The largest bound that may still hold the narrowest: the lowest plus what the
     /// bound can lose, `r_v sqrt(3)`.
     within: f64,
@@ -69,8 +79,9 @@ pub(super) fn narrowest_of(
     let mut best = Narrowest {
         clearance: CAP,
         at: samples.start,
+        spot: Spot::default(),
     };
-    for &(lb, p) in &samples.bounds {
+    for &(lb, p, spot) in &samples.bounds {
         // A bound within a micrometre of the best is as good as equal: the samples
         // along a flat face all share it.
         if lb - r_u + 1e-6 >= best.clearance || lb > samples.within {
@@ -97,6 +108,7 @@ pub(super) fn narrowest_of(
             best = Narrowest {
                 clearance: c,
                 at: p,
+                spot,
             };
         }
     }
@@ -109,22 +121,89 @@ pub(super) fn narrowest_of(
 /// measured only for the moves taken. (It can differ from `narrowest_of` only where a
 /// sample is within a micrometre of the narrowest, which that counts as equal.)
 pub(super) fn keeps_above(ctx: &CollisionContext, samples: &Samples, floor: f64) -> bool {
-    let r_u = ctx.params().unit_radius as f64;
-    let field = ctx.field();
-    let r_v = field.grid().resolution();
-    // A unit keeps at most `floor` where its centre is within `reach` of the map.
-    let reach = floor + r_u;
-    for &(lb, p) in &samples.bounds {
+    let reach = floor + ctx.params().unit_radius as f64;
+    for &(lb, p, _) in &samples.bounds {
         // The bound is a lower bound: from here on every sample keeps more.
         if lb > reach || lb > samples.within {
             break;
         }
-        // As `narrowest_of` takes the bound near the cap.
-        if lb - r_u >= CAP - r_v || exact_clearance(field, p, reach, reach + 1e-9) <= reach {
+        if at_or_below(ctx, lb, p, floor) {
             return false;
         }
     }
     true
+}
+
+/// Whether the unit at `p`, whose distance to the map the field bounds below by `lb`
+/// (at most `floor + r_u`), keeps `floor` or less, as [`narrowest_of`] would measure
+/// it: exactly, as far as the floor; near the cap, by the bound.
+fn at_or_below(ctx: &CollisionContext, lb: f64, p: Point3<f64>, floor: f64) -> bool {
+    let r_u = ctx.params().unit_radius as f64;
+    let field = ctx.field();
+    let reach = floor + r_u;
+    lb - r_u >= CAP - field.grid().resolution()
+        || exact_clearance(field, p, reach, reach + 1e-9) <= reach
+}
+
+/// Whether edge `e` of `steps` surely fails [`keeps_above`] at `floor`, by a look at
+/// the unit of `near` alone, at the samples nearest its parameter (a pinch moves
+/// little with a move, and most moves fail there). `false` decides nothing. A sample
+/// found at or below the floor here is one of the edge's [`samples`], measured as
+/// `keeps_above` measures it; and where `keeps_above` would stop before reaching it
+/// (its bound far above the lowest), the lowest is at or below the floor too.
+pub(super) fn fails_near(
+    ctx: &CollisionContext,
+    e: usize,
+    steps: &[Step],
+    near: Spot,
+    floor: f64,
+) -> bool {
+    let edge = EdgeSamples::of(ctx, e, steps);
+    let reach = floor + ctx.params().unit_radius as f64;
+    let j = (near.t * edge.n as f64).round() as usize;
+    (j.saturating_sub(1)..=(j + 1).min(edge.n)).any(|j| {
+        let Some(&p) = edge.positions(j).get(near.unit) else {
+            return false;
+        };
+        let lb = ctx.field().clearance_above(p, edge.cap);
+        lb < edge.cap && lb <= reach && at_or_below(ctx, lb, p, floor)
+    })
+}
+
+/// An edge's samples as [`samples`] takes them: `n + 1`, evenly along the edge.
+struct EdgeSamples {
+    kind: crate::collision::verify::EdgeKind,
+    a: Vec<f64>,
+    b: Vec<f64>,
+    n: usize,
+    link: f64,
+    /// Distances at or beyond this (m) are not kept: `CAP + r_u`.
+    cap: f64,
+}
+
+impl EdgeSamples {
+    fn of(ctx: &CollisionContext, e: usize, steps: &[Step]) -> Self {
+        let params = ctx.params();
+        let link = params.link_length as f64;
+        let (a, b) = (zeta(&steps[e]), zeta(&steps[e + 1]));
+        let kind = classify_edge(&a, &b);
+        let r_v = ctx.field().grid().resolution();
+        let n = edge_intervals(kind, link, &a, &b, SAMPLE_SPACING * r_v).max(1);
+        EdgeSamples {
+            kind,
+            a,
+            b,
+            n,
+            link,
+            cap: CAP + params.unit_radius as f64,
+        }
+    }
+
+    /// The unit positions at sample `j` (of `0..=n`).
+    fn positions(&self, j: usize) -> Vec<Point3<f64>> {
+        let z = edge_sample(self.kind, &self.a, &self.b, j as f64 / self.n as f64);
+        positions_f64(self.link, [z[0], z[1], z[2]], &z[3..])
+    }
 }
 
 /// The unit positions of edge `e` of `steps` that `keep` keeps, at the samples
@@ -135,21 +214,16 @@ pub(super) fn samples(
     steps: &[Step],
     keep: impl Fn(&Point3<f64>) -> bool,
 ) -> Samples {
-    let params = ctx.params();
-    let (l, r_u) = (params.link_length as f64, params.unit_radius as f64);
-    let (a, b) = (zeta(&steps[e]), zeta(&steps[e + 1]));
-    let kind = classify_edge(&a, &b);
+    let edge = EdgeSamples::of(ctx, e, steps);
     let field = ctx.field();
     let r_v = field.grid().resolution();
-    let cap = CAP + r_u;
-    let n = edge_intervals(kind, l, &a, &b, SAMPLE_SPACING * r_v).max(1);
-    let mut bounds: Vec<(f64, Point3<f64>)> = Vec::new();
-    for j in 0..=n {
-        let z = edge_sample(kind, &a, &b, j as f64 / n as f64);
-        for p in positions_f64(l, [z[0], z[1], z[2]], &z[3..]) {
-            let lb = field.clearance_above(p, cap);
-            if lb < cap && keep(&p) {
-                bounds.push((lb, p));
+    let mut bounds: Vec<(f64, Point3<f64>, Spot)> = Vec::new();
+    for j in 0..=edge.n {
+        let t = j as f64 / edge.n as f64;
+        for (unit, p) in edge.positions(j).into_iter().enumerate() {
+            let lb = field.clearance_above(p, edge.cap);
+            if lb < edge.cap && keep(&p) {
+                bounds.push((lb, p, Spot { t, unit }));
             }
         }
     }

@@ -34,7 +34,7 @@ use super::Step;
 use crate::collision::exact::positions_f64;
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
 use crate::collision::CollisionContext;
-use measure::{keeps_above, measure, measure_whole, narrowest_of, samples, Narrowest};
+use measure::{fails_near, keeps_above, measure, measure_whole, narrowest_of, samples, Narrowest};
 use passage::{across, below_aim, in_passage};
 
 mod measure;
@@ -414,6 +414,11 @@ impl Widener<'_> {
         let mut judged = Vec::with_capacity(floors.len());
         for &(k, floor) in floors {
             self.spent += 1;
+            // Most moves that fail, fail where the edge was narrowest: a look there
+            // settles them before every sample is placed.
+            if fails_near(self.ctx, k, &moved, self.narrow[k].spot, floor) {
+                return false;
+            }
             let s = samples(self.ctx, k, &moved, |_| true);
             if !keeps_above(self.ctx, &s, floor) {
                 return false;

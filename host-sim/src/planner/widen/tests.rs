@@ -1,6 +1,6 @@
 //! Widening's tests: on a window and on an opening with a door behind it.
 
-use super::measure::{distance, keeps_above, measure, measure_whole, samples};
+use super::measure::{distance, fails_near, keeps_above, measure, measure_whole, samples, Spot};
 use super::passage::TARGET_SHARE;
 use super::*;
 use crate::collision::exact::positions_f64;
@@ -175,6 +175,43 @@ fn keeps_above_agrees_with_measure() {
     assert_eq!(checked, 32);
 }
 
+/// `fails_near` settles a move only where `keeps_above` would fail it: translations
+/// through the window moved a few centimetres each way, looked at by the unit and
+/// sample where the unmoved edge was narrowest, at floors around that narrowest.
+/// Most moves towards a wall fail there, so it settles some.
+#[test]
+fn fails_near_settles_only_moves_that_fail() {
+    let ctx = window();
+    let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
+    let turned = Shape::from_slice(3, &[0.4, 0.0, 0.3, 0.1, -0.2]).unwrap();
+    let (mut settled, mut failed) = (0, 0);
+    for (k, shape) in [straight, turned].into_iter().enumerate() {
+        let base = [
+            step([1.2, 1.04, 0.97], &shape),
+            step([3.6, 1.04, 0.97], &shape),
+        ];
+        let narrow = measure_whole(&ctx, 0, &base);
+        for (dy, dz) in [
+            (0.0, 0.0),
+            (0.03, 0.0),
+            (-0.03, 0.02),
+            (0.0, -0.05),
+            (0.06, 0.06),
+        ] {
+            let mut moved = base;
+            moved[1].xi += Vector3::new(0.0, dy, dz);
+            for floor in [-1e-3, 0.0, 1e-4, 5e-3, 0.02].map(|d| narrow.clearance + d) {
+                let keeps = keeps_above(&ctx, &samples(&ctx, 0, &moved, |_| true), floor);
+                let fails = fails_near(&ctx, 0, &moved, narrow.spot, floor);
+                assert!(!(fails && keeps), "{k} ({dy}, {dz}) {floor}");
+                failed += usize::from(!keeps);
+                settled += usize::from(fails);
+            }
+        }
+    }
+    assert!(settled > 0 && failed > 0, "{settled} of {failed}");
+}
+
 /// An edge no move widens gives up the edges at its pinch that keep about as
 /// little, and only those.
 #[test]
@@ -183,6 +220,7 @@ fn an_edge_stuck_at_a_pinch_gives_up_its_neighbours_there() {
     let at = |x: f64, clearance: f64| Narrowest {
         clearance,
         at: Point3::new(x, 1.0, 1.0),
+        spot: Spot::default(),
     };
     let mut w = Widener {
         ctx: &ctx,
