@@ -402,17 +402,40 @@ pub fn exact_clearance(
     let r = g.resolution();
     let c0 = g.lattice_index(p);
     let rings = (cap / r).ceil() as i32 + 1;
-    let half = Vector3::repeat(r / 2.0);
-    // Lattice x of every row's first voxel.
-    let x0 = g.origin()[0];
+    let (origin, dims) = (g.origin(), g.dims());
+    let x0 = origin[0];
+    let nx = dims[0];
     let mut best = cap;
-    // How far `v` lies from the slab of voxels `i` along axis `a`, as
+    // How far `p` lies from the slab of voxels `i` along axis `a`, as
     // `point_box_distance` measures it (so that a row skipped by it holds no cube
     // nearer than `best`, to the bit).
     let slab = |a: usize, i: i32| {
         let c = (i as f64 + 0.5) * r;
         ((c - r / 2.0) - p[a]).max(p[a] - (c + r / 2.0)).max(0.0)
     };
+    // The slabs of every row offset in y, then in z: on the stack unless the cap
+    // is far beyond what the planner asks for.
+    let span = (2 * rings + 1) as usize;
+    let mut stack = [0.0f64; 2 * STACK_SPAN];
+    let mut heap = Vec::new();
+    let slabs: &mut [f64] = if span <= STACK_SPAN {
+        &mut stack[..2 * span]
+    } else {
+        heap.resize(2 * span, 0.0);
+        &mut heap
+    };
+    for d in 0..span {
+        let o = d as i32 - rings;
+        slabs[d] = slab(1, c0[1] + o);
+        slabs[span + d] = slab(2, c0[2] + o);
+    }
+    let (gy, gz) = slabs.split_at(span);
+    let cells = |y: i32, z: i32| {
+        let (ly, lz) = (y as i64 - origin[1] as i64, z as i64 - origin[2] as i64);
+        (ly >= 0 && lz >= 0 && (ly as usize) < dims[1] && (lz as usize) < dims[2])
+            .then(|| (lz as usize * dims[1] + ly as usize) * nx)
+    };
+    let unknown = g.unknown_is_occupied();
     for k in 0..=rings {
         // Every cube of a row in ring k is at least (k - 1) r away.
         if (k - 1) as f64 * r >= best {
@@ -422,17 +445,23 @@ pub fn exact_clearance(
             // On the ring's faces in z every y belongs to the ring; inside them only
             // its two y faces do.
             let step = if dz.abs() == k { 1 } else { (2 * k).max(1) };
-            let gz = slab(2, c0[2] + dz);
+            let gz = gz[(dz + rings) as usize];
+            // Rows whose square distance exceeds this are as far as `best` or farther
+            // by `sqrt` too (the factor covers rounding): no plane or row beyond it
+            // holds a cube nearer than `best`. The few within it are read.
+            let skip = best * best * (1.0 + 1e-12);
+            if gz * gz > skip {
+                continue;
+            }
             for dy in (-k..=k).step_by(step as usize) {
-                let (y, z) = (c0[1] + dy, c0[2] + dz);
-                let gy = slab(1, y);
-                if (gy * gy + gz * gz).sqrt() >= best {
+                let gy = gy[(dy + rings) as usize];
+                let yz = gy * gy + gz * gz;
+                if yz > skip {
                     continue;
                 }
+                let (y, z) = (c0[1] + dy, c0[2] + dz);
                 // The row's raw states and gaps; `None` outside the grid.
-                let row = g
-                    .row_start(y, z)
-                    .map(|start| (g.raw_row_at(start), field.row_gaps_at(start)));
+                let row = cells(y, z).map(|start| (g.raw_row_at(start), field.row_gaps_at(start)));
                 let candidates = row_candidates(g, c0[0], row);
                 if let Candidates::Beyond(gap) = candidates {
                     if gap as f64 * r >= best {
@@ -445,9 +474,13 @@ pub fn exact_clearance(
                             .ok()
                             .and_then(|i| cells.get(i).copied())
                     });
-                    if g.is_obstacle_raw(raw) {
-                        let c = g.voxel_center([x, y, z]);
-                        best = best.min(point_box_distance(p, c - half, c + half));
+                    let obstacle = match raw {
+                        Some(v) => v == 1 || (v > 1 && unknown),
+                        None => unknown,
+                    };
+                    if obstacle {
+                        let gx = slab(0, x);
+                        best = best.min((gx * gx + gy * gy + gz * gz).sqrt());
                     }
                     best <= stop
                 };
@@ -463,6 +496,10 @@ pub fn exact_clearance(
     }
     best
 }
+
+/// Row offsets per axis whose slabs [`exact_clearance`] keeps on the stack: a
+/// 1.5 m cap at 0.05 m.
+const STACK_SPAN: usize = 65;
 
 /// Where the obstacle cubes of a row nearest a point in lattice column `x` can be.
 enum Candidates {
