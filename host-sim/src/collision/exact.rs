@@ -161,7 +161,10 @@ pub fn nearest_obstacle(
                 let (zs, ys, xs) = (span(2, bz), span(1, by), span(0, bx));
                 for z in zs.0..=zs.1 {
                     for y in ys.0..=ys.1 {
-                        for x in xs.0..=xs.1 {
+                        let Some((first, last)) = search.row_span(y, z, xs) else {
+                            continue;
+                        };
+                        for x in first..=last {
                             search.visit(grid, [x, y, z]);
                         }
                     }
@@ -208,6 +211,43 @@ impl Search {
             half_diag: 0.5 * resolution * 3f64.sqrt(),
             best: None,
         }
+    }
+
+    /// The voxels of row `(y, z)` among `xs` that may hold a cube within the search's
+    /// limit; `None` when none can. For a point, a row is left out when the point is
+    /// farther from the whole row (across it, in y and z) than the limit, and of the
+    /// others only the voxels whose own gap along x leaves room are kept; both
+    /// compare squares with a relative allowance, so that rounding never leaves out a
+    /// cube the voxel-by-voxel test would take. A segment's rows are read whole (a
+    /// bound for them costs more than the few voxels a block's row holds).
+    fn row_span(&self, y: i64, z: i64, xs: (i64, i64)) -> Option<(i64, i64)> {
+        if self.a != self.b {
+            return Some(xs);
+        }
+        let p = self.a;
+        let limit = self
+            .best
+            .map_or(self.reach, |(n, _)| n.distance.min(self.reach));
+        let r = 2.0 * self.half;
+        // How far p lies from the row's faces along an axis, as `point_box_distance`
+        // measures it from a voxel's.
+        let gap = |a: usize, i: i64| {
+            let c = (i as f64 + 0.5) * r;
+            ((c - self.half) - p[a])
+                .max(p[a] - (c + self.half))
+                .max(0.0)
+        };
+        let (gy, gz) = (gap(1, y), gap(2, z));
+        let room = limit * limit * (1.0 + 1e-12) - (gy * gy + gz * gz);
+        if room < 0.0 {
+            return None;
+        }
+        // Voxels more than `room.sqrt()` from p along x hold no cube within the limit
+        // (with a voxel to spare).
+        let along = (room.sqrt() / r).floor() as i64 + 2;
+        let x = (p[0] / r).floor() as i64;
+        let (first, last) = (xs.0.max(x - along), xs.1.min(x + along));
+        (first <= last).then_some((first, last))
     }
 
     /// Measures lattice voxel `i` when it is an obstacle.
@@ -402,9 +442,8 @@ pub fn exact_clearance(
     let r = g.resolution();
     let c0 = g.lattice_index(p);
     let rings = (cap / r).ceil() as i32 + 1;
-    let (origin, dims) = (g.origin(), g.dims());
-    let x0 = origin[0];
-    let nx = dims[0];
+    // Lattice x of every row's first voxel.
+    let x0 = g.origin()[0];
     let mut best = cap;
     // How far `p` lies from the slab of voxels `i` along axis `a`, as
     // `point_box_distance` measures it (so that a row skipped by it holds no cube
@@ -430,12 +469,6 @@ pub fn exact_clearance(
         slabs[span + d] = slab(2, c0[2] + o);
     }
     let (gy, gz) = slabs.split_at(span);
-    let cells = |y: i32, z: i32| {
-        let (ly, lz) = (y as i64 - origin[1] as i64, z as i64 - origin[2] as i64);
-        (ly >= 0 && lz >= 0 && (ly as usize) < dims[1] && (lz as usize) < dims[2])
-            .then(|| (lz as usize * dims[1] + ly as usize) * nx)
-    };
-    let unknown = g.unknown_is_occupied();
     for k in 0..=rings {
         // Every cube of a row in ring k is at least (k - 1) r away.
         if (k - 1) as f64 * r >= best {
@@ -461,7 +494,9 @@ pub fn exact_clearance(
                 }
                 let (y, z) = (c0[1] + dy, c0[2] + dz);
                 // The row's raw states and gaps; `None` outside the grid.
-                let row = cells(y, z).map(|start| (g.raw_row_at(start), field.row_gaps_at(start)));
+                let row = g
+                    .row_start(y, z)
+                    .map(|start| (g.raw_row_at(start), field.row_gaps_at(start)));
                 let candidates = row_candidates(g, c0[0], row);
                 if let Candidates::Beyond(gap) = candidates {
                     if gap as f64 * r >= best {
@@ -474,11 +509,7 @@ pub fn exact_clearance(
                             .ok()
                             .and_then(|i| cells.get(i).copied())
                     });
-                    let obstacle = match raw {
-                        Some(v) => v == 1 || (v > 1 && unknown),
-                        None => unknown,
-                    };
-                    if obstacle {
+                    if g.is_obstacle_raw(raw) {
                         let gx = slab(0, x);
                         best = best.min((gx * gx + gy * gy + gz * gz).sqrt());
                     }
