@@ -475,9 +475,6 @@ pub fn exact_clearance(
             break;
         }
         for dz in -k..=k {
-            // On the ring's faces in z every y belongs to the ring; inside them only
-            // its two y faces do.
-            let step = if dz.abs() == k { 1 } else { (2 * k).max(1) };
             let gz = gz[(dz + rings) as usize];
             // Rows whose square distance exceeds this are as far as `best` or farther
             // by `sqrt` too (the factor covers rounding): no plane or row beyond it
@@ -486,6 +483,9 @@ pub fn exact_clearance(
             if gz * gz > skip {
                 continue;
             }
+            // On the ring's faces in z every y belongs to the ring; inside them only
+            // its two y faces do.
+            let step = if dz.abs() == k { 1 } else { (2 * k).max(1) };
             for dy in (-k..=k).step_by(step as usize) {
                 let gy = gy[(dy + rings) as usize];
                 let yz = gy * gy + gz * gz;
@@ -511,7 +511,12 @@ pub fn exact_clearance(
                     });
                     if g.is_obstacle_raw(raw) {
                         let gx = slab(0, x);
-                        best = best.min((gx * gx + gy * gy + gz * gz).sqrt());
+                        // As `point_box_distance` sums the squares; a square beyond
+                        // `skip` is no nearer by `sqrt` either.
+                        let s = gx * gx + gy * gy + gz * gz;
+                        if s <= skip {
+                            best = best.min(s.sqrt());
+                        }
                     }
                     best <= stop
                 };
