@@ -130,8 +130,9 @@ pub struct Nearest {
 /// examined (a voxel outside it is more than `reach` away along some axis), including
 /// voxels outside the grid (unknown, obstacles when unknown space counts as occupied),
 /// except those in blocks the grid proves free of obstacles
-/// ([`Grid::block_may_hold_obstacle`]). Of several cubes at the same distance, the one
-/// first in z, then y, then x.
+/// ([`Grid::block_may_hold_obstacle`]) and, for a point, those of rows or stretches of
+/// rows that lie beyond the limit (`Search::row_span`). Of several cubes at the same
+/// distance, the one first in z, then y, then x.
 pub fn nearest_obstacle(
     grid: &Grid,
     a: impl Into<Point3<f64>>,

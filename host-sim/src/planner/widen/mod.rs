@@ -17,7 +17,8 @@
 //! against voxel cube) at twice the verifier's sample spacing; within `r_v` of the cap
 //! the distance field's bound stands in for it. A move is judged by whether the
 //! edges it touches stay above their floors, which measures far less than finding
-//! their narrowest (most moves fail); an edge no move widens is given up with the
+//! their narrowest (most moves fail, and a look at the unit that was narrowest
+//! settles most of those); an edge no move widens is given up with the
 //! edges stuck at the same pinch ([`SAME_PINCH`]).
 //!
 //! An edge is judged by its narrowest sample, which lies in one passage; a second
