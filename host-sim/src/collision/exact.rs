@@ -230,16 +230,8 @@ impl Search {
             .best
             .map_or(self.reach, |(n, _)| n.distance.min(self.reach));
         let r = 2.0 * self.half;
-        // How far p lies from the row's faces along an axis, as `point_box_distance`
-        // measures it from a voxel's.
-        let gap = |a: usize, i: i64| {
-            let c = (i as f64 + 0.5) * r;
-            ((c - self.half) - p[a])
-                .max(p[a] - (c + self.half))
-                .max(0.0)
-        };
-        let (gy, gz) = (gap(1, y), gap(2, z));
-        let room = limit * limit * (1.0 + 1e-12) - (gy * gy + gz * gz);
+        let (gy, gz) = (slab_gap(r, p[1], y), slab_gap(r, p[2], z));
+        let room = limit * limit * SQUARE_ALLOWANCE - (gy * gy + gz * gz);
         if room < 0.0 {
             return None;
         }
@@ -446,13 +438,7 @@ pub fn exact_clearance(
     // Lattice x of every row's first voxel.
     let x0 = g.origin()[0];
     let mut best = cap;
-    // How far `p` lies from the slab of voxels `i` along axis `a`, as
-    // `point_box_distance` measures it (so that a row skipped by it holds no cube
-    // nearer than `best`, to the bit).
-    let slab = |a: usize, i: i32| {
-        let c = (i as f64 + 0.5) * r;
-        ((c - r / 2.0) - p[a]).max(p[a] - (c + r / 2.0)).max(0.0)
-    };
+    let slab = |a: usize, i: i32| slab_gap(r, p[a], i.into());
     // The slabs of every row offset in y, then in z: on the stack unless the cap
     // is far beyond what the planner asks for.
     let span = (2 * rings + 1) as usize;
@@ -480,7 +466,7 @@ pub fn exact_clearance(
             // Rows whose square distance exceeds this are as far as `best` or farther
             // by `sqrt` too (the factor covers rounding): no plane or row beyond it
             // holds a cube nearer than `best`. The few within it are read.
-            let skip = best * best * (1.0 + 1e-12);
+            let skip = best * best * SQUARE_ALLOWANCE;
             if gz * gz > skip {
                 continue;
             }
@@ -533,6 +519,20 @@ pub fn exact_clearance(
     }
     best
 }
+
+/// How far the coordinate `v` lies from the slab of voxels `i` (lattice index,
+/// resolution `r`) along its axis, as `point_box_distance` measures it from a voxel's
+/// faces: a row or plane left out by it holds no cube nearer, to the bit.
+#[inline]
+fn slab_gap(r: f64, v: f64, i: i64) -> f64 {
+    let c = (i as f64 + 0.5) * r;
+    ((c - r / 2.0) - v).max(v - (c + r / 2.0)).max(0.0)
+}
+
+/// A square distance beyond `best * best` times this is at or beyond `best` by `sqrt`
+/// too: the factor covers the rounding of both, so a row, plane or cube left out by
+/// squares is one `sqrt` would leave out.
+const SQUARE_ALLOWANCE: f64 = 1.0 + 1e-12;
 
 /// Row offsets per axis whose slabs [`exact_clearance`] keeps on the stack: a
 /// 1.5 m cap at 0.05 m.
