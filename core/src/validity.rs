@@ -12,7 +12,7 @@ use crate::geometry::{
 };
 use nalgebra::Vector3;
 
-use crate::kinematics::{directions, link_direction, offsets, offsets_from, Points};
+use crate::kinematics::{directions, link_direction, offsets_from, Points};
 use crate::params::{ChainParams, MAX_LINKS};
 use crate::shape::Shape;
 
@@ -264,8 +264,12 @@ fn safe_step(
     margin: f32,
 ) -> Result<f32, Violation> {
     let mut dt = f32::INFINITY;
+    // Each link's direction once, for the bends and the unit centres alike.
+    let dirs = directions(s);
     for k in 0..s.links().saturating_sub(1) {
-        let slack = params.beta_max - bend(s, k);
+        // The same value as `bend`, from the directions at hand.
+        let bend = libm::acosf(dirs[k].dot(&dirs[k + 1]).clamp(-1.0, 1.0));
+        let slack = params.beta_max - bend;
         if slack < margin {
             return Err(Violation::Bend(k as u8));
         }
@@ -274,7 +278,7 @@ fn safe_step(
             dt = dt.min(slack / r);
         }
     }
-    let p = offsets(params, s);
+    let p = offsets_from(params, &dirs, s.links());
     let mut err = None;
     visit_pairs(params, s.units(), &p, |x, y, gap| {
         if gap < margin {
@@ -300,6 +304,7 @@ fn safe_step(
 mod tests {
     use super::*;
     use crate::angle::deg;
+    use crate::kinematics::offsets;
 
     proptest::proptest! {
         /// The squared-distance test of `check_shape` finds a collision exactly
