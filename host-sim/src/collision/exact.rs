@@ -11,7 +11,7 @@ use nalgebra::{Point3, Vector3};
 use super::OutOfBounds;
 use crate::map::blocks::BLOCK;
 use crate::map::distance::DistanceField;
-use crate::map::grid::Grid;
+use crate::map::grid::{floor, Grid};
 use crate::map::row_gaps::FAR;
 
 /// Distance from point `p` to the closed box `lo..hi`.
@@ -185,8 +185,8 @@ fn search_box(grid: &Grid, a: Point3<f64>, b: Point3<f64>, reach: f64) -> ([i64;
     for ax in 0..3 {
         let (mn, mx) = (a[ax].min(b[ax]) - reach, a[ax].max(b[ax]) + reach);
         // Voxel i spans [i r, (i + 1) r]: it touches [mn, mx] when i r <= mx and (i+1) r >= mn.
-        lo[ax] = (mn / r).floor() as i64 - 1;
-        hi[ax] = (mx / r).floor() as i64 + 1;
+        lo[ax] = floor(mn / r) as i64 - 1;
+        hi[ax] = floor(mx / r) as i64 + 1;
     }
     (lo, hi)
 }
@@ -237,8 +237,8 @@ impl Search {
         }
         // Voxels more than `room.sqrt()` from p along x hold no cube within the limit
         // (with a voxel to spare).
-        let along = (room.sqrt() / r).floor() as i64 + 2;
-        let x = (p[0] / r).floor() as i64;
+        let along = floor(room.sqrt() / r) as i64 + 2;
+        let x = floor(p[0] / r) as i64;
         let (first, last) = (xs.0.max(x - along), xs.1.min(x + along));
         (first <= last).then_some((first, last))
     }

@@ -48,7 +48,7 @@ use std::sync::OnceLock;
 
 use nalgebra::Point3;
 
-use super::grid::Grid;
+use super::grid::{floor, Grid};
 
 /// Size of the exact `G(n)` table.
 const G_TABLE: usize = 4096;
@@ -318,6 +318,14 @@ impl Columns {
     }
 }
 
+/// A local index from its value in `f64` (a whole number in `0..dims`), by way of
+/// `u32`: grids are far smaller along every axis, and the conversion to `u64`
+/// costs several times more.
+#[inline]
+fn local(li: f64) -> usize {
+    li as u32 as usize
+}
+
 /// Rounds a non-negative `f64` down to an `f32`.
 fn f32_down(v: f64) -> f32 {
     let f = v as f32;
@@ -338,6 +346,9 @@ pub struct DistanceField {
     /// Per voxel, how far along its row the nearest obstacle voxel lies
     /// ([`super::row_gaps`]): for exact distances.
     row_gaps: Vec<u8>,
+    /// The grid's dimensions as `f64`, which every query compares against (the
+    /// conversion costs more than the comparison).
+    extent: [f64; 3],
 }
 
 impl DistanceField {
@@ -356,7 +367,13 @@ impl DistanceField {
             })
             .collect();
         let row_gaps = super::row_gaps::row_gaps(&grid);
-        DistanceField { grid, lb, row_gaps }
+        let extent = grid.dims().map(|d| d as f64);
+        DistanceField {
+            grid,
+            lb,
+            row_gaps,
+            extent,
+        }
     }
 
     /// The grid the field was built from.
@@ -390,7 +407,7 @@ impl DistanceField {
         let rel = q - self.grid.origin()[a] as f64;
         // For the integer bound `dims`, `rel` and `rel.floor()` fall on the same side, so
         // the fine and the coarse query agree on what is outside.
-        if (rel < 0.0 || rel >= self.grid.dims()[a] as f64) && self.grid.unknown_is_occupied() {
+        if (rel < 0.0 || rel >= self.extent[a]) && self.grid.unknown_is_occupied() {
             return None;
         }
         Some(rel)
@@ -422,11 +439,11 @@ impl DistanceField {
                 return 0.0;
             };
             // Centres bracketing p: local indices floor(rel - 0.5) and + 1, clamped.
-            let lo = (rel - 0.5).floor();
-            let max = (dims[a] - 1) as f64;
+            let lo = floor(rel - 0.5);
+            let max = self.extent[a] - 1.0;
             for (j, v) in [lo, lo + 1.0].into_iter().enumerate() {
                 let li = v.clamp(0.0, max);
-                idx[a][j] = li as usize;
+                idx[a][j] = local(li);
                 d2[a][j] = self.centre_gap_sq(p[a], li, a);
             }
         }
@@ -462,9 +479,9 @@ impl DistanceField {
             let Some(rel) = self.grid_coordinate(p[a], a) else {
                 return 0.0;
             };
-            let rel = rel.floor();
-            let li = rel.clamp(0.0, (dims[a] - 1) as f64);
-            l[a] = li as usize;
+            let rel = floor(rel);
+            let li = rel.clamp(0.0, self.extent[a] - 1.0);
+            l[a] = local(li);
             d2 += self.centre_gap_sq(p[a], li, a);
         }
         let v = self.lb[l[0] + dims[0] * (l[1] + dims[1] * l[2])] as f64;

@@ -288,11 +288,8 @@ impl Grid {
     /// voxel above it). Saturates far outside the `i32` range.
     pub fn lattice_index(&self, p: impl Into<Point3<f64>>) -> [i32; 3] {
         let p = p.into();
-        [p.x, p.y, p.z].map(|v| {
-            (v / self.resolution)
-                .floor()
-                .clamp(i32::MIN as f64, i32::MAX as f64) as i32
-        })
+        [p.x, p.y, p.z]
+            .map(|v| floor(v / self.resolution).clamp(i32::MIN as f64, i32::MAX as f64) as i32)
     }
 
     /// Centre of the voxel with lattice index `i` (m).
@@ -502,9 +499,75 @@ impl Grid {
     }
 }
 
+/// `v.floor()`, exactly, without a library call: the baseline x86-64 target has no
+/// rounding instruction, so `f64::floor` is a call there, and the lattice lookups of
+/// the distance field and the exact searches make millions of them. Where `floor`
+/// gives `-0.0` this may give `+0.0`; every caller casts the result to an integer or
+/// adds to it, which cannot tell them apart.
+#[inline]
+pub(crate) fn floor(v: f64) -> f64 {
+    // Below 2^52 in magnitude the cast truncates exactly; truncation is the floor
+    // except below zero off the integers.
+    if v.abs() < 4_503_599_627_370_496.0 {
+        let t = v as i64 as f64;
+        if t > v {
+            t - 1.0
+        } else {
+            t
+        }
+    } else {
+        v.floor()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `floor` is `f64::floor` up to the sign of a zero, everywhere.
+    #[test]
+    fn floor_matches_the_library() {
+        let same = |v: f64| {
+            let (a, b) = (floor(v), v.floor());
+            assert!(a == b || (a.is_nan() && b.is_nan()), "{v}: {a} vs {b}");
+        };
+        let big = 4_503_599_627_370_496.0f64;
+        for v in [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            -1e-300,
+            1e-300,
+            2.5,
+            -2.5,
+            big,
+            -big,
+            big - 0.5,
+            -(big - 0.5),
+            big * 4.0,
+            f64::MAX,
+            f64::MIN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            -0.999_999_999_999_999_9,
+            1.0 - f64::EPSILON,
+        ] {
+            same(v);
+        }
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..100_000 {
+            // xorshift: bit patterns of every magnitude and sign.
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            same(f64::from_bits(x));
+            same((x % 2_000_001) as f64 / 1000.0 - 1000.0);
+        }
+    }
 
     #[test]
     fn the_obstacle_summary_counts_every_write() {
