@@ -319,10 +319,10 @@ impl Columns {
 }
 
 /// A local index from its value in `f64` (a whole number in `0..dims`), by way of
-/// `u32`: grids are far smaller along every axis, and the conversion to `u64`
-/// costs several times more.
+/// `u32`: a grid spans fewer than 2^32 voxels along every axis (its lattice indices
+/// are `i32`), and the conversion to `u64` costs several times more.
 #[inline]
-fn local(li: f64) -> usize {
+fn local_index(li: f64) -> usize {
     li as u32 as usize
 }
 
@@ -443,7 +443,7 @@ impl DistanceField {
             let max = self.extent[a] - 1.0;
             for (j, v) in [lo, lo + 1.0].into_iter().enumerate() {
                 let li = v.clamp(0.0, max);
-                idx[a][j] = local(li);
+                idx[a][j] = local_index(li);
                 d2[a][j] = self.centre_gap_sq(p[a], li, a);
             }
         }
@@ -481,7 +481,7 @@ impl DistanceField {
             };
             let rel = floor(rel);
             let li = rel.clamp(0.0, self.extent[a] - 1.0);
-            l[a] = local(li);
+            l[a] = local_index(li);
             d2 += self.centre_gap_sq(p[a], li, a);
         }
         let v = self.lb[l[0] + dims[0] * (l[1] + dims[1] * l[2])] as f64;
