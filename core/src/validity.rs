@@ -79,7 +79,12 @@ impl core::fmt::Display for Violation {
 pub fn bend(shape: &Shape, k: usize) -> f32 {
     let a = link_direction(shape.pitch(k), shape.yaw(k));
     let b = link_direction(shape.pitch(k + 1), shape.yaw(k + 1));
-    libm::acosf(a.dot(&b).clamp(-1.0, 1.0))
+    bend_between(&a, &b)
+}
+
+/// The angle between two link directions (rad): [`bend`] from directions at hand.
+fn bend_between(a: &Vector3<f32>, b: &Vector3<f32>) -> f32 {
+    libm::acosf(a.dot(b).clamp(-1.0, 1.0))
 }
 
 /// Joint limits only: pitch of every link, bend between consecutive links.
@@ -99,8 +104,7 @@ fn limits_with(
         }
     }
     for k in 0..shape.links().saturating_sub(1) {
-        // The same value as `bend`, from the directions at hand.
-        if libm::acosf(dirs[k].dot(&dirs[k + 1]).clamp(-1.0, 1.0)) > params.beta_max {
+        if bend_between(&dirs[k], &dirs[k + 1]) > params.beta_max {
             return Err(Violation::Bend(k as u8));
         }
     }
@@ -267,9 +271,7 @@ fn safe_step(
     // Each link's direction once, for the bends and the unit centres alike.
     let dirs = directions(s);
     for k in 0..s.links().saturating_sub(1) {
-        // The same value as `bend`, from the directions at hand.
-        let bend = libm::acosf(dirs[k].dot(&dirs[k + 1]).clamp(-1.0, 1.0));
-        let slack = params.beta_max - bend;
+        let slack = params.beta_max - bend_between(&dirs[k], &dirs[k + 1]);
         if slack < margin {
             return Err(Violation::Bend(k as u8));
         }
