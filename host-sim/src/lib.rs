@@ -18,7 +18,9 @@
 //! - [`sim`]: [`sim::simulate`], [`sim::Flight`];
 //! - [`trajectory`]: [`trajectory::build`], a plan timed and blended into a
 //!   trajectory, its exact check and its file;
-//! - [`picture`]: figures, plan and map pictures (SVG, PNG).
+//! - [`picture`]: figures, plan and map pictures (SVG, PNG);
+//! - [`export`]: a trajectory or flight as a ROS 2 bag (MCAP) or per-unit MAVLink
+//!   setpoints (`.tlog`).
 //!
 //! ```
 //! use std::sync::atomic::AtomicUsize;
@@ -51,6 +53,7 @@
 
 pub mod baseline;
 pub mod collision;
+pub mod export;
 mod fsutil;
 pub mod map;
 pub mod picture;

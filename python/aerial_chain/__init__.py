@@ -11,10 +11,11 @@ the Rust library ``aerial_chain`` (the ``arc`` command line uses the same code):
     ac.verify(world, plan)                           # raises VerifyError if INVALID
     plan.unit_positions()                            # (waypoints, N, 3) numpy array
     flight = ac.simulate(world, plan)                # flight.unit_positions: (T, N, 3)
+    ac.export(world, plan, "window.mcap")            # a ROS 2 bag; .tlog: MAVLink
 
-Bad input raises ``MapError``, ``PlanError``, ``VerifyError`` or ``SimError``, all
-subclasses of ``ArcError`` (a ``ValueError``), with a message naming the file, field
-or argument and the value.
+Bad input raises ``MapError``, ``PlanError``, ``VerifyError``, ``SimError`` or
+``ExportError``, all subclasses of ``ArcError`` (a ``ValueError``), with a message
+naming the file, field or argument and the value.
 """
 
 from . import _native
@@ -22,6 +23,7 @@ from ._native import (
     DEFAULT_CLEARANCE,
     SCENARIOS,
     ArcError,
+    ExportError,
     Flight,
     Map,
     MapError,
@@ -30,6 +32,7 @@ from ._native import (
     SimError,
     VerifyError,
     VerifyReport,
+    export,
     plan,
     simulate,
     verify,

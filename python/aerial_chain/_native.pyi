@@ -15,6 +15,7 @@ _Point = Union[Sequence[float], NDArray[np.float64]]
 __all__ = [
     "ArcError",
     "DEFAULT_CLEARANCE",
+    "ExportError",
     "Flight",
     "Map",
     "MapError",
@@ -24,6 +25,7 @@ __all__ = [
     "SimError",
     "VerifyError",
     "VerifyReport",
+    "export",
     "plan",
     "simulate",
     "verify",
@@ -49,6 +51,9 @@ class VerifyError(ArcError):
 
 class SimError(ArcError):
     """The simulation cannot fly the plan: settings outside their limits, a plan it cannot time."""
+
+class ExportError(ArcError):
+    """An export that cannot be made: an output name that is no .mcap or .tlog, options outside their limits."""
 
 @final
 class Map:
@@ -219,3 +224,17 @@ def simulate(
 ) -> Flight:
     """Flies ``plan`` on ``map`` with the chain's dynamics and control stack (``arc
     sim``); raises ``SimError`` for settings outside their limits."""
+
+def export(
+    map: Map,
+    source: Union[Plan, Flight],
+    path: _Path,
+    rate: float = 50.0,
+    sysid_base: int = 1,
+    hold_s: float = 1.0,
+    arm: bool = False,
+    autopilot: str = "px4",
+) -> int:
+    """Writes a plan (timed as ``arc trajectory`` times it) or a flight as ``arc export``
+    does: a ROS 2 bag when ``path`` ends in ``.mcap``, MAVLink 2 setpoints when it ends
+    in ``.tlog``; returns the bytes written; raises ``ExportError``."""

@@ -6,7 +6,8 @@
 //! - `map::Map`: an OctoMap `.bt` file or a built-in scenario;
 //! - `plan::plan` (the ARCplanner with the defaults of `arc plan`), `plan::Plan`
 //!   (the `arc-plan/1` file), `plan::verify` (the exact verifier of docs/model.md);
-//! - `sim::simulate` and `sim::Flight`, the chain flown by its control stack.
+//! - `sim::simulate` and `sim::Flight`, the chain flown by its control stack;
+//! - `export::export`, a plan or flight as a ROS 2 bag or MAVLink setpoints.
 //!
 //! Configurations and flights come out as NumPy arrays. Bad input raises one of the
 //! exceptions below, all subclasses of `ArcError`, itself a `ValueError`, with the
@@ -17,6 +18,7 @@
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+mod export;
 mod map;
 mod plan;
 mod sim;
@@ -44,6 +46,12 @@ pyo3::create_exception!(
     VerifyError,
     ArcError,
     "The exact verifier found the plan INVALID on the map (the message says where)."
+);
+pyo3::create_exception!(
+    aerial_chain,
+    ExportError,
+    ArcError,
+    "An export that cannot be made: an output name that is no .mcap or .tlog, options outside their limits."
 );
 pyo3::create_exception!(
     aerial_chain,
@@ -75,6 +83,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("PlanError", py.get_type::<PlanError>())?;
     m.add("VerifyError", py.get_type::<VerifyError>())?;
     m.add("SimError", py.get_type::<SimError>())?;
+    m.add("ExportError", py.get_type::<ExportError>())?;
     m.add(
         "DEFAULT_CLEARANCE",
         aerial_chain::collision::DEFAULT_CLEARANCE,
@@ -90,5 +99,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(plan::verify, m)?)?;
     m.add_function(wrap_pyfunction!(sim::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(export::export, m)?)?;
     Ok(())
 }

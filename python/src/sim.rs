@@ -15,10 +15,14 @@ use crate::{err, json_to_py, SimError};
 /// its report. Arrays are indexed by sample first (`T` samples), then by unit.
 #[pyclass(module = "aerial_chain", frozen)]
 pub struct Flight {
+    /// The chain flown.
+    pub(crate) params: aerial_chain_core::ChainParams,
     /// The recorded samples.
-    samples: Vec<Sample>,
+    pub(crate) samples: Vec<Sample>,
     /// The summary of the whole flight.
-    report: FlightReport,
+    pub(crate) report: FlightReport,
+    /// One simulation step in this many is recorded.
+    pub(crate) record_every: usize,
 }
 
 impl Flight {
@@ -173,7 +177,9 @@ pub fn simulate(
         })
         .map_err(err::<SimError>)?;
     Ok(Flight {
+        params,
         samples: flight.samples.into_iter().step_by(record_every).collect(),
         report: flight.report,
+        record_every,
     })
 }

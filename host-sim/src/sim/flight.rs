@@ -16,7 +16,7 @@ use aerial_chain_core::kinematics::Points;
 use aerial_chain_core::validity::visit_pairs;
 use aerial_chain_core::{ChainParams, MAX_UNITS};
 use nalgebra::{UnitQuaternion, Vector3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::controller::ControlOutput;
 use super::controller::{ChainController, ControllerConfig};
@@ -208,7 +208,7 @@ fn check_budget(n: usize, t_ref: f64, cfg: &SimConfig) -> Result<usize, SimError
 }
 
 /// A recorded body state, compact (`f32`).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BodySample {
     /// Position (m).
     pub p: [f32; 3],
@@ -234,7 +234,7 @@ impl BodySample {
 }
 
 /// Everything recorded at one step.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Sample {
     /// Time (s).
     pub t: f64,
@@ -257,7 +257,7 @@ pub struct Sample {
 }
 
 /// Joint-limit excursions of the flown chain.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LimitExcursions {
     /// Largest `|theta_i| - theta_max` seen, if positive (deg).
     pub max_pitch_excess_deg: f64,
@@ -268,7 +268,7 @@ pub struct LimitExcursions {
 }
 
 /// The flight's summary.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FlightReport {
     /// Number of units.
     pub units: usize,

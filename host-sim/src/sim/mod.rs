@@ -7,6 +7,7 @@
 //! - `mpc`: the head's position MPC (a second-order-cone QP solved by clarabel);
 //! - `controller`: link controllers, mixer and unit attitude loops (paper Fig. 3);
 //! - `flight`: [`simulate`], the recorded flight and its report;
+//! - `file`: [`FlightFile`], the `arc-sim/1` flight file;
 //! - `clearance`: the exact clearance of the flown chain to a map;
 //! - `plot`: SVG plots of a flight.
 
@@ -14,6 +15,7 @@ mod bodies;
 pub(crate) mod clearance;
 pub(crate) mod controller;
 pub(crate) mod dynamics;
+mod file;
 pub(crate) mod flight;
 pub(crate) mod model;
 pub(crate) mod mpc;
@@ -69,6 +71,7 @@ pub use flight::BodySample;
 
 pub use controller::{ChainController, ControllerConfig};
 pub use dynamics::{BodyState, ChainDynamics, Formulation, UnitCommand, V3};
+pub use file::{FlightFile, FlightFileError, FORMAT as FLIGHT_FORMAT};
 pub use flight::{
     simulate, simulate_reference, simulate_with_progress, Flight, FlightReport, Gust, Obstacles,
     Progress, Sample, SimConfig, SimError,

@@ -153,7 +153,7 @@ pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
         }
         let merged_m = motions.merged;
         let reference = Reference::from_segments(params.n(), &waypoints[0], segments);
-        let (times, zetas) = sample(&reference, settings.dt);
+        let (times, zetas) = sample(&reference, settings.dt)?;
         let windows = windows(reference.segments(), &blend_m, &merged_m, settings.dt);
         let margin = settings.clearance;
         let required = |t: f64| match windows.iter().any(|w| w.0 <= t && t <= w.1) {
@@ -251,14 +251,20 @@ fn merged_near(segments: &[Segment], merged: &[bool], v: &Violation, dt: f64) ->
 
 /// The samples of `r`: every multiple of `dt` up to the first at or after its end (an
 /// unblended edge starts on one, so the chain is sampled at rest at its waypoint).
-fn sample(r: &Reference, dt: f64) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let last = ((r.duration() / dt) - 1e-9).ceil().max(0.0) as usize;
-    (0..=last)
+/// Blends are timed by the limits, not by the plan's stop-and-go length, so the
+/// budget is checked here again, before the samples are made.
+fn sample(r: &Reference, dt: f64) -> Result<(Vec<f64>, Vec<Vec<f64>>), TrajectoryError> {
+    let last = ((r.duration() / dt) - 1e-9).ceil().max(0.0);
+    // `max` has made a NaN duration 0; `as` saturates an infinite one.
+    if last >= MAX_SAMPLES as f64 {
+        return Err(TrajectoryError::TooLong(last as usize));
+    }
+    Ok((0..=last as usize)
         .map(|j| {
             let t = j as f64 * dt;
             (t, r.zeta(t))
         })
-        .unzip()
+        .unzip())
 }
 
 /// The blended corner whose overlap (two samples either side) holds `v`.

@@ -11,6 +11,7 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 mod bench;
 mod checks;
 mod common;
+mod export;
 #[path = "../../fsutil.rs"]
 mod fsutil;
 mod map;
@@ -114,6 +115,9 @@ enum Command {
     /// flies with its default limits; a flight keeps its own times. `view.html#t=3.5`
     /// opens at 3.5 s.
     View(view::ViewArgs),
+    /// Export a plan, trajectory or flight for robot software: a ROS 2 bag (.mcap) or
+    /// per-unit MAVLink offboard setpoints (.tlog).
+    Export(Box<export::ExportArgs>),
 }
 
 /// The command line, where every option that takes a value takes a negative number
@@ -180,6 +184,7 @@ where
         Command::Bench(c) => bench::run(c),
         Command::Sim(a) => sim::run(a),
         Command::View(a) => view::run(a),
+        Command::Export(a) => export::run(*a),
     }
 }
 

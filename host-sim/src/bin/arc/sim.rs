@@ -6,7 +6,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use clap::Args;
-use serde::Serialize;
 
 use super::checks;
 use super::common::{looser_assumption, read_plan, MapArgs, MotionArgs, MotionFile, Report};
@@ -19,7 +18,7 @@ use aerial_chain::sim::Reference;
 use aerial_chain::sim::V3;
 use aerial_chain::sim::{footprint, MapClearance};
 use aerial_chain::sim::{
-    simulate_reference, simulate_with_progress, FlightReport, Gust, Progress, Sample, SimConfig,
+    simulate_reference, simulate_with_progress, FlightFile, Gust, Progress, SimConfig,
 };
 use aerial_chain::trajectory::{self, Trajectory, TrajectoryError};
 
@@ -65,17 +64,6 @@ pub struct SimArgs {
     /// Keep one recorded step in this many in the JSON output.
     #[arg(long, default_value_t = 10)]
     record_every: usize,
-}
-
-/// The JSON written by `--out`.
-#[derive(Serialize)]
-struct SimFile<'a> {
-    format: &'static str,
-    plan: String,
-    map: String,
-    report: &'a FlightReport,
-    record_every: usize,
-    samples: Vec<&'a Sample>,
 }
 
 fn parse_gust(s: &str) -> Result<Gust, CliError> {
@@ -373,18 +361,9 @@ fn write_flight(
     plan_name: &str,
     flight: &aerial_chain::sim::Flight,
 ) -> Result<(), CliError> {
-    let file = SimFile {
-        format: "arc-sim/1",
-        plan: plan_name.to_string(),
-        map: a.map.name(),
-        report: &flight.report,
-        record_every: a.record_every,
-        samples: flight.samples.iter().step_by(a.record_every).collect(),
-    };
-    let text = serde_json::to_string(&file)
-        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
-    crate::fsutil::write_output(path, text.as_bytes())
-        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))
+    FlightFile::new(flight, plan_name, &a.map.name(), a.record_every)
+        .write(path)
+        .map_err(|e| CliError::input(e.to_string()))
 }
 
 /// Draws the flight over the map's footprint in the height band the chain flew.

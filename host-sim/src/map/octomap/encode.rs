@@ -46,6 +46,14 @@ impl OcTree {
         let header = header_text(Kind::Binary, self.stats.nodes, self.resolution);
         let mut out = Vec::with_capacity(header.len() + 2 * self.codes.len());
         out.extend_from_slice(header.as_bytes());
+        out.extend_from_slice(&self.to_binary_stream());
+        out
+    }
+
+    /// The tree's nodes as OctoMap's `writeBinaryData` writes them: a `.bt` file
+    /// without its header, what an `octomap_msgs/Octomap` with `binary = true` carries.
+    pub fn to_binary_stream(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(2 * self.codes.len());
         for code in self.preorder() {
             out.extend_from_slice(&code.to_le_bytes());
         }
