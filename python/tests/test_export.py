@@ -43,18 +43,33 @@ def stamp(t):
     return t.sec + t.nanosec * 1e-9
 
 
-@pytest.fixture(scope="module")
-def case(tmp_path_factory):
-    d = tmp_path_factory.mktemp("export")
-    world = ac.Map.scenario("window")
-    plan = ac.plan(world, units=N)
-    plan.write(d / "plan.json")
-    arc("trajectory", "--scenario", "window", "--plan", d / "plan.json", "--out", d / "traj.json")
+def load(d, name, world, plan_file):
+    arc("trajectory", "--scenario", name, "--plan", plan_file, "--out", d / "traj.json")
     traj = json.loads((d / "traj.json").read_text())
     t = np.array([s["t"] for s in traj["samples"]])
     p = np.array([s["p"] for s in traj["samples"]])  # (T, N, 3)
     zeta = np.array([s["zeta"] for s in traj["samples"]])
-    return {"dir": d, "world": world, "plan": plan, "traj": traj, "t": t, "p": p, "zeta": zeta}
+    plan = ac.Plan.read(plan_file)
+    return {"dir": d, "name": name, "world": world, "plan": plan, "n": plan.units,
+            "t": t, "p": p, "zeta": zeta}
+
+
+@pytest.fixture(scope="module", params=["window", "maze", "silos", "corridor"])
+def case(request, tmp_path_factory):
+    """A built-in scenario planned by `arc plan` with its defaults, and its trajectory."""
+    name = request.param
+    d = tmp_path_factory.mktemp(name)
+    arc("plan", "--scenario", name, "--out", d / "plan.json")
+    return load(d, name, ac.Map.scenario(name), d / "plan.json")
+
+
+@pytest.fixture(scope="module")
+def window(tmp_path_factory):
+    """Scenario window planned from Python with N = 4, and its trajectory."""
+    d = tmp_path_factory.mktemp("python-window")
+    world = ac.Map.scenario("window")
+    ac.plan(world, units=N).write(d / "plan.json")
+    return load(d, "window", world, d / "plan.json")
 
 
 def bag(path):
@@ -65,15 +80,15 @@ def bag(path):
 
 
 def test_bag_decodes_field_by_field(case):
-    d, t, p, zeta = case["dir"], case["t"], case["p"], case["zeta"]
-    arc("export", "--scenario", "window", "--plan", d / "plan.json", "--to", d / "plan.mcap")
+    d, t, p, zeta, n = case["dir"], case["t"], case["p"], case["zeta"], case["n"]
+    arc("export", "--scenario", case["name"], "--plan", d / "plan.json", "--to", d / "plan.mcap")
     topics = bag(d / "plan.mcap")
-    paths = {f"/arc/unit_{i + 1}/path" for i in range(N)}
+    paths = {f"/arc/unit_{i + 1}/path" for i in range(n)}
     assert set(topics) == {"/arc/map", "/arc/trajectory", "/tf", "/arc/chain"} | paths
     assert len(topics["/tf"]) == len(topics["/arc/chain"]) == len(t)
     for k, m in enumerate(topics["/tf"]):
         assert m.log_time_ns == round(t[k] * 1e9)
-        assert [x.child_frame_id for x in m.ros_msg.transforms] == [f"unit_{i + 1}" for i in range(N)]
+        assert [x.child_frame_id for x in m.ros_msg.transforms] == [f"unit_{i + 1}" for i in range(n)]
         for u, x in enumerate(m.ros_msg.transforms):
             assert x.header.frame_id == "map"
             assert abs(stamp(x.header.stamp) - t[k]) < 1e-9
@@ -84,11 +99,11 @@ def test_bag_decodes_field_by_field(case):
 
 
 def test_bag_trajectory_velocities_paths_markers(case):
-    d, t, p, zeta = case["dir"], case["t"], case["p"], case["zeta"]
+    d, t, p, zeta, n = case["dir"], case["t"], case["p"], case["zeta"], case["n"]
     topics = bag(d / "plan.mcap")
     (traj,) = topics["/arc/trajectory"]
     msg = traj.ros_msg
-    assert msg.joint_names == [f"unit_{i + 1}" for i in range(N)]
+    assert msg.joint_names == [f"unit_{i + 1}" for i in range(n)]
     assert len(msg.points) == len(t)
     v = np.gradient(p, t, axis=0)  # central differences, one-sided at the ends
     h = np.diff(t)
@@ -99,7 +114,7 @@ def test_bag_trajectory_velocities_paths_markers(case):
     yaw_rate = np.gradient(zeta[:, 3], t)
     for k, point in enumerate(msg.points):
         assert abs(stamp(point.time_from_start) - (t[k] - t[0])) < 1e-9
-        for u in range(N):
+        for u in range(n):
             tr = point.transforms[u].translation
             assert np.allclose([tr.x, tr.y, tr.z], p[k, u], atol=MM, rtol=0)
             lin = point.velocities[u].linear
@@ -107,7 +122,7 @@ def test_bag_trajectory_velocities_paths_markers(case):
             acc = point.accelerations[u].linear
             assert np.allclose([acc.x, acc.y, acc.z], a[k, u], atol=1e-6, rtol=0)
             assert abs(point.velocities[u].angular.z - yaw_rate[k]) < 1e-6
-    for u in range(N):
+    for u in range(n):
         (path,) = topics[f"/arc/unit_{u + 1}/path"]
         poses = path.ros_msg.poses
         assert len(poses) == len(t)
@@ -121,18 +136,18 @@ def test_bag_trajectory_velocities_paths_markers(case):
         assert links.scale.x == pytest.approx(2 * chain["link_radius"])
         got = np.array([[q.x, q.y, q.z] for q in spheres.points])
         assert np.allclose(got, p[k], atol=MM, rtol=0)
-        assert len(links.points) == 2 * (N - 1)
+        assert len(links.points) == 2 * (n - 1)
 
 
 def test_bag_map_is_the_octomap_stream(case):
-    d = case["dir"]
+    d, name = case["dir"], case["name"]
     topics = bag(d / "plan.mcap")
     (m,) = topics["/arc/map"]
     msg = m.ros_msg
     assert msg.binary and msg.id == "OcTree"
     assert msg.resolution == pytest.approx(case["world"].resolution)
-    arc("map", "export", "--scenario", "window", "--out", d / "window.bt")
-    bt = (d / "window.bt").read_bytes()
+    arc("map", "export", "--scenario", name, "--out", d / "map.bt")
+    bt = (d / "map.bt").read_bytes()
     stream = bt[bt.index(b"\ndata\n") + len(b"\ndata\n") :]
     assert bytes(b & 0xFF for b in msg.data) == stream
 
@@ -148,8 +163,8 @@ def messages(path):
 
 
 def test_tlog_setpoints_per_unit_in_ned(case):
-    d, t, p, zeta = case["dir"], case["t"], case["p"], case["zeta"]
-    arc("export", "--scenario", "window", "--plan", d / "plan.json", "--to", d / "plan.tlog",
+    d, t, p, zeta, n = case["dir"], case["t"], case["p"], case["zeta"], case["n"]
+    arc("export", "--scenario", case["name"], "--plan", d / "plan.json", "--to", d / "plan.tlog",
         "--sysid-base", 7)
     ms = messages(d / "plan.tlog")
     assert all(m.get_srcSystem() == 255 and m.get_srcComponent() == 191 for m in ms)
@@ -158,7 +173,7 @@ def test_tlog_setpoints_per_unit_in_ned(case):
     assert np.allclose(np.diff(beats), 1.0) and beats[0] == 0.0
     hold = 1.0
     v = np.gradient(p, t, axis=0)
-    for u in range(N):
+    for u in range(n):
         sp = [m for m in ms if m.get_type() == "SET_POSITION_TARGET_LOCAL_NED" and m.target_system == 7 + u]
         times = np.array([m._timestamp for m in sp])
         assert np.all(np.abs(np.diff(times) - 1 / RATE) < 2e-6)  # 50 Hz, well above 2 Hz
@@ -178,8 +193,8 @@ def test_tlog_setpoints_per_unit_in_ned(case):
             assert abs(wrap(m.yaw - (math.pi / 2 - zeta[k, 3]))) < DEG
 
 
-def test_tlog_arms_after_a_second_of_setpoints(case):
-    d = case["dir"]
+def test_tlog_arms_after_a_second_of_setpoints(window):
+    d = window["dir"]
     arc("export", "--scenario", "window", "--plan", d / "plan.json", "--to", d / "arm.tlog", "--arm")
     ms = messages(d / "arm.tlog")
     for u in range(N):
@@ -192,8 +207,8 @@ def test_tlog_arms_after_a_second_of_setpoints(case):
         assert min(c._timestamp for c in cmds) - sp[0] >= 1.0 - 1e-6
 
 
-def test_flight_exports_attitude_targets(case):
-    d = case["dir"]
+def test_flight_exports_attitude_targets(window):
+    d = window["dir"]
     arc("sim", "--scenario", "window", "--plan", d / "plan.json", "--out", d / "flight.json")
     flight = json.loads((d / "flight.json").read_text())
     arc("export", "--scenario", "window", "--flight", d / "flight.json", "--to", d / "flight.tlog",
@@ -224,17 +239,20 @@ def test_flight_exports_attitude_targets(case):
         assert np.allclose(got, want, atol=2e-3)  # 0.1 degree
 
 
-def test_python_export_matches_the_command_line(case):
-    d, world, plan = case["dir"], case["world"], case["plan"]
+def test_python_export_matches_the_command_line(window):
+    d, world, plan = window["dir"], window["world"], window["plan"]
+    arc("export", "--scenario", "window", "--plan", d / "plan.json", "--to", d / "cli.mcap")
+    arc("export", "--scenario", "window", "--plan", d / "plan.json", "--to", d / "cli.tlog",
+        "--sysid-base", 7)
     written = ac.export(world, plan, d / "py.mcap")
     assert written == (d / "py.mcap").stat().st_size
-    assert (d / "py.mcap").read_bytes() == (d / "plan.mcap").read_bytes()
+    assert (d / "py.mcap").read_bytes() == (d / "cli.mcap").read_bytes()
     ac.export(world, plan, d / "py.tlog", sysid_base=7)
-    assert (d / "py.tlog").read_bytes() == (d / "plan.tlog").read_bytes()
+    assert (d / "py.tlog").read_bytes() == (d / "cli.tlog").read_bytes()
 
 
-def test_python_export_of_a_flight(case):
-    world, plan, d = case["world"], case["plan"], case["dir"]
+def test_python_export_of_a_flight(window):
+    world, plan, d = window["world"], window["plan"], window["dir"]
     flight = ac.simulate(world, plan)
     ac.export(world, flight, d / "sim.tlog", hold_s=0.0)
     ms = messages(d / "sim.tlog")
@@ -253,8 +271,8 @@ def test_python_export_of_a_flight(case):
         ("out.tlog", {"autopilot": "apm"}, "autopilot"),
     ],
 )
-def test_python_export_refuses_bad_input(case, path, kwargs, words):
-    d = case["dir"]
+def test_python_export_refuses_bad_input(window, path, kwargs, words):
+    d = window["dir"]
     with pytest.raises(ac.ExportError, match=words.replace(".", r"\.")):
-        ac.export(case["world"], case["plan"], d / path, **kwargs)
+        ac.export(window["world"], window["plan"], d / path, **kwargs)
     assert not (d / path).exists()
