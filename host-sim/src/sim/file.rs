@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::flight::{Flight, FlightReport, Sample};
 use crate::fsutil;
 use crate::plan_file::ChainSection;
+use crate::trajectory::FileError;
 
 /// The format tag of a flight file.
 pub const FORMAT: &str = "arc-sim/1";
@@ -32,27 +33,6 @@ pub struct FlightFile {
     pub samples: Vec<Sample>,
 }
 
-/// A flight file that cannot be read or breaks the format's rules.
-#[derive(Debug, thiserror::Error)]
-pub enum FlightFileError {
-    /// The file cannot be read or written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: String,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// The file is not a flight file, or breaks a rule; `what` says which.
-    #[error("{path}: {what}")]
-    Invalid {
-        /// The file.
-        path: String,
-        /// The broken rule, naming the field and the value.
-        what: String,
-    },
-}
-
 impl FlightFile {
     /// The file of `flight`, keeping one sample in `record_every` (at least 1).
     pub fn new(flight: &Flight, plan: &str, map: &str, record_every: usize) -> Self {
@@ -69,17 +49,17 @@ impl FlightFile {
     }
 
     /// Reads and checks a flight file (`-`: standard input).
-    pub fn read(path: &Path) -> Result<Self, FlightFileError> {
+    pub fn read(path: &Path) -> Result<Self, FileError> {
         let name = fsutil::input_name(path);
         match fsutil::read_input(path) {
             Ok(text) => Self::parse(&text, &name),
-            Err(source) => Err(FlightFileError::Io { path: name, source }),
+            Err(source) => Err(FileError::Io { path: name, source }),
         }
     }
 
     /// Parses and checks a flight's text; `name` names it in errors.
-    pub fn parse(text: &str, name: &str) -> Result<Self, FlightFileError> {
-        let invalid = |what: String| FlightFileError::Invalid {
+    pub fn parse(text: &str, name: &str) -> Result<Self, FileError> {
+        let invalid = |what: String| FileError::Invalid {
             path: name.to_string(),
             what,
         };
@@ -90,8 +70,8 @@ impl FlightFile {
     }
 
     /// Writes the file as JSON, atomically (`-`: standard output).
-    pub fn write(&self, path: &Path) -> Result<(), FlightFileError> {
-        let io = |source| FlightFileError::Io {
+    pub fn write(&self, path: &Path) -> Result<(), FileError> {
+        let io = |source| FileError::Io {
             path: fsutil::output_name(path),
             source,
         };

@@ -71,7 +71,7 @@ pub use flight::BodySample;
 
 pub use controller::{ChainController, ControllerConfig};
 pub use dynamics::{BodyState, ChainDynamics, Formulation, UnitCommand, V3};
-pub use file::{FlightFile, FlightFileError, FORMAT as FLIGHT_FORMAT};
+pub use file::{FlightFile, FORMAT as FLIGHT_FORMAT};
 pub use flight::{
     simulate, simulate_reference, simulate_with_progress, Flight, FlightReport, Gust, Obstacles,
     Progress, Sample, SimConfig, SimError,

@@ -72,7 +72,8 @@ pub struct TrajectoryFile {
     pub samples: Vec<SampleRow>,
 }
 
-/// Why a trajectory file cannot be read, used or written.
+/// Why a trajectory file (or a flight file, `sim::FlightFile`) cannot be read, used or
+/// written.
 #[derive(Debug, thiserror::Error)]
 pub enum FileError {
     /// The file could not be read or written.
@@ -83,8 +84,8 @@ pub enum FileError {
         /// The cause.
         source: std::io::Error,
     },
-    /// Not JSON of the trajectory's shape, or a rule of the format broken; the text
-    /// says which, and names the field and value.
+    /// Not JSON of the file's shape, or a rule of the format broken; the text says
+    /// which, and names the field and value.
     #[error("{path}: {what}")]
     Invalid {
         /// The file.
