@@ -189,11 +189,12 @@ def plan(
     srs: int = 500,
     srs_seed: int = 1,
     clearance: float = ...,
-    time_limit: Optional[float] = None,
+    time_limit: Optional[float] = ...,
     smooth: bool = True,
 ) -> Plan:
-    """Plans on ``map`` with the ARCplanner and the defaults of ``arc plan``; raises
-    ``PlanError`` for bad input and when no plan is found."""
+    """Plans on ``map`` with the ARCplanner and the defaults of ``arc plan`` (a time
+    limit of 60 s; ``None``: none); raises ``PlanError`` for bad input and when no plan
+    is found."""
 
 def verify(
     map: Map,

@@ -92,8 +92,9 @@ impl Limits {
     }
 }
 
-/// How a trajectory is made.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// How a trajectory is made. In a file (serde), a field left out takes its default.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Settings {
     /// The limits.
     pub limits: Limits,
