@@ -15,7 +15,9 @@
 //! - [`planner`]: [`planner::Planner`], [`planner::Query`], [`planner::ArcPlanner`],
 //!   [`planner::to_plan`]; [`baseline`]: [`baseline::FullStatePrm`];
 //! - [`plan_file`]: [`plan_file::Plan`], the `arc-plan/1` file;
-//! - [`sim`]: [`sim::simulate`], [`sim::Flight`];
+//! - [`sim`]: [`sim::simulate`] (stopping at every waypoint), [`sim::Flight`];
+//! - [`flying`]: [`flying::fly`], a plan flown as `arc sim` flies it (along its
+//!   blended trajectory), and [`flying::time`], the clock of that flight;
 //! - [`trajectory`]: [`trajectory::build`], a plan timed and blended into a
 //!   trajectory, its exact check and its file;
 //! - [`picture`]: figures, plan and map pictures (SVG, PNG);
@@ -48,6 +50,7 @@
 
 pub mod baseline;
 pub mod collision;
+pub mod flying;
 mod fsutil;
 pub mod map;
 pub mod picture;

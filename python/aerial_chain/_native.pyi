@@ -217,6 +217,8 @@ def simulate(
     goal_tol: float = 0.1,
     settle_time: float = 10.0,
     record_every: int = 10,
+    blend: bool = True,
 ) -> Flight:
-    """Flies ``plan`` on ``map`` with the chain's dynamics and control stack (``arc
-    sim``); raises ``SimError`` for settings outside their limits."""
+    """Flies ``plan`` on ``map`` with the chain's dynamics and control stack as ``arc
+    sim`` does (along the plan's blended trajectory; ``blend=False``: stopping at every
+    waypoint); raises ``SimError`` for settings outside their limits."""
