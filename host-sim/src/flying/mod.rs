@@ -90,18 +90,9 @@ pub fn time(plan: &Plan, grid: &Grid, options: &FlyOptions) -> Result<Timed, Fly
     let params = plan.check()?;
     let cfg = options.sim_config();
     cfg.validate()?;
-    let hold = cfg.limits.start_hold;
     if options.timing.blend {
         match trajectory::build(plan, grid, &options.timing) {
-            Ok(tr) => {
-                let reference = tr.reference().with_start_hold(hold);
-                let timing = Timing::Trajectory(Box::new(tr));
-                return Ok(Timed {
-                    timing,
-                    reference,
-                    start_hold: hold,
-                });
-            }
+            Ok(tr) => return Ok(Timed::along(tr, options)),
             Err(TrajectoryError::Inadmissible(v)) => {
                 return stop_at_waypoints(plan, &params, &cfg, Some(Box::new(v)));
             }
@@ -172,6 +163,17 @@ pub fn fly(
 }
 
 impl Timed {
+    /// The motion flown along `tr`, a trajectory of the plan already made with
+    /// `options.timing` (as [`time`] makes it): after the start hold of `options`.
+    pub fn along(tr: Trajectory, options: &FlyOptions) -> Self {
+        let hold = options.sim.limits.start_hold;
+        Self {
+            reference: tr.reference().with_start_hold(hold),
+            timing: Timing::Trajectory(Box::new(tr)),
+            start_hold: hold,
+        }
+    }
+
     /// When the flight reaches each of `plan`'s waypoints and when it leaves it (s,
     /// the rest at the start included): the clock of `arc view`. Stopping at every
     /// waypoint, the times of its timed edges; along a trajectory, the time of the

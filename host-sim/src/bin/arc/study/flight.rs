@@ -9,13 +9,12 @@
 use std::fmt::Write as _;
 
 use aerial_chain::collision::verify_plan;
+use aerial_chain::flying::{self, FlyOptions, Timed};
 use aerial_chain::picture::{palette, stroke, Axis, Figure, Mark, Panel};
 use aerial_chain::planner::{Query, Settings};
 use aerial_chain::planning::{self, PlanOptions, Request};
 use aerial_chain::problem::scenarios;
-use aerial_chain::sim::{
-    simulate_reference, simulate_with_progress, FlightReport, MapClearance, Progress, SimConfig,
-};
+use aerial_chain::sim::{FlightReport, Progress};
 use aerial_chain::trajectory;
 
 use super::report::csv_field;
@@ -167,26 +166,22 @@ fn fly_both(run: &mut FlightRun) -> Result<(), String> {
     run.blended = tr.blended();
     run.merged = tr.merged();
     run.trajectory_duration_s = tr.duration();
-    let cfg = SimConfig::default();
-    let obstacles = MapClearance::new(grid, &params);
-    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
-    let before = simulate_with_progress(
-        &params,
-        &waypoints,
-        &cfg,
-        Some(&obstacles),
-        &Progress::default(),
-    )
-    .map_err(|e| e.to_string())?;
+    // Both as `arc sim` flies them: `--no-blend`, then the default, along the
+    // trajectory made above.
+    let stopping = FlyOptions {
+        timing: trajectory::Settings {
+            blend: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let (before, _) =
+        flying::fly(&plan, grid, &stopping, &Progress::default()).map_err(|e| e.to_string())?;
     run.before = Some(Flown::of(&before.report));
-    let after = simulate_reference(
-        &params,
-        tr.reference(),
-        &cfg,
-        Some(&obstacles),
-        &Progress::default(),
-    )
-    .map_err(|e| e.to_string())?;
+    let blended = FlyOptions::default();
+    let timed = Timed::along(tr, &blended);
+    let after = flying::fly_timed(&plan, &timed, grid, &blended, &Progress::default())
+        .map_err(|e| e.to_string())?;
     run.after = Some(Flown::of(&after.report));
     Ok(())
 }
@@ -388,6 +383,26 @@ mod tests {
             before: Some(flown(before)),
             after: Some(flown(after)),
         }
+    }
+
+    #[test]
+    fn a_run_plans_through_the_facade_and_flies_both_ways_as_arc_sim_does() {
+        let r = run_one("window", 3, 1);
+        assert!(r.error.is_empty(), "{}", r.error);
+        let (before, after) = (r.before.unwrap(), r.after.unwrap());
+        assert!(before.success && after.success);
+        // Blended, the flight ends sooner.
+        assert!(
+            after.time_s + 1.0 < before.time_s,
+            "{} {}",
+            after.time_s,
+            before.time_s
+        );
+        // The blended flight arrives (within its goal tolerance) about when its
+        // trajectory, after the hold, ends.
+        let end = r.trajectory_duration_s + 1.0;
+        assert!((after.time_s - end).abs() < 1.5, "{} {end}", after.time_s);
+        assert!(r.shape_motion_rad.1 <= r.shape_motion_rad.0 + 1e-9);
     }
 
     #[test]
