@@ -13,7 +13,9 @@ use aerial_chain::collision::{verify_plan, EdgeKind, DEFAULT_CLEARANCE};
 use aerial_chain::map::DistanceField;
 use aerial_chain::plan_file::MapSection;
 use aerial_chain::planner::{Query, Settings};
-use aerial_chain::planning::{self, PlanOptions, PlanningError, Request, DEFAULT_TIME_LIMIT_S};
+use aerial_chain::planning::{
+    self, PlanOptions, PlanningError, Request, DEFAULT_TIME_LIMIT_S, MAX_TIME_LIMIT_S,
+};
 use aerial_chain_core::kinematics::positions_into;
 use aerial_chain_core::{ChainParams, Shape, MAX_UNITS};
 
@@ -386,8 +388,12 @@ pub fn plan(
         srs_seed,
         trajectory: None,
     };
+    // Only a given limit can be refused.
+    let limit = time_limit.unwrap_or(DEFAULT_TIME_LIMIT_S);
     options.termination().map_err(|_| {
-        err::<PlanError>(format!("time_limit = {time_limit:?}: a positive time (s)"))
+        err::<PlanError>(format!(
+            "time_limit = {limit}: a positive time (s), at most {MAX_TIME_LIMIT_S:e}"
+        ))
     })?;
     let request = Request {
         field: Arc::new(DistanceField::new(map.grid.clone())),
