@@ -128,6 +128,26 @@ fn the_facade_plans_what_arc_plan_writes() {
     assert!(report.ok, "{:?}", report.violation);
 }
 
+/// `arc plan` has a documented default time limit, and a query it stops says what
+/// was tried and how to give it longer.
+#[test]
+fn the_time_limit_has_a_default_and_its_failure_says_what_was_tried() {
+    let help = support::run(&["plan", "--help"], Path::new("."));
+    assert!(help.stdout.contains("[default: 60]"), "{help:?}");
+    let dir = tmp();
+    let out = dir.path().join("p.json");
+    let e = plan_scenario("maze", 5, &["--time-limit", "1e-6"], &out).unwrap_err();
+    assert_eq!(e.code, Some(1), "{e}");
+    for says in [
+        "time limit reached",
+        "time limit stopped it after trying",
+        "--time-limit",
+    ] {
+        assert!(e.message.contains(says), "{e}");
+    }
+    assert!(!out.exists(), "no plan file without a plan");
+}
+
 #[test]
 fn unreachable_goal_exits_1_with_the_reason() {
     let dir = tmp();
