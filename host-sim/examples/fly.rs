@@ -1,5 +1,6 @@
 //! Write a built-in scenario as an OctoMap `.bt` file, plan through it from the file,
-//! verify the plan exactly and fly it with the chain's dynamics and control stack.
+//! verify the plan exactly and fly it with the chain's dynamics and control stack, as
+//! `arc sim` flies it.
 //!
 //! ```sh
 //! cargo run --example fly            # the `window` scenario, N = 5
@@ -8,8 +9,9 @@
 use std::error::Error;
 use std::path::Path;
 
+use aerial_chain::flying::{fly as fly_plan, FlyOptions};
 use aerial_chain::problem::scenarios;
-use aerial_chain::sim::{simulate, FlightReport, MapClearance, SimConfig};
+use aerial_chain::sim::{FlightReport, Progress};
 
 #[path = "plan_on_map.rs"]
 pub mod plan_on_map;
@@ -32,10 +34,8 @@ pub fn fly(scenario: &str, dir: &Path) -> Result<FlightReport, Box<dyn Error>> {
         goal: sc.goal,
     })?;
 
-    let params = plan.check()?;
-    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
-    let obstacles = MapClearance::new(&grid, &params);
-    let flight = simulate(&params, &waypoints, &SimConfig::default(), Some(&obstacles))?;
+    // As `arc sim` flies it: along the plan's blended trajectory, after a rest.
+    let (flight, _) = fly_plan(&plan, &grid, &FlyOptions::default(), &Progress::default())?;
     let r = flight.report;
     println!(
         "flown {:.1} s: head RMS error {:.3} m, minimum clearance {} m, {}",

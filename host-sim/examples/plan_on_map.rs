@@ -10,14 +10,12 @@
 
 use std::error::Error;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicUsize;
-use std::sync::Arc;
 
-use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
-use aerial_chain::map::{DistanceField, Grid, OcTree};
+use aerial_chain::collision::verify_plan;
+use aerial_chain::map::{Grid, OcTree};
 use aerial_chain::plan_file::{MapSection, MapSource, Plan};
-use aerial_chain::planner::{to_plan, ArcPlanner, Planner, Query, Settings, Termination};
-use aerial_chain::tables::{ShapeTables, TableSettings};
+use aerial_chain::planner::Query;
+use aerial_chain::planning::{self, PlanOptions, Request};
 use aerial_chain_core::{ChainParams, Shape};
 use nalgebra::Point3;
 
@@ -48,16 +46,11 @@ pub fn plan_on_map(p: &Problem) -> Result<(Grid, Plan), Box<dyn Error>> {
     let params = ChainParams::new(p.units)
         .validate()
         .map_err(|e| format!("units = {}: {e}", p.units))?;
-    let field = Arc::new(DistanceField::new(grid.clone()));
-    let ctx = CollisionContext::new(field, params, DEFAULT_CLEARANCE)?;
-    let tables = ShapeTables::build(params, &TableSettings::default(), &AtomicUsize::new(0))?;
-    let mut planner = ArcPlanner::new(ctx, tables, Settings::default())?;
     let query = Query::new(p.start, Shape::line(p.units, p.yaw), p.goal);
-    let solution = planner.solve(&query, Termination::default())?;
-    // Shortcuts and merged moves, as `arc plan` does unless --no-smooth.
-    let (solution, _) = planner.refine(&solution, None);
-    let map = MapSection::of(&grid).with_source(MapSource::file(p.map, &bytes));
-    let plan = to_plan(&solution, &params, map);
+    let mut request = Request::new(grid.clone(), params, query);
+    request.map = MapSection::of(&grid).with_source(MapSource::file(p.map, &bytes));
+    // Search, post-processing and the plan file, as `arc plan` makes them.
+    let plan = planning::plan(&request, None, &PlanOptions::default())?.plan;
 
     // The planner's checks are conservative shortcuts; the verifier is the contract.
     let report = verify_plan(&grid, &plan);

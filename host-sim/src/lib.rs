@@ -15,37 +15,36 @@
 //! - [`planner`]: [`planner::Planner`], [`planner::Query`], [`planner::ArcPlanner`],
 //!   [`planner::to_plan`]; [`baseline`]: [`baseline::FullStatePrm`];
 //! - [`plan_file`]: [`plan_file::Plan`], the `arc-plan/1` file;
-//! - [`sim`]: [`sim::simulate`], [`sim::Flight`];
+//! - [`sim`]: [`sim::simulate`] (stopping at every waypoint), [`sim::Flight`];
+//! - [`flying`]: [`flying::fly`], a plan flown as `arc sim` flies it (along its
+//!   blended trajectory), and [`flying::time`], the clock of that flight;
 //! - [`trajectory`]: [`trajectory::build`], a plan timed and blended into a
 //!   trajectory, its exact check and its file;
 //! - [`picture`]: figures, plan and map pictures (SVG, PNG);
 //! - [`export`]: a trajectory or flight as a ROS 2 bag (MCAP) or per-unit MAVLink
-//!   setpoints (`.tlog`).
+//!   setpoints (`.tlog`);
+//! - [`planning`]: [`planning::plan`], the facade: plan as `arc plan` does (search,
+//!   post-processing, the plan file, optionally its trajectory) under one
+//!   [`planning::PlanOptions`].
+//!
+//! Plan through the `window` scenario as `arc plan --scenario window --units 5` does,
+//! then check the plan with the exact verifier rather than trust the planner:
 //!
 //! ```
-//! use std::sync::atomic::AtomicUsize;
-//! use std::sync::Arc;
-//!
-//! use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
-//! use aerial_chain::map::DistanceField;
-//! use aerial_chain::plan_file::MapSection;
-//! use aerial_chain::planner::{to_plan, ArcPlanner, Planner, Query, Settings, Termination};
+//! use aerial_chain::collision::verify_plan;
+//! use aerial_chain::planner::Query;
+//! use aerial_chain::planning::{plan, PlanOptions, Request};
 //! use aerial_chain::problem::scenarios;
-//! use aerial_chain::tables::{ShapeTables, TableSettings};
 //! use aerial_chain_core::ChainParams;
 //!
 //! let scenario = scenarios::build("window")?;
-//! let params = ChainParams::new(5);
-//! let field = Arc::new(DistanceField::new(scenario.grid.clone()));
-//! let ctx = CollisionContext::new(field, params, DEFAULT_CLEARANCE)?;
-//! let progress = AtomicUsize::new(0); // shapes sampled so far, for a progress display
-//! let tables = ShapeTables::build(params, &TableSettings::default(), &progress)?;
-//! let mut planner = ArcPlanner::new(ctx, tables, Settings::default())?;
 //! let query = Query::new(scenario.start, scenario.start_shape(5)?, scenario.goal);
-//! let solution = planner.solve(&query, Termination::default())?;
-//! let grid = &scenario.grid;
-//! let plan = to_plan(&solution, &params, MapSection::of(grid));
-//! assert!(verify_plan(grid, &plan).ok);
+//! let request = Request::new(scenario.grid.clone(), ChainParams::new(5), query);
+//! // `arc plan`'s defaults: shape tables built here, post-processing, 60 s at most.
+//! let planned = plan(&request, None, &PlanOptions::default())?;
+//! assert!(verify_plan(request.grid(), &planned.plan).ok);
+//! println!("{} waypoints, {:.2} m of head path", planned.plan.waypoints.len(),
+//!          planned.quality.head_path_m);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -54,12 +53,14 @@
 pub mod baseline;
 pub mod collision;
 pub mod export;
+pub mod flying;
 mod fsutil;
 pub mod map;
 pub mod picture;
 pub mod plan_file;
 pub mod plan_picture;
 pub mod planner;
+pub mod planning;
 pub mod problem;
 mod shape_index;
 pub mod sim;

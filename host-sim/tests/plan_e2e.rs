@@ -6,7 +6,10 @@ use std::path::Path;
 
 use aerial_chain::collision::verify_plan;
 use aerial_chain::plan_file::Plan;
+use aerial_chain::planner::Query;
+use aerial_chain::planning::{self, PlanOptions, Request};
 use aerial_chain::problem::scenarios;
+use aerial_chain_core::ChainParams;
 mod support;
 
 use support::{
@@ -102,6 +105,47 @@ fn same_seed_same_plan_byte_for_byte() {
         run("d.json", "8"),
         "another seed, another roadmap"
     );
+}
+
+/// The library's facade makes the plan `arc plan` writes with its defaults: the same
+/// waypoints, the same quality, and the exact verifier accepts it.
+#[test]
+fn the_facade_plans_what_arc_plan_writes() {
+    let dir = tmp();
+    let (cli, sc) = plan_verified("maze", 5, dir.path());
+    let query = Query::new(sc.start, sc.start_shape(5).expect("start shape"), sc.goal);
+    let request = Request::new(sc.grid.clone(), ChainParams::new(5), query);
+    let planned = planning::plan(&request, None, &PlanOptions::default()).expect("a plan");
+    let zetas =
+        |p: &Plan| -> Vec<Vec<f64>> { p.waypoints.iter().map(|w| w.zeta.clone()).collect() };
+    assert_eq!(zetas(&planned.plan), zetas(&cli));
+    assert_eq!(planned.plan.stats["quality"], cli.stats["quality"]);
+    assert_eq!(
+        planned.plan.stats["refinement"]["widening"],
+        cli.stats["refinement"]["widening"]
+    );
+    let report = verify_plan(&sc.grid, &planned.plan);
+    assert!(report.ok, "{:?}", report.violation);
+}
+
+/// `arc plan` has a documented default time limit, and a query it stops says what
+/// was tried and how to give it longer.
+#[test]
+fn the_time_limit_has_a_default_and_its_failure_says_what_was_tried() {
+    let help = support::run(&["plan", "--help"], Path::new("."));
+    assert!(help.stdout.contains("[default: 60]"), "{help:?}");
+    let dir = tmp();
+    let out = dir.path().join("p.json");
+    let e = plan_scenario("maze", 5, &["--time-limit", "1e-6"], &out).unwrap_err();
+    assert_eq!(e.code, Some(1), "{e}");
+    for says in [
+        "time limit reached",
+        "time limit stopped it after trying",
+        "--time-limit",
+    ] {
+        assert!(e.message.contains(says), "{e}");
+    }
+    assert!(!out.exists(), "no plan file without a plan");
 }
 
 #[test]

@@ -194,11 +194,12 @@ def plan(
     srs: int = 500,
     srs_seed: int = 1,
     clearance: float = ...,
-    time_limit: Optional[float] = None,
+    time_limit: Optional[float] = ...,
     smooth: bool = True,
 ) -> Plan:
-    """Plans on ``map`` with the ARCplanner and the defaults of ``arc plan``; raises
-    ``PlanError`` for bad input and when no plan is found."""
+    """Plans on ``map`` with the ARCplanner and the defaults of ``arc plan`` (a time
+    limit of 60 s; ``None``: none); raises ``PlanError`` for bad input and when no plan
+    is found."""
 
 def verify(
     map: Map,
@@ -221,9 +222,11 @@ def simulate(
     goal_tol: float = 0.1,
     settle_time: float = 10.0,
     record_every: int = 10,
+    blend: bool = True,
 ) -> Flight:
-    """Flies ``plan`` on ``map`` with the chain's dynamics and control stack (``arc
-    sim``); raises ``SimError`` for settings outside their limits."""
+    """Flies ``plan`` on ``map`` with the chain's dynamics and control stack as ``arc
+    sim`` does (along the plan's blended trajectory; ``blend=False``: stopping at every
+    waypoint); raises ``SimError`` for settings outside their limits."""
 
 def export(
     map: Map,

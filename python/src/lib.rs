@@ -4,9 +4,11 @@
 //! the library `aerial_chain`'s public face, wrapped for Python with PyO3.
 //!
 //! - `map::Map`: an OctoMap `.bt` file or a built-in scenario;
-//! - `plan::plan` (the ARCplanner with the defaults of `arc plan`), `plan::Plan`
-//!   (the `arc-plan/1` file), `plan::verify` (the exact verifier of docs/model.md);
-//! - `sim::simulate` and `sim::Flight`, the chain flown by its control stack;
+//! - `plan::plan` (the ARCplanner with the defaults of `arc plan`, through the
+//!   library's facade `aerial_chain::planning::plan`), `plan::Plan` (the `arc-plan/1`
+//!   file), `plan::verify` (the exact verifier of docs/model.md);
+//! - `sim::simulate` and `sim::Flight`, the chain flown by its control stack as `arc
+//!   sim` flies it (`aerial_chain::flying::fly`);
 //! - `export::export`, a plan or flight as a ROS 2 bag or MAVLink setpoints.
 //!
 //! Configurations and flights come out as NumPy arrays. Bad input raises one of the

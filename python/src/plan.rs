@@ -2,22 +2,20 @@
 //! defaults of `arc plan`, `Plan` is an `arc-plan/1` file, `verify()` is `arc verify`.
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicUsize;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2, PyArray3};
 use pyo3::prelude::*;
 
-use aerial_chain::collision::{verify_plan, CollisionContext, EdgeKind, DEFAULT_CLEARANCE};
+use aerial_chain::collision::{verify_plan, EdgeKind, DEFAULT_CLEARANCE};
 use aerial_chain::map::DistanceField;
 use aerial_chain::plan_file::MapSection;
-use aerial_chain::planner::{
-    annotate_quality, to_plan, ArcPlanner, Planner, Quality, Query, Settings, Termination,
+use aerial_chain::planner::{Query, Settings};
+use aerial_chain::planning::{
+    self, PlanOptions, PlanningError, Request, DEFAULT_TIME_LIMIT_S, MAX_TIME_LIMIT_S,
 };
-use aerial_chain::tables::{ShapeTables, TableSettings};
 use aerial_chain_core::kinematics::positions_into;
 use aerial_chain_core::{ChainParams, Shape, MAX_UNITS};
 
@@ -336,16 +334,18 @@ fn query(map: &Map, params: &ChainParams, asked: Asked) -> PyResult<Query> {
     })
 }
 
-/// Plans on `map` with the ARCplanner and the defaults of `arc plan` (shape tables of
-/// `srs` random shapes, `Settings::default()`, refinement on), for a chain of `units`
-/// (default: the scenario's). `start`, `goal` (m) and `start_yaw` (rad) default to the
-/// scenario's; `start_shape` is 2N - 1 angles (default: straight behind the head).
+/// Plans on `map` with the ARCplanner and the defaults of `arc plan` (the library's
+/// facade `aerial_chain::planning::plan`: shape tables of `srs` random shapes,
+/// `Settings::default()`, post-processing on, a time limit of 60 s), for a chain of
+/// `units` (default: the scenario's). `start`, `goal` (m) and `start_yaw` (rad)
+/// default to the scenario's; `start_shape` is 2N - 1 angles (default: straight
+/// behind the head); `time_limit=None` plans without a limit.
 /// Raises `PlanError` for bad input and when no plan is found (the message says why).
 #[pyfunction]
 #[pyo3(signature = (
     map, units = None, start = None, goal = None, start_yaw = None, start_shape = None,
     goal_tol = 0.3, seed = 1, srs = 500, srs_seed = 1, clearance = DEFAULT_CLEARANCE,
-    time_limit = None, smooth = true
+    time_limit = Some(DEFAULT_TIME_LIMIT_S), smooth = true
 ))]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each with a default.
 pub fn plan(
@@ -376,52 +376,35 @@ pub fn plan(
         goal_tol,
     };
     let query = query(map, &params, asked)?;
-    let stop = Termination {
-        time_limit: time_limit
-            .map(|t| {
-                Duration::try_from_secs_f64(t)
-                    .ok()
-                    .filter(|d| !d.is_zero())
-                    .ok_or_else(|| {
-                        err::<PlanError>(format!("time_limit = {t}: a positive time (s)"))
-                    })
-            })
-            .transpose()?,
+    let options = PlanOptions {
+        planner: Settings {
+            seed,
+            ..Settings::default()
+        },
+        clearance,
+        no_smooth: !smooth,
+        time_limit_s: time_limit,
+        srs,
+        srs_seed,
+        trajectory: None,
     };
-    let settings = Settings {
-        seed,
-        ..Settings::default()
+    // Only a given limit can be refused.
+    let limit = time_limit.unwrap_or(DEFAULT_TIME_LIMIT_S);
+    options.termination().map_err(|_| {
+        err::<PlanError>(format!(
+            "time_limit = {limit}: a positive time (s), at most {MAX_TIME_LIMIT_S:e}"
+        ))
+    })?;
+    let request = Request {
+        field: Arc::new(DistanceField::new(map.grid.clone())),
+        params,
+        query,
+        map: MapSection::of(&map.grid).with_source(map.source.clone()),
     };
-    let plan = py.detach(|| -> Result<aerial_chain::plan_file::Plan, String> {
-        let tables = TableSettings {
-            srs,
-            seed: srs_seed,
-            ..TableSettings::default()
-        };
-        let tables = ShapeTables::build(params, &tables, &AtomicUsize::new(0))
-            .map_err(|e| format!("srs = {srs}: {e}"))?;
-        let field = Arc::new(DistanceField::new(map.grid.clone()));
-        let ctx = CollisionContext::new(field, params, clearance)
-            .map_err(|e| format!("clearance = {clearance}: {e}"))?;
-        let mut planner = ArcPlanner::new(ctx, tables, settings).map_err(|e| e.to_string())?;
-        let began = Instant::now();
-        let solution = planner
-            .solve(&query, stop)
-            .map_err(|e| format!("{}: no plan: {e}", map.name))?;
-        let (solution, refinement) = if smooth {
-            let (refined, r) = planner.refine(&solution, stop.deadline(began));
-            (refined, Some(r))
-        } else {
-            (solution, None)
-        };
-        let section = MapSection::of(&map.grid).with_source(map.source.clone());
-        let mut plan = to_plan(&solution, &params, section);
-        annotate_quality(
-            &mut plan,
-            &Quality::of(&solution.steps),
-            refinement.as_ref(),
-        );
-        Ok(plan)
-    });
-    Plan::checked(plan.map_err(err::<PlanError>)?)
+    let planned = py.detach(|| planning::plan(&request, None, &options));
+    let planned = planned.map_err(|e| match e {
+        PlanningError::NoPlan(_) => err::<PlanError>(format!("{}: {e}", map.name)),
+        e => err::<PlanError>(e.to_string()),
+    })?;
+    Plan::checked(planned.plan)
 }

@@ -5,7 +5,9 @@ use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 
-use aerial_chain::sim::{BodySample, FlightReport, MapClearance, Sample, SimConfig};
+use aerial_chain::flying::{fly, FlyOptions};
+use aerial_chain::sim::{BodySample, FlightReport, Progress, Sample, SimConfig};
+use aerial_chain::trajectory::{Limits, Settings};
 
 use crate::map::Map;
 use crate::plan::Plan;
@@ -130,16 +132,18 @@ impl Flight {
     }
 }
 
-/// Flies `plan` on `map` with the chain's dynamics and control stack (`arc sim`, same
-/// defaults): `rate` (Hz), largest unit `speed` (m/s), head `accel` (m/s^2), shape
-/// `angular_rate` (rad/s), arrival within `goal_tol` (m) and `settle_time` (s) of the
-/// plan's end. Keeps one step in `record_every`. Raises `SimError` for settings outside
-/// their limits or a plan the simulation cannot fly; a flight that fails is no error
-/// (`Flight.success`, `Flight.report`).
+/// Flies `plan` on `map` with the chain's dynamics and control stack as `arc sim` does
+/// (the library's `aerial_chain::flying::fly`, same defaults): along the plan's
+/// blended trajectory, or stopping at every waypoint where the plan is not admissible
+/// as one or `blend=False` asks for it; `rate` (Hz), largest unit `speed` (m/s), head
+/// `accel` (m/s^2), shape `angular_rate` (rad/s), arrival within `goal_tol` (m) and
+/// `settle_time` (s) of the plan's end. Keeps one step in `record_every`. Raises
+/// `SimError` for settings outside their limits or a plan the simulation cannot fly;
+/// a flight that fails is no error (`Flight.success`, `Flight.report`).
 #[pyfunction]
 #[pyo3(signature = (
     map, plan, rate = 500.0, speed = 0.5, accel = 0.5, angular_rate = 0.4, goal_tol = 0.1,
-    settle_time = 10.0, record_every = 10
+    settle_time = 10.0, record_every = 10, blend = true
 ))]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each with a default.
 pub fn simulate(
@@ -153,31 +157,41 @@ pub fn simulate(
     goal_tol: f64,
     settle_time: f64,
     record_every: usize,
+    blend: bool,
 ) -> PyResult<Flight> {
     if record_every == 0 {
         return Err(err::<SimError>("record_every = 0: at least 1"));
     }
-    let mut cfg = SimConfig {
+    let sim = SimConfig {
         rate,
         goal_tolerance: goal_tol,
         settle_time,
         ..SimConfig::default()
     };
-    cfg.limits.speed = speed;
-    cfg.limits.accel = accel;
-    cfg.limits.angular_rate = angular_rate;
-    cfg.validate()
+    let limits = Limits {
+        speed,
+        accel,
+        angular_rate,
+        ..Limits::default()
+    };
+    let options = FlyOptions {
+        sim,
+        timing: Settings {
+            limits,
+            blend,
+            ..Settings::default()
+        },
+    };
+    // Settings first, with the words of `arc sim`, before any trajectory is made.
+    options
+        .sim_config()
+        .validate()
         .map_err(|e| err::<SimError>(format!("simulation settings: {e}")))?;
-    let params = plan.params;
-    let waypoints: Vec<Vec<f64>> = plan.plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
-    let flight = py
-        .detach(|| {
-            let obstacles = MapClearance::new(&map.grid, &params);
-            aerial_chain::sim::simulate(&params, &waypoints, &cfg, Some(&obstacles))
-        })
+    let (flight, _) = py
+        .detach(|| fly(&plan.plan, &map.grid, &options, &Progress::default()))
         .map_err(err::<SimError>)?;
     Ok(Flight {
-        params,
+        params: flight.params,
         samples: flight.samples.into_iter().step_by(record_every).collect(),
         report: flight.report,
         record_every,

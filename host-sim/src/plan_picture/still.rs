@@ -34,38 +34,10 @@ const PIECE_M: f64 = 0.25;
 /// Width of a plan's picture (px).
 const WIDTH: f64 = 1100.0;
 
-/// The time at which `trajectory` (made from `plan`) passes each waypoint: the first
-/// sample nearest to it (head position and shape angles) after the previous one's.
+/// The time at which `trajectory` (made from `plan`) passes each waypoint
+/// ([`Trajectory::waypoint_times`]).
 pub fn waypoint_times(plan: &Plan, trajectory: &Trajectory) -> Vec<f64> {
-    let (times, zetas) = (trajectory.times(), trajectory.zetas());
-    let l = trajectory.params().link_length as f64;
-    let wrap = |a: f64| {
-        (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
-    };
-    let distance = |w: &[f64], z: &[f64]| -> f64 {
-        let head: f64 = (0..3).map(|k| (w[k] - z[k]).powi(2)).sum();
-        let shape: f64 = w[3..]
-            .iter()
-            .zip(&z[3..])
-            .map(|(a, b)| (l * wrap(a - b)).powi(2))
-            .sum();
-        head + shape
-    };
-    let mut from = 0;
-    plan.waypoints
-        .iter()
-        .map(|w| {
-            let mut best = (f64::INFINITY, from);
-            for (j, z) in zetas.iter().enumerate().skip(from) {
-                let d = distance(&w.zeta, z);
-                if d < best.0 {
-                    best = (d, j);
-                }
-            }
-            from = best.1;
-            times.get(from).copied().unwrap_or(0.0)
-        })
-        .collect()
+    trajectory.waypoint_times(plan)
 }
 
 /// What a waypoint's shape came from, as the picture shows it: a rim colour and

@@ -167,7 +167,7 @@ impl ArcPlanner {
         let ((chosen, steps, last), threading) = rayon::join(
             || {
                 let mut chosen = post.refined_and_carried(raw, deadline);
-                let (steps, last) = post.widened_again(&mut chosen, raw);
+                let (steps, last) = post.widened_again(&mut chosen, raw, deadline);
                 (chosen, steps, last)
             },
             || post.threading(raw, deadline),
@@ -237,7 +237,8 @@ impl Post<'_> {
         // free (or run after it).
         let ((widened, first, kept), (plain, mut checks)) = rayon::join(
             || {
-                let (widened, first) = super::widen::widen(self.ctx, self.ctx_min, raw.to_vec());
+                let (widened, first) =
+                    super::widen::widen(self.ctx, self.ctx_min, raw.to_vec(), deadline);
                 let kept = self.keep_margin(first.in_passages).map(|ctx| {
                     let (steps, spent) = self.shortcut(&ctx, &widened, deadline);
                     (steps, spent, ctx)
@@ -275,12 +276,17 @@ impl Post<'_> {
     /// The last widening, of the other stages' result (taking its steps): where
     /// neither the widened plan was taken nor refinement changed the search's plan
     /// `raw`, it would repeat the first move for move, whose result is taken.
-    fn widened_again(&self, chosen: &mut Chosen, raw: &[Step]) -> (Vec<Step>, Widening) {
+    fn widened_again(
+        &self,
+        chosen: &mut Chosen,
+        raw: &[Step],
+        deadline: Option<Instant>,
+    ) -> (Vec<Step>, Widening) {
         let steps = std::mem::take(&mut chosen.steps);
         if chosen.first_moves.is_none() && steps == raw {
             (std::mem::take(&mut chosen.widened), chosen.first)
         } else {
-            super::widen::widen(&chosen.ctx, self.ctx_min, steps)
+            super::widen::widen(&chosen.ctx, self.ctx_min, steps, deadline)
         }
     }
 

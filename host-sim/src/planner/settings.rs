@@ -2,7 +2,10 @@
 //! of its roadmap and online construction.
 
 /// Which shape sources the planner may use (the paper's ablation).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
 pub enum Mode {
     /// Library and random shapes (the full ARCplanner).
     Both,
@@ -13,7 +16,10 @@ pub enum Mode {
 }
 
 /// What the planner prefers when several shapes fit.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
 pub enum Preference {
     /// Keep the shape as long as it fits; cheapest change otherwise.
     Least,
@@ -21,8 +27,10 @@ pub enum Preference {
     Coverage,
 }
 
-/// Planner parameters; every one has a command-line flag.
-#[derive(Clone, Debug, PartialEq)]
+/// Planner parameters; every one has a command-line flag. In a file (serde), a field
+/// left out takes its default.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Settings {
     /// Head roadmap vertices `M_VT`.
     pub vertices: usize,

@@ -12,6 +12,7 @@
 //! trajectory: [`check_samples`] checks them independently of how they were made.
 //!
 //! - `build`: [`build`] and [`Trajectory`], the generator;
+//! - `clock`: [`Trajectory::waypoint_times`], when it passes the plan's waypoints;
 //! - `check`: [`check_samples`], the exact check of sampled motion and its limits;
 //! - `group`: which edges fly together as one motion, and how a merge gives way;
 //! - `merge`: what a merged motion demands of the limits, and which edges lie on a line;
@@ -19,6 +20,7 @@
 
 mod build;
 mod check;
+mod clock;
 mod file;
 mod group;
 mod merge;
@@ -92,8 +94,9 @@ impl Limits {
     }
 }
 
-/// How a trajectory is made.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// How a trajectory is made. In a file (serde), a field left out takes its default.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Settings {
     /// The limits.
     pub limits: Limits,

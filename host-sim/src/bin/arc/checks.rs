@@ -10,7 +10,7 @@ pub use aerial_chain::picture::PictureFormat;
 
 /// Longest `--time-limit` (s): about 11.6 days. Beyond it a limit means nothing, and
 /// far beyond it `Duration` cannot hold it.
-pub const MAX_TIME_LIMIT_S: f64 = 1e6;
+pub const MAX_TIME_LIMIT_S: f64 = aerial_chain::planning::MAX_TIME_LIMIT_S;
 
 /// Most head-roadmap vertices `arc plan` may ever hold, growth included
 /// (`--vertices` times 2^`--max-growth`): about 1 GiB of roadmap at the default

@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicUsize;
+use std::sync::Arc;
 use std::time::Instant;
 
 use aerial_chain_core::ChainParams;
@@ -12,11 +13,10 @@ use super::common::{write_plan, ProblemArgs, Report};
 use super::trajectory::TimingArgs;
 use super::{CliError, CliResult};
 use aerial_chain::collision::DEFAULT_CLEARANCE;
-use aerial_chain::planner::{
-    annotate_quality, to_plan, ArcPlanner, Mode, PlanError, Planner, Preference, Settings,
-    Termination,
-};
-use aerial_chain::planner::{Quality, Refinement};
+use aerial_chain::map::DistanceField;
+use aerial_chain::plan_file::MapSection;
+use aerial_chain::planner::{Mode, Preference, Quality, Refinement, Settings};
+use aerial_chain::planning::{self, PlanOptions, PlanningError, Request, DEFAULT_TIME_LIMIT_S};
 use aerial_chain::tables::{ShapeTables, TableSettings};
 
 /// `arc plan`
@@ -89,9 +89,10 @@ pub struct PlanArgs {
     /// dropped shape changes (see `planner::refine`).
     #[arg(long)]
     no_smooth: bool,
-    /// Give up after this many seconds.
-    #[arg(long)]
-    time_limit: Option<f64>,
+    /// Give up after this many seconds of search and post-processing (setup, the
+    /// map and the shape tables, is not counted); at most 1e6.
+    #[arg(long, default_value_t = DEFAULT_TIME_LIMIT_S)]
+    time_limit: f64,
     /// Output plan (JSON, arc-plan/1); `-` writes it to standard output.
     #[arg(long)]
     out: PathBuf,
@@ -163,7 +164,7 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
         "dropped edges per query",
     )?;
     checks::length("--clearance-min", a.clearance_min, false)?;
-    checks::time_limit(a.time_limit)?;
+    checks::time_limit(Some(a.time_limit))?;
     checks::srs(a.srs)?;
     a.timing.settings()?;
     let stdout = |p: &std::path::Path| crate::fsutil::is_stdio(p);
@@ -209,63 +210,69 @@ pub fn load_tables(
     }
 }
 
+/// The facade's options from the command line (checked before).
+fn options(a: &PlanArgs) -> Result<PlanOptions, CliError> {
+    Ok(PlanOptions {
+        planner: Settings {
+            vertices: a.vertices,
+            r_t: a.r_t,
+            max_neighbours: a.max_neighbours,
+            n_psi: a.n_psi,
+            d_c: a.d_c,
+            mode: a.mode,
+            prefer: a.prefer,
+            seed: a.seed,
+            max_replans: a.max_replans,
+            max_growth: a.max_growth,
+            clearance_weight: a.clearance_weight,
+            follow_step: a.follow_step,
+            clearance_min: a.clearance_min,
+            head_lattice: a.head_lattice,
+        },
+        clearance: a.clearance,
+        no_smooth: a.no_smooth,
+        time_limit_s: Some(a.time_limit),
+        srs: a.srs,
+        srs_seed: a.srs_seed,
+        trajectory: match a.trajectory {
+            Some(_) => Some(a.timing.settings()?),
+            None => None,
+        },
+    })
+}
+
 /// Runs `arc plan`.
 pub fn run(a: PlanArgs) -> CliResult {
     check(&a)?;
+    let options = options(&a)?;
     // Setup (map, distance field, shape tables) is timed apart: the time limit
     // covers what follows it (docs/promises.md).
     let setup = Instant::now();
-    let (ctx, params, query, map) = a.problem.context(a.clearance)?;
+    let (loaded, params, query) = a.problem.load()?;
+    let map = MapSection::of(&loaded.grid).with_source(loaded.source.clone());
+    let request = Request {
+        field: Arc::new(DistanceField::new(loaded.grid)),
+        params,
+        query,
+        map,
+    };
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
-    let settings = Settings {
-        vertices: a.vertices,
-        r_t: a.r_t,
-        max_neighbours: a.max_neighbours,
-        n_psi: a.n_psi,
-        d_c: a.d_c,
-        mode: a.mode,
-        prefer: a.prefer,
-        seed: a.seed,
-        max_replans: a.max_replans,
-        max_growth: a.max_growth,
-        clearance_weight: a.clearance_weight,
-        follow_step: a.follow_step,
-        clearance_min: a.clearance_min,
-        head_lattice: a.head_lattice,
-    };
-    let mut planner =
-        ArcPlanner::new(ctx, tables, settings).map_err(|e| CliError::input(e.to_string()))?;
-    let setup_s = setup.elapsed().as_secs_f64();
-    let stop = Termination {
-        time_limit: checks::time_limit(a.time_limit)?,
-    };
-    let began = Instant::now();
-    let solution = planner.solve(&query, stop).map_err(|e| match e {
-        // The query itself is unusable: bad input, as in `arc bench prm`.
-        PlanError::TablesMismatch { .. }
-        | PlanError::StartInvalid(_)
-        | PlanError::GoalInvalid(_) => CliError::input(e.to_string()),
-        _ => CliError::failed(format!(
-            "no plan: {e} (after {:.1} ms of planning; setup {:.1} ms)",
-            began.elapsed().as_secs_f64() * 1e3,
-            setup_s * 1e3
-        )),
+    let loading_s = setup.elapsed().as_secs_f64();
+    let planned = planning::plan(&request, Some(tables), &options).map_err(|e| match e {
+        PlanningError::NoPlan(mut n) => {
+            n.setup_s += loading_s;
+            CliError::failed(n.to_string())
+        }
+        e => CliError::input(e.to_string()),
     })?;
-    let (solution, refinement) = if a.no_smooth {
-        (solution, None)
-    } else {
-        let (refined, r) = planner.refine(&solution, stop.deadline(began));
-        (refined, Some(r))
-    };
-    let quality = Quality::of(&solution.steps);
-    let mut plan = to_plan(&solution, &params, map);
-    annotate_quality(&mut plan, &quality, refinement.as_ref());
-    let s = &solution.stats;
+    let setup_s = loading_s + planned.timings.setup_s;
+    let plan = &planned.plan;
+    let s = &planned.stats;
     let details = format!(
         "{} head edges, {} shape changes ({} LSC, {} SRS, {} yaw rotations, {} follow), {} replans",
         s.edges, s.shape_changes, s.lsc_uses, s.srs_uses, s.rotations, s.follow_uses, s.replans
     );
-    let report = write_plan(&plan, &a.out, "solved on", &a.problem.map, &details)?;
+    let report = write_plan(plan, &a.out, "solved on", &a.problem.map, &details)?;
     report.line(format_args!(
         "  setup {:.1} ms, search structures {:.1} ms (free regions {:.1} ms, uniform roadmap of {} vertices), planning {:.1} ms ({:.1} ms in {} collision checks)",
         setup_s * 1e3,
@@ -276,7 +283,7 @@ pub fn run(a: PlanArgs) -> CliResult {
         s.timings.collision_s * 1e3,
         s.collision_checks
     ));
-    print_quality(&report, &quality, refinement.as_ref());
+    print_quality(&report, &planned.quality, planned.refinement.as_ref());
     match s.min_margin_at {
         Some(p) => report.line(format_args!(
             "  smallest clearance margin kept: {:.3} m (below --clearance {:.3} m from ({:.2}, {:.2}, {:.2}) on)",
@@ -292,21 +299,20 @@ pub fn run(a: PlanArgs) -> CliResult {
             s.lattice_s * 1e3
         ));
     }
-    let grid = planner.context().field().grid();
+    let grid = request.grid();
     let mut timed = None;
-    if let Some(path) = &a.trajectory {
-        let began = Instant::now();
-        let tr = super::trajectory::make(&plan, "the plan", grid, &a.timing.settings()?)?;
-        super::trajectory::write(&tr, &plan, path, &report)?;
+    if let (Some(path), Some(made)) = (&a.trajectory, planned.trajectory) {
+        let tr = made.map_err(|e| super::trajectory::refused(e, "the plan"))?;
+        super::trajectory::write(&tr, plan, path, &report)?;
         report.line(format_args!(
             "  trajectory made and checked in {:.1} ms",
-            began.elapsed().as_secs_f64() * 1e3
+            planned.timings.trajectory_s * 1e3
         ));
         timed = Some(tr);
     }
     if let Some(pic) = &a.picture {
         let goal = Some((query.goal, query.goal_tol));
-        match draw(&a, pic, grid, &plan, timed, goal)? {
+        match draw(&a, pic, grid, plan, timed, goal)? {
             Some((frames, step)) => report.line(format_args!(
                 "  animation: {} ({frames} frames, one per {step} s of the trajectory)",
                 pic.display()

@@ -11,16 +11,14 @@ use super::checks;
 use super::common::{looser_assumption, read_plan, MapArgs, MotionArgs, MotionFile, Report};
 use super::trajectory::{read_trajectory, TimingArgs};
 use super::{CliError, CliResult};
+use aerial_chain::flying::{self, FlyError, FlyOptions, Timed, Timing};
 use aerial_chain::map::Grid;
 use aerial_chain::plan_file::Plan;
 use aerial_chain::sim::flight_svg;
 use aerial_chain::sim::Reference;
 use aerial_chain::sim::V3;
 use aerial_chain::sim::{footprint, MapClearance};
-use aerial_chain::sim::{
-    simulate_reference, simulate_with_progress, FlightFile, Gust, Progress, SimConfig,
-};
-use aerial_chain::trajectory::{self, Trajectory, TrajectoryError};
+use aerial_chain::sim::{simulate_reference, FlightFile, Gust, Progress, SimConfig};
 
 /// `arc sim`
 #[derive(Args, Debug)]
@@ -142,6 +140,10 @@ fn check(a: &SimArgs) -> Result<(), CliError> {
 pub fn run(a: SimArgs) -> CliResult {
     check(&a)?;
     let cfg = sim_config(&a)?;
+    let options = FlyOptions {
+        sim: cfg.clone(),
+        timing: a.timing.settings()?,
+    };
     // With `--out -` the flight is standard output; the report goes to standard error.
     let report = Report::new(a.out.as_deref().unwrap_or(Path::new("")));
     let say = |args: std::fmt::Arguments<'_>| report.line(args);
@@ -152,11 +154,16 @@ pub fn run(a: SimArgs) -> CliResult {
             // never the plan's: a plan made with looser assumptions fails (docs/model.md).
             let looser = looser_assumption(&plan, &a.map);
             let loaded = a.map.load()?;
-            let motion = match timed(&a, &plan, &name, &loaded.grid, &say)? {
-                Some(tr) => Motion::Timed(tr.reference().clone()),
-                None => Motion::Waypoints(plan.waypoints.iter().map(|w| w.zeta.clone()).collect()),
-            };
-            (name, plan.waypoints.len(), params, looser, loaded, motion)
+            let timed = timed(&options, &plan, &name, &loaded.grid, &say)?;
+            let count = plan.waypoints.len();
+            (
+                name,
+                count,
+                params,
+                looser,
+                loaded,
+                Motion::Plan(Box::new((plan, timed))),
+            )
         }
         MotionFile::Trajectory(path) => {
             let (file, name, params) = read_trajectory(path)?;
@@ -177,15 +184,16 @@ pub fn run(a: SimArgs) -> CliResult {
                 params,
                 looser,
                 loaded,
-                Motion::Timed(r),
+                Motion::Trajectory(r),
             )
         }
     };
-    let obstacles = MapClearance::new(&loaded.grid, &params);
+    let grid = &loaded.grid;
     let flight = with_progress(|progress| match &motion {
-        Motion::Timed(r) => simulate_reference(&params, r, &cfg, Some(&obstacles), progress),
-        Motion::Waypoints(w) => {
-            simulate_with_progress(&params, w, &cfg, Some(&obstacles), progress)
+        Motion::Plan(p) => flying::fly_timed(&p.0, &p.1, grid, &options, progress),
+        Motion::Trajectory(r) => {
+            let obstacles = MapClearance::new(grid, &params);
+            simulate_reference(&params, r, &cfg, Some(&obstacles), progress).map_err(Into::into)
         }
     })
     .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
@@ -239,48 +247,44 @@ pub fn run(a: SimArgs) -> CliResult {
     )))
 }
 
-/// What is flown: a timed reference, or a plan's waypoints stopping at each.
+/// What is flown: a plan as `arc sim` times it, or a trajectory file's motion.
 enum Motion {
-    Timed(Reference),
-    Waypoints(Vec<Vec<f64>>),
+    Plan(Box<(Plan, Timed)>),
+    Trajectory(Reference),
 }
 
-/// The trajectory to fly: made from the plan and checked exactly on the map, unless
-/// `--no-blend` asks for the stop at every waypoint; a plan that is not admissible as
-/// a trajectory is flown stopping at every waypoint, and the report says why.
+/// The plan timed for its flight (`flying::time`): the trajectory made from it and
+/// checked exactly on the map, unless `--no-blend` asks for the stop at every
+/// waypoint; a plan that is not admissible as a trajectory is flown stopping at every
+/// waypoint, and the report says why.
 fn timed(
-    a: &SimArgs,
+    options: &FlyOptions,
     plan: &Plan,
     plan_name: &str,
     grid: &Grid,
     say: &dyn Fn(std::fmt::Arguments<'_>),
-) -> Result<Option<Trajectory>, CliError> {
-    if a.timing.no_blend {
-        say(format_args!(
+) -> Result<Timed, CliError> {
+    let timed = flying::time(plan, grid, options).map_err(|e| match e {
+        FlyError::Trajectory(e) => super::trajectory::refused(e, plan_name),
+        e => CliError::input(format!("{plan_name}: {e}")),
+    })?;
+    match &timed.timing {
+        Timing::Trajectory(tr) => say(format_args!(
+            "  timing: trajectory of {:.2} s ({:.2} s stopping at every waypoint), {} of {} corners blended, {} corners merged",
+            tr.duration(),
+            tr.stop_go_duration(),
+            tr.blended(),
+            tr.corners(),
+            tr.merged()
+        )),
+        Timing::StopAtWaypoints(Some(v)) => say(format_args!(
+            "  timing: stopping at every waypoint: the plan is not admissible as a trajectory ({v})"
+        )),
+        Timing::StopAtWaypoints(None) => say(format_args!(
             "  timing: stopping at every waypoint (--no-blend)"
-        ));
-        return Ok(None);
+        )),
     }
-    match trajectory::build(plan, grid, &a.timing.settings()?) {
-        Ok(tr) => {
-            say(format_args!(
-                "  timing: trajectory of {:.2} s ({:.2} s stopping at every waypoint), {} of {} corners blended, {} corners merged",
-                tr.duration(),
-                tr.stop_go_duration(),
-                tr.blended(),
-                tr.corners(),
-                tr.merged()
-            ));
-            Ok(Some(tr))
-        }
-        Err(TrajectoryError::Inadmissible(v)) => {
-            say(format_args!(
-                "  timing: stopping at every waypoint: the plan is not admissible as a trajectory ({v})"
-            ));
-            Ok(None)
-        }
-        Err(e) => Err(super::trajectory::refused(e, plan_name)),
-    }
+    Ok(timed)
 }
 
 /// The simulation settings from the command line, checked.

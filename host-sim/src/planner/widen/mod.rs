@@ -31,7 +31,9 @@
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
-use super::Step;
+use std::time::Instant;
+
+use super::{expired, Step};
 use crate::collision::exact::positions_f64;
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
 use crate::collision::CollisionContext;
@@ -116,11 +118,14 @@ pub struct Widening {
 /// Moves the stations of `steps` towards the middle of narrow passages (see the module
 /// docs). `ctx` is the context the plan was checked in; moves must pass its checks,
 /// or, for an edge that did not pass them before (where the search gave way), those of
-/// `ctx_min`.
+/// `ctx_min`. Past `deadline` (the query's time limit) no move is tried: the moves
+/// taken are kept, and the result is as admissible as ever (only then can two runs
+/// differ).
 pub(super) fn widen(
     ctx: &CollisionContext,
     ctx_min: &CollisionContext,
     steps: Vec<Step>,
+    deadline: Option<Instant>,
 ) -> (Vec<Step>, Widening) {
     let edges = steps.len().saturating_sub(1);
     let narrow: Vec<Narrowest> = (0..edges).map(|e| measure_whole(ctx, e, &steps)).collect();
@@ -132,10 +137,11 @@ pub(super) fn widen(
         steps,
         spent: edges,
         splits: 0,
+        deadline,
     };
     let before = w.narrowest();
     let mut moves = 0;
-    while w.spent < BUDGET {
+    while w.may_spend() {
         let Some(e) = w.worst() else { break };
         if w.improve(e) {
             moves += 1;
@@ -168,9 +174,17 @@ struct Widener<'a> {
     spent: usize,
     /// Translations split so far.
     splits: usize,
+    /// When to stop trying moves (the query's time limit).
+    deadline: Option<Instant>,
 }
 
 impl Widener<'_> {
+    /// Whether another measurement may be spent: budget left, and the deadline not
+    /// passed.
+    fn may_spend(&self) -> bool {
+        self.spent < BUDGET && !expired(self.deadline)
+    }
+
     fn narrowest(&self) -> f64 {
         self.narrow.iter().map(|n| n.clearance).fold(CAP, f64::min)
     }
@@ -281,7 +295,7 @@ impl Widener<'_> {
         tries.extend(dirs.iter().skip(1).map(|d| (last, d)));
         for (f, d) in tries {
             for g in groups {
-                if self.spent >= BUDGET {
+                if !self.may_spend() {
                     return false;
                 }
                 if self.try_move(g, d * (f * r_v), e) {
@@ -458,7 +472,7 @@ impl Widener<'_> {
         let mut moves = 0;
         for e in 0..self.narrow.len() {
             let Some(along) = self.along(e) else { continue };
-            while self.spent < BUDGET && self.narrow[e].clearance < CAP {
+            while self.may_spend() && self.narrow[e].clearance < CAP {
                 let Some((target, grad, away)) = self.off_middle(e, along) else {
                     break;
                 };
@@ -473,7 +487,7 @@ impl Widener<'_> {
                 let r_v = self.ctx.field().grid().resolution();
                 let taken = STEPS.iter().any(|&f| {
                     groups.iter().any(|g| {
-                        self.spent < BUDGET && self.try_move_at(g, d * (f * r_v), e, target, &away)
+                        self.may_spend() && self.try_move_at(g, d * (f * r_v), e, target, &away)
                     })
                 });
                 if !taken {

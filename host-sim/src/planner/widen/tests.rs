@@ -35,7 +35,7 @@ fn step(xi: [f64; 3], shape: &Shape) -> Step {
 fn widened_in_the_window(steps: &[Step]) -> Vec<Step> {
     let ctx = window();
     assert!(steps.windows(2).all(|w| edge_passes(&ctx, &w[0], &w[1])));
-    let (out, report) = widen(&ctx, &ctx, steps.to_vec());
+    let (out, report) = widen(&ctx, &ctx, steps.to_vec(), None);
     let (first, last) = (&steps[0], &steps[steps.len() - 1]);
     assert_eq!((out[0].xi, out[out.len() - 1].xi), (first.xi, last.xi));
     assert!(out.iter().all(|s| s.shape == first.shape));
@@ -60,6 +60,21 @@ fn an_off_centre_passage_moves_to_the_middle_and_stays_admissible() {
 }
 
 #[test]
+fn past_its_deadline_widening_moves_nothing_and_keeps_the_plan() {
+    let ctx = window();
+    let past = Some(std::time::Instant::now());
+    std::thread::sleep(std::time::Duration::from_millis(2));
+    let (out, report) = widen(&ctx, &ctx, off_centre(), past);
+    assert_eq!(out, off_centre());
+    assert_eq!(report.moves, 0);
+    assert_eq!(report.before, report.after);
+    // Without a deadline the same plan is widened (the test above): the deadline is
+    // what stopped it.
+    let (_, free) = widen(&ctx, &ctx, off_centre(), None);
+    assert!(free.moves > 0);
+}
+
+#[test]
 fn a_passage_between_start_and_goal_is_split_and_centred() {
     let straight = Shape::from_slice(3, &[0.0; 5]).unwrap();
     // One translation from the start to the goal, both of which stay.
@@ -76,8 +91,8 @@ fn a_passage_between_start_and_goal_is_split_and_centred() {
 #[test]
 fn the_same_plan_widens_the_same_way() {
     let ctx = window();
-    let (a, ra) = widen(&ctx, &ctx, off_centre());
-    let (b, rb) = widen(&ctx, &ctx, off_centre());
+    let (a, ra) = widen(&ctx, &ctx, off_centre(), None);
+    let (b, rb) = widen(&ctx, &ctx, off_centre(), None);
     assert!(ra.moves > 0);
     assert_eq!((a, ra), (b, rb));
 }
@@ -134,7 +149,7 @@ fn a_second_passage_on_the_same_translation_is_widened_too() {
     assert!(steps.windows(2).all(|w| edge_passes(&ctx, &w[0], &w[1])));
     let door_before = clearance_at_wall(&ctx, &steps, 3.05);
     assert!(door_before < 0.16, "{door_before}");
-    let (out, report) = widen(&ctx, &ctx, steps);
+    let (out, report) = widen(&ctx, &ctx, steps, None);
     assert!(out.windows(2).all(|w| edge_passes(&ctx, &w[0], &w[1])));
     let opening = clearance_at_wall(&ctx, &out, 2.05);
     let door = clearance_at_wall(&ctx, &out, 3.05);
@@ -234,6 +249,7 @@ fn an_edge_stuck_at_a_pinch_gives_up_its_neighbours_there() {
             at(1.9, 0.09),
         ],
         stuck: vec![false; 5],
+        deadline: None,
         spent: 0,
         splits: 0,
     };
@@ -250,7 +266,7 @@ fn wide_plans_are_left_alone() {
         step([1.0, 1.0, 1.0], &straight),
         step([1.4, 1.0, 1.0], &straight),
     ];
-    let (out, report) = widen(&ctx, &ctx, steps.clone());
+    let (out, report) = widen(&ctx, &ctx, steps.clone(), None);
     assert_eq!(out, steps);
     assert_eq!(report.moves, 0);
     assert_eq!(report.before, CAP);

@@ -7,20 +7,14 @@
 //! Runs are sequential: each is deterministic in its spec, timings aside.
 
 use std::fmt::Write as _;
-use std::sync::atomic::AtomicUsize;
-use std::sync::Arc;
-use std::time::Instant;
 
-use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
-use aerial_chain::map::DistanceField;
+use aerial_chain::collision::verify_plan;
+use aerial_chain::flying::{self, FlyOptions, Timed};
 use aerial_chain::picture::{palette, stroke, Axis, Figure, Mark, Panel};
-use aerial_chain::plan_file::MapSection;
-use aerial_chain::planner::{to_plan, ArcPlanner, Planner, Query, Settings, Termination};
+use aerial_chain::planner::{Query, Settings};
+use aerial_chain::planning::{self, PlanOptions, Request};
 use aerial_chain::problem::scenarios;
-use aerial_chain::sim::{
-    simulate_reference, simulate_with_progress, FlightReport, MapClearance, Progress, SimConfig,
-};
-use aerial_chain::tables::{ShapeTables, TableSettings};
+use aerial_chain::sim::{FlightReport, Progress};
 use aerial_chain::trajectory;
 
 use super::report::csv_field;
@@ -122,35 +116,37 @@ fn fly_both(run: &mut FlightRun) -> Result<(), String> {
     let params = ChainParams::new(run.units)
         .validate()
         .map_err(|e| e.to_string())?;
-    let field = Arc::new(DistanceField::new(sc.grid.clone()));
-    let ctx = CollisionContext::new(field, params, DEFAULT_CLEARANCE).map_err(|e| e.to_string())?;
-    let ts = TableSettings {
-        seed: run.seed,
-        ..Default::default()
-    };
-    let tables =
-        ShapeTables::build(params, &ts, &AtomicUsize::new(0)).map_err(|e| e.to_string())?;
-    let settings = Settings {
-        seed: run.seed,
-        ..Default::default()
-    };
-    let mut planner = ArcPlanner::new(ctx, tables, settings).map_err(|e| e.to_string())?;
     let query = Query::new(
         sc.start,
         sc.start_shape(run.units).map_err(|e| e.to_string())?,
         sc.goal,
     );
-    let solution = planner
-        .solve(&query, Termination::default())
-        .map_err(|e| format!("no plan: {e}"))?;
-    let (solution, refinement) = planner.refine(&solution, None);
+    // `arc plan`'s defaults with the run's seeds, without a time limit (runs are
+    // deterministic), and the trajectory `arc sim` flies.
+    let options = PlanOptions {
+        planner: Settings {
+            seed: run.seed,
+            ..Default::default()
+        },
+        srs_seed: run.seed,
+        time_limit_s: None,
+        trajectory: Some(trajectory::Settings::default()),
+        ..Default::default()
+    };
+    let request = Request::new(sc.grid.clone(), params, query);
+    // The planner's reason alone: the error column holds no timing.
+    let planned = planning::plan(&request, None, &options).map_err(|e| match e {
+        planning::PlanningError::NoPlan(n) => format!("no plan: {}", n.error),
+        e => e.to_string(),
+    })?;
+    let refinement = planned.refinement.ok_or("post-processing was asked for")?;
     run.refine_s = refinement.time_s;
     run.shape_motion_rad = (
         refinement.before.shape_motion_rad,
         refinement.after.shape_motion_rad,
     );
     let grid = &sc.grid;
-    let plan = to_plan(&solution, &params, MapSection::of(grid));
+    let plan = planned.plan;
     let check = verify_plan(grid, &plan);
     if !check.ok {
         return Err(format!("plan invalid: {:?}", check.violation));
@@ -160,35 +156,32 @@ fn fly_both(run: &mut FlightRun) -> Result<(), String> {
         .iter()
         .filter(|e| **e == aerial_chain::collision::EdgeKind::ShapeChange)
         .count();
-    let began = Instant::now();
-    let tr = trajectory::build(&plan, grid, &trajectory::Settings::default())
-        .map_err(|e| e.to_string())?;
-    run.trajectory_s = began.elapsed().as_secs_f64();
+    let tr = match planned.trajectory {
+        Some(made) => made.map_err(|e| e.to_string())?,
+        None => return Err("the trajectory was asked for".into()),
+    };
+    run.trajectory_s = planned.timings.trajectory_s;
     run.head_path_m = tr.head_path_m();
     run.corners = tr.corners();
     run.blended = tr.blended();
     run.merged = tr.merged();
     run.trajectory_duration_s = tr.duration();
-    let cfg = SimConfig::default();
-    let obstacles = MapClearance::new(grid, &params);
-    let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
-    let before = simulate_with_progress(
-        &params,
-        &waypoints,
-        &cfg,
-        Some(&obstacles),
-        &Progress::default(),
-    )
-    .map_err(|e| e.to_string())?;
+    // Both as `arc sim` flies them: `--no-blend`, then the default, along the
+    // trajectory made above.
+    let stopping = FlyOptions {
+        timing: trajectory::Settings {
+            blend: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let (before, _) =
+        flying::fly(&plan, grid, &stopping, &Progress::default()).map_err(|e| e.to_string())?;
     run.before = Some(Flown::of(&before.report));
-    let after = simulate_reference(
-        &params,
-        tr.reference(),
-        &cfg,
-        Some(&obstacles),
-        &Progress::default(),
-    )
-    .map_err(|e| e.to_string())?;
+    let blended = FlyOptions::default();
+    let timed = Timed::along(tr, &blended);
+    let after = flying::fly_timed(&plan, &timed, grid, &blended, &Progress::default())
+        .map_err(|e| e.to_string())?;
     run.after = Some(Flown::of(&after.report));
     Ok(())
 }
@@ -390,6 +383,26 @@ mod tests {
             before: Some(flown(before)),
             after: Some(flown(after)),
         }
+    }
+
+    #[test]
+    fn a_run_plans_through_the_facade_and_flies_both_ways_as_arc_sim_does() {
+        let r = run_one("window", 3, 1);
+        assert!(r.error.is_empty(), "{}", r.error);
+        let (before, after) = (r.before.unwrap(), r.after.unwrap());
+        assert!(before.success && after.success);
+        // Blended, the flight ends sooner.
+        assert!(
+            after.time_s + 1.0 < before.time_s,
+            "{} {}",
+            after.time_s,
+            before.time_s
+        );
+        // The blended flight arrives (within its goal tolerance) about when its
+        // trajectory, after the hold, ends.
+        let end = r.trajectory_duration_s + 1.0;
+        assert!((after.time_s - end).abs() < 1.5, "{} {end}", after.time_s);
+        assert!(r.shape_motion_rad.1 <= r.shape_motion_rad.0 + 1e-9);
     }
 
     #[test]

@@ -48,6 +48,7 @@ use aerial_chain::plan_file::MapSection;
 use aerial_chain::planner::{
     to_plan, ArcPlanner, Failure, Planner, Settings, Solution, SolutionStats, Termination,
 };
+use aerial_chain::planning;
 use aerial_chain::problem::passages::{OpeningClearance, PassageSpec};
 use aerial_chain::problem::scenarios::{self, Scenario};
 use aerial_chain::tables::{ShapeTables, TableSettings};
@@ -496,11 +497,10 @@ fn passage_result(
     let spec = PassageSpec::parse(name).ok()?;
     let params = *planner.context().params();
     let g = &env.scenario.grid;
-    let as_plan = |s| to_plan(s, &params, MapSection::of(g));
+    let raw = to_plan(sol, &params, MapSection::of(g));
     let t = Instant::now();
-    let (post, _) = planner.refine(sol, None);
+    let post = planning::finish(planner, sol.clone(), MapSection::of(g), true, None).plan;
     let post_s = t.elapsed().as_secs_f64();
-    let (raw, post) = (as_plan(sol), as_plan(&post));
     let raw_o = spec.opening_clearances(&raw, &params).ok()?;
     let post_o = spec.opening_clearances(&post, &params).ok()?;
     Some(PassageResult {

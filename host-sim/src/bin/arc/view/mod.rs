@@ -93,8 +93,8 @@ pub fn run(a: ViewArgs) -> CliResult {
         .map(|p| read_flight(p, units))
         .transpose()?;
     let loaded = a.map.load()?;
-    let waypoints =
-        scene::waypoints(&plan).map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
+    let waypoints = scene::waypoints(&plan, &loaded.grid)
+        .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
     let last = plan.waypoints[plan.waypoints.len() - 1].xi();
     let goal = a
         .goal

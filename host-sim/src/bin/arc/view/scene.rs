@@ -4,9 +4,9 @@
 
 use std::collections::{BTreeMap, HashSet};
 
+use aerial_chain::flying::{self, FlyOptions};
 use aerial_chain::map::{Cell, Grid};
 use aerial_chain::plan_file::Plan;
-use aerial_chain::sim::{Reference, ReferenceLimits};
 use aerial_chain_core::kinematics::positions_into;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -49,7 +49,7 @@ pub struct Boxes {
     pub unknown: Vec<i32>,
 }
 
-/// The plan's waypoints, on the time axis of `arc sim`.
+/// The plan's waypoints, on the time axis of `arc sim` (its default settings).
 #[derive(Serialize)]
 pub struct Waypoints {
     /// Time each waypoint is reached (s).
@@ -127,32 +127,27 @@ pub fn kind_of(label: &str) -> &'static str {
     }
 }
 
-/// The unit centres of every waypoint, and the time each is reached when flown as
-/// `arc sim` flies it with its default limits (the start hold included).
-pub fn waypoints(plan: &Plan) -> Result<Waypoints, String> {
+/// The unit centres of every waypoint, and the time each is reached when flown on
+/// `grid` as `arc sim` flies it with its default settings (`flying::time`: along the
+/// plan's trajectory, the start hold included), times to the millisecond.
+pub fn waypoints(plan: &Plan, grid: &Grid) -> Result<Waypoints, String> {
     let n = plan.chain.units as usize;
     let l = plan.chain.link_length;
-    let zetas: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
-    let reference = Reference::new(n, l, &zetas, &ReferenceLimits::default())
+    let timed = flying::time(plan, grid, &FlyOptions::default())
         .map_err(|e| format!("cannot time the plan: {e}"))?;
-    let mut t = vec![0.0; zetas.len()];
-    let mut leave = vec![0.0; zetas.len()];
-    for s in reference.segments() {
-        if s.to_waypoint > 0 {
-            t[s.to_waypoint] = mm(s.t0 + s.duration);
-            leave[s.to_waypoint - 1] = mm(s.t0);
-        }
-    }
-    if let (Some(l), Some(&end)) = (leave.last_mut(), t.last()) {
-        *l = end;
-    }
+    let (t, leave) = timed.waypoint_times(plan);
+    let (t, leave) = (
+        t.into_iter().map(mm).collect(),
+        leave.into_iter().map(mm).collect(),
+    );
+    let count = plan.waypoints.len();
     let labels = plan.stats.get("waypoint_sources");
     let label = |i: usize| labels.and_then(|l| l.get(i)).and_then(|v| v.as_str());
-    let source: Vec<String> = (0..zetas.len())
+    let source: Vec<String> = (0..count)
         .map(|i| label(i).unwrap_or("").to_string())
         .collect();
     let kind = source.iter().map(|s| kind_of(s)).collect();
-    let mut units = Vec::with_capacity(zetas.len() * n * 3);
+    let mut units = Vec::with_capacity(count * n * 3);
     let mut out = vec![Vector3::<f64>::zeros(); n];
     for w in &plan.waypoints {
         let xi = w.xi();

@@ -1,0 +1,103 @@
+//! The facade's tests: the same plan as the steps it stands for, and its errors.
+
+use aerial_chain_core::ChainParams;
+use nalgebra::Point3;
+
+use super::*;
+use crate::collision::verify_plan;
+use crate::planner::{Settings, Termination};
+use crate::problem::scenarios;
+use crate::tables::TableSettings;
+
+/// The `window` scenario for a chain of 3 and options with small tables (fast).
+fn window() -> (Request, PlanOptions) {
+    let sc = scenarios::build("window").unwrap();
+    let params = ChainParams::new(3);
+    let query = Query::new(sc.start, sc.start_shape(3).unwrap(), sc.goal);
+    let options = PlanOptions {
+        srs: 60,
+        ..PlanOptions::default()
+    };
+    (Request::new(sc.grid.clone(), params, query), options)
+}
+
+#[test]
+fn the_facade_plans_as_search_refine_and_annotate_do_one_by_one() {
+    let (request, options) = window();
+    let planned = plan(&request, None, &options).unwrap();
+    // The same steps by hand, as `arc plan` ran them before the facade.
+    let tables = ShapeTables::build(
+        request.params,
+        &TableSettings {
+            srs: 60,
+            ..TableSettings::default()
+        },
+        &AtomicUsize::new(0),
+    )
+    .unwrap();
+    let ctx = CollisionContext::new(request.field.clone(), request.params, options.clearance);
+    let mut planner = ArcPlanner::new(ctx.unwrap(), tables, Settings::default()).unwrap();
+    let raw = planner
+        .solve(&request.query, Termination::default())
+        .unwrap();
+    let (refined, r) = planner.refine(&raw, None);
+    let mut by_hand = to_plan(&refined, &request.params, request.map.clone());
+    annotate_quality(&mut by_hand, &Quality::of(&refined.steps), Some(&r));
+    assert_eq!(planned.plan.waypoints, by_hand.waypoints);
+    assert_eq!(planned.plan.stats["quality"], by_hand.stats["quality"]);
+    assert!(planned.plan.stats.contains_key("refinement"));
+    assert_eq!(planned.quality, Quality::of(&refined.steps));
+    assert!(verify_plan(request.grid(), &planned.plan).ok);
+    assert!(planned.trajectory.is_none());
+}
+
+#[test]
+fn without_smoothing_the_plan_is_the_searchs_and_a_trajectory_comes_when_asked() {
+    let (request, mut options) = window();
+    options.no_smooth = true;
+    options.trajectory = Some(crate::trajectory::Settings::default());
+    let planned = plan(&request, None, &options).unwrap();
+    assert!(planned.refinement.is_none());
+    assert!(!planned.plan.stats.contains_key("refinement"));
+    let tr = planned.trajectory.expect("asked for").expect("admissible");
+    assert!(tr.duration() > 0.0);
+}
+
+#[test]
+fn bad_input_and_no_plan_are_told_apart() {
+    let (request, options) = window();
+    let bad_clearance = PlanOptions {
+        clearance: -1.0,
+        ..options.clone()
+    };
+    let e = plan(&request, None, &bad_clearance).unwrap_err();
+    assert!(
+        e.is_input() && e.to_string().starts_with("clearance = -1"),
+        "{e}"
+    );
+    let mut in_wall = request.clone();
+    in_wall.query.start = Point3::new(4.1, 1.0, 1.5);
+    let e = plan(&in_wall, None, &options).unwrap_err();
+    assert!(
+        e.is_input() && e.to_string().contains("start is invalid"),
+        "{e}"
+    );
+    let other_chain = ShapeTables::build(
+        ChainParams::new(4),
+        &options.table_settings(),
+        &AtomicUsize::new(0),
+    )
+    .unwrap();
+    let e = plan(&request, Some(other_chain), &options).unwrap_err();
+    assert!(e.is_input(), "{e}");
+    // A microsecond: far less than the window's query takes.
+    let short = PlanOptions {
+        time_limit_s: Some(1e-6),
+        ..options
+    };
+    let e = plan(&request, None, &short).unwrap_err();
+    assert!(!e.is_input(), "{e}");
+    let s = e.to_string();
+    assert!(s.starts_with("no plan: time limit reached"), "{s}");
+    assert!(s.contains("time limit stopped it after trying"), "{s}");
+}
