@@ -27,6 +27,8 @@ pub enum Source {
     Shrunk,
     /// A configuration of the full-state PRM's roadmap ([`crate::baseline`]).
     Sampled,
+    /// The yaw and shape a goal asks for ([`crate::goal::GoalPose`]).
+    Goal,
 }
 
 /// A shape with its origin.

@@ -263,7 +263,7 @@ pub(super) fn count_sources(steps: &[Step], stats: &mut Stats) {
             Source::Srs(_) | Source::SrsTurned(_) => stats.srs_uses += 1,
             Source::Follow => stats.follow_uses += 1,
             Source::Shrunk => stats.shrunk += 1,
-            Source::Start | Source::Sampled => {}
+            Source::Start | Source::Sampled | Source::Goal => {}
         }
     }
 }

@@ -26,6 +26,7 @@ pub(crate) mod connect;
 pub(crate) mod construction;
 mod error;
 pub(crate) mod follow;
+mod goal_pose;
 pub(crate) mod graph;
 pub(crate) mod lattice;
 pub(crate) mod motion;

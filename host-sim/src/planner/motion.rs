@@ -25,6 +25,7 @@ pub fn source_label(s: &Source, shape_change: bool) -> String {
         (Source::Follow, true) => "follow".into(),
         (Source::Shrunk, true) => "shrunk".into(),
         (Source::Sampled, true) => "sampled".into(),
+        (Source::Goal, true) => "goal".into(),
     }
 }
 

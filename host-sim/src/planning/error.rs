@@ -38,13 +38,35 @@ pub enum PlanningError {
     /// The query ran and found no plan ([`NoPlan`] says why and what was tried).
     #[error(transparent)]
     NoPlan(Box<NoPlan>),
+    /// The goal's yaw and shape give no valid configuration at the goal (bad input).
+    #[error("the goal configuration ({pose}) is not valid at ({x:.3}, {y:.3}, {z:.3}): {why}", x = at[0], y = at[1], z = at[2])]
+    GoalPose {
+        /// The pose in words.
+        pose: String,
+        /// The goal's head position.
+        at: [f64; 3],
+        /// Why, by the exact test (at the best heading tried).
+        why: String,
+    },
+    /// The route reached the goal, but no checked shape change takes the chain into
+    /// the goal's yaw and shape there.
+    #[error("no plan: the head reached ({x:.3}, {y:.3}, {z:.3}), but no checked shape change (direct, or through one library or random shape) takes the chain into the goal configuration ({pose}) there", x = at[0], y = at[1], z = at[2])]
+    PoseUnreachable {
+        /// The pose in words.
+        pose: String,
+        /// Where the head's route ended.
+        at: [f64; 3],
+    },
 }
 
 impl PlanningError {
     /// Whether the input is at fault (options, tables, query), rather than the query
     /// having no plan.
     pub fn is_input(&self) -> bool {
-        !matches!(self, PlanningError::NoPlan(_))
+        !matches!(
+            self,
+            PlanningError::NoPlan(_) | PlanningError::PoseUnreachable { .. }
+        )
     }
 }
 

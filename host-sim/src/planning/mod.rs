@@ -12,6 +12,7 @@
 //! The `arc plan` command, the Python package, the examples and the benchmarks plan
 //! through this module; none of them refines or annotates a plan itself.
 
+mod arrival;
 mod error;
 mod options;
 
@@ -21,10 +22,12 @@ use std::time::Instant;
 
 use aerial_chain_core::ChainParams;
 
+pub use arrival::Arrival;
 pub use error::{NoPlan, PlanningError};
 pub use options::{PlanOptions, DEFAULT_TIME_LIMIT_S, MAX_TIME_LIMIT_S};
 
 use crate::collision::CollisionContext;
+use crate::goal::GoalPose;
 use crate::map::{DistanceField, Grid};
 use crate::plan_file::{MapSection, Plan};
 use crate::planner::{
@@ -34,8 +37,8 @@ use crate::planner::{
 use crate::tables::ShapeTables;
 use crate::trajectory::{Trajectory, TrajectoryError};
 
-/// What to plan: a map (its distance field), a chain, a query, and how the plan file
-/// records the map.
+/// What to plan: a map (its distance field), a chain, a query (with the goal's yaw and
+/// shape, when it asks for them), and how the plan file records the map.
 #[derive(Clone, Debug)]
 pub struct Request {
     /// The map's distance field (it keeps the grid).
@@ -44,6 +47,8 @@ pub struct Request {
     pub params: ChainParams,
     /// Start, start shape, goal and its tolerance.
     pub query: Query,
+    /// The yaw and shape the chain should arrive in (default: any).
+    pub pose: GoalPose,
     /// The plan file's map section ([`MapSection::of`] the grid, with its source).
     pub map: MapSection,
 }
@@ -57,8 +62,15 @@ impl Request {
             field: Arc::new(DistanceField::new(grid)),
             params,
             query,
+            pose: GoalPose::default(),
             map,
         }
+    }
+
+    /// The request with the goal's yaw and shape `pose`.
+    pub fn with_pose(mut self, pose: GoalPose) -> Self {
+        self.pose = pose;
+        self
     }
 
     /// The map's grid.
@@ -122,6 +134,7 @@ pub fn plan(
     options: &PlanOptions,
 ) -> Result<Planned, PlanningError> {
     let stop = options.termination()?;
+    arrival::check_pose(request)?;
     let setup = Instant::now();
     let mut planner = planner(request, tables, options)?;
     let setup_s = setup.elapsed().as_secs_f64();
@@ -132,13 +145,18 @@ pub fn plan(
     let search_s = began.elapsed().as_secs_f64();
     let post = Instant::now();
     let smooth = !options.no_smooth;
+    let arrive = arrival::Arrival {
+        goal: request.query.goal,
+        pose: request.pose,
+    };
     let done = finish(
         &planner,
         solution,
         request.map.clone(),
         smooth,
         stop.deadline(began),
-    );
+        &arrive,
+    )?;
     let post_s = post.elapsed().as_secs_f64();
     let made = Instant::now();
     let trajectory = options
@@ -215,31 +233,35 @@ fn no_plan(
 }
 
 /// Makes `solution` (of `planner`'s last query) the plan file `arc plan` writes:
-/// post-processed when `smooth` (stopping at `deadline` with what it has), on the map
-/// `map` describes, its quality and post-processing recorded.
+/// post-processed when `smooth` (stopping at `deadline` with what it has), then
+/// ending in the goal's yaw and shape (`arrive`), on the map `map` describes, its
+/// quality and post-processing recorded. Fails only when no checked shape change
+/// reaches the goal's configuration.
 pub fn finish(
     planner: &ArcPlanner,
     solution: Solution<Stats>,
     map: MapSection,
     smooth: bool,
     deadline: Option<Instant>,
-) -> Finished {
-    let (solution, refinement) = match smooth {
+    arrive: &arrival::Arrival,
+) -> Result<Finished, PlanningError> {
+    let (mut solution, refinement) = match smooth {
         true => {
             let (refined, r) = planner.refine(&solution, deadline);
             (refined, Some(r))
         }
         false => (solution, None),
     };
+    arrive.extend(planner, &mut solution.steps)?;
     let quality = Quality::of(&solution.steps);
     let mut plan = to_plan(&solution, planner.context().params(), map);
     annotate_quality(&mut plan, &quality, refinement.as_ref());
-    Finished {
+    Ok(Finished {
         plan,
         stats: solution.stats,
         quality,
         refinement,
-    }
+    })
 }
 
 #[cfg(test)]

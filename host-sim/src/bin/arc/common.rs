@@ -446,3 +446,42 @@ mod tests {
         assert!(parse_point("1,inf,2").unwrap_err().contains("not finite"));
     }
 }
+
+/// The yaw and shape a plan must end in (`arc plan`, `arc verify`).
+#[derive(Args, Debug, Clone)]
+pub struct GoalPoseArgs {
+    /// The head's yaw at the goal (degrees): the plan ends in it.
+    #[arg(long, allow_hyphen_values = true)]
+    pub goal_yaw_deg: Option<f64>,
+    /// The shape at the goal: a library name (LI, SE, SM, SV, CA, PN) or 2N - 1 angles
+    /// `a,b,...` (rad: head yaw, then every link's pitch and yaw); without
+    /// --goal-yaw-deg it matches at any heading.
+    #[arg(long)]
+    pub goal_shape: Option<String>,
+}
+
+impl GoalPoseArgs {
+    /// The pose for the chain `params`, each flag checked.
+    pub fn pose(&self, params: &ChainParams) -> Result<aerial_chain::goal::GoalPose, CliError> {
+        if let Some(y) = self.goal_yaw_deg {
+            if !(y.is_finite() && y.abs() <= 360.0) {
+                return Err(super::checks::bad(
+                    "--goal-yaw-deg",
+                    y,
+                    "degrees within [-360, 360]",
+                ));
+            }
+        }
+        let shape = match &self.goal_shape {
+            Some(text) => Some(
+                aerial_chain::goal::parse_shape(params, text)
+                    .map_err(|e| CliError::input(format!("--goal-shape {text}: {e}")))?,
+            ),
+            None => None,
+        };
+        Ok(aerial_chain::goal::GoalPose {
+            yaw: self.goal_yaw_deg.map(|y| y.to_radians() as f32),
+            shape,
+        })
+    }
+}

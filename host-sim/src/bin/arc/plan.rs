@@ -9,7 +9,7 @@ use aerial_chain_core::ChainParams;
 use clap::Args;
 
 use super::checks;
-use super::common::{write_plan, ProblemArgs, Report};
+use super::common::{write_plan, GoalPoseArgs, ProblemArgs, Report};
 use super::trajectory::TimingArgs;
 use super::{CliError, CliResult};
 use aerial_chain::collision::DEFAULT_CLEARANCE;
@@ -93,6 +93,8 @@ pub struct PlanArgs {
     /// map and the shape tables, is not counted); at most 1e6.
     #[arg(long, default_value_t = DEFAULT_TIME_LIMIT_S)]
     time_limit: f64,
+    #[command(flatten)]
+    pose: GoalPoseArgs,
     /// Output plan (JSON, arc-plan/1); `-` writes it to standard output.
     #[arg(long)]
     out: PathBuf,
@@ -250,10 +252,12 @@ pub fn run(a: PlanArgs) -> CliResult {
     let setup = Instant::now();
     let (loaded, params, query) = a.problem.load()?;
     let map = MapSection::of(&loaded.grid).with_source(loaded.source.clone());
+    let pose = a.pose.pose(&params)?;
     let request = Request {
         field: Arc::new(DistanceField::new(loaded.grid)),
         params,
         query,
+        pose,
         map,
     };
     let tables = load_tables(a.tables.as_ref(), params, a.srs, a.srs_seed)?;
@@ -263,7 +267,8 @@ pub fn run(a: PlanArgs) -> CliResult {
             n.setup_s += loading_s;
             CliError::failed(n.to_string())
         }
-        e => CliError::input(e.to_string()),
+        e if e.is_input() => CliError::input(e.to_string()),
+        e => CliError::failed(e.to_string()),
     })?;
     let setup_s = loading_s + planned.timings.setup_s;
     let plan = &planned.plan;

@@ -5,7 +5,9 @@ use std::path::Path;
 use clap::Args;
 
 use super::checks;
-use super::common::{looser_assumption, parse_point, MapArgs, MotionArgs, MotionFile};
+use super::common::{
+    looser_assumption, parse_point, GoalPoseArgs, MapArgs, MotionArgs, MotionFile,
+};
 use super::trajectory::{read_trajectory, LimitArgs};
 use super::{CliError, CliResult};
 use aerial_chain::collision::{verify_plan, VerifyOptions};
@@ -33,6 +35,9 @@ pub struct VerifyArgs {
     /// Goal tolerance (m).
     #[arg(long, default_value_t = 0.3)]
     goal_tol: f64,
+    /// The yaw and shape the plan must end in (within 1e-6 rad, docs/model.md).
+    #[command(flatten)]
+    pose: GoalPoseArgs,
 }
 
 /// A point for messages: `(x, y, z)`.
@@ -105,8 +110,26 @@ pub fn run(a: VerifyArgs) -> CliResult {
     if !report.ok {
         return Err(CliError::failed("INVALID"));
     }
+    ends_in_pose(&plan, &a.pose)?;
     println!("  VALID");
     Ok(())
+}
+
+/// Checks that the plan's last configuration is the yaw and shape asked for, where
+/// asked (docs/model.md, "Goal configurations").
+fn ends_in_pose(plan: &Plan, args: &GoalPoseArgs) -> CliResult {
+    let params = plan.check().map_err(|e| CliError::input(e.to_string()))?;
+    let pose = args.pose(&params)?;
+    let last = plan.waypoints[plan.waypoints.len() - 1].eta();
+    if pose.holds(last) {
+        return Ok(());
+    }
+    Err(CliError::failed(format!(
+        "INVALID: the last configuration (head yaw {:.4} rad) is not the goal's {} within {} rad",
+        last[0],
+        pose.describe(args.goal_shape.as_deref()),
+        aerial_chain::goal::POSE_TOLERANCE
+    )))
 }
 
 /// Checks that the head starts at `start` (within 1e-6 m) and ends within `tol` of

@@ -499,7 +499,10 @@ fn passage_result(
     let g = &env.scenario.grid;
     let raw = to_plan(sol, &params, MapSection::of(g));
     let t = Instant::now();
-    let post = planning::finish(planner, sol.clone(), MapSection::of(g), true, None).plan;
+    let end = planning::Arrival::anywhere(env.scenario.goal);
+    let post = planning::finish(planner, sol.clone(), MapSection::of(g), true, None, &end)
+        .ok()?
+        .plan;
     let post_s = t.elapsed().as_secs_f64();
     let raw_o = spec.opening_clearances(&raw, &params).ok()?;
     let post_o = spec.opening_clearances(&post, &params).ok()?;
