@@ -15,7 +15,8 @@
 //! - [`planner`]: [`planner::Planner`], [`planner::Query`], [`planner::ArcPlanner`],
 //!   [`planner::to_plan`]; [`baseline`]: [`baseline::FullStatePrm`];
 //! - [`plan_file`]: [`plan_file::Plan`], the `arc-plan/1` file;
-//! - [`goal`]: [`goal::GoalPose`], the yaw and shape a goal may ask for;
+//! - [`goal`]: [`goal::GoalPose`], the yaw and shape a goal may ask for; [`mission`]:
+//!   [`mission::Mission`], an ordered list of goals (`arc-mission/1`);
 //! - [`sim`]: [`sim::simulate`] (stopping at every waypoint), [`sim::Flight`];
 //! - [`flying`]: [`flying::fly`], a plan flown as `arc sim` flies it (along its
 //!   blended trajectory), and [`flying::time`], the clock of that flight;
@@ -58,6 +59,7 @@ pub mod flying;
 mod fsutil;
 pub mod goal;
 pub mod map;
+pub mod mission;
 pub mod picture;
 pub mod plan_file;
 pub mod plan_picture;

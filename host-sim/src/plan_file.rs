@@ -136,11 +136,18 @@ pub fn f32_decimal(x: f32) -> f64 {
     x.to_string().parse().unwrap_or(f64::from(x))
 }
 
-/// One waypoint: a full configuration zeta (2N + 2 numbers).
+/// One waypoint: a full configuration zeta (2N + 2 numbers), and, in a mission's
+/// plan, the goal it reaches (docs/model.md, "Missions").
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Waypoint {
     /// `[x1, y1, z1, psi1_r, theta_1, psi_1, ..., theta_{N-1}, psi_{N-1}]`.
     pub zeta: Vec<f64>,
+    /// The index of the mission goal reached here, if one is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goal: Option<usize>,
+    /// How long the chain rests here (s), at a goal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hold_s: Option<f64>,
 }
 
 /// Where a planner's time went (seconds): the part of a planner's statistics, and of a
@@ -259,6 +266,26 @@ pub enum FormatError {
         /// The position of the number in `zeta`.
         at: usize,
     },
+    /// A hold that is no number of seconds `>= 0`.
+    #[error("waypoints[{index}].hold_s = {value} is not a number of seconds >= 0")]
+    Hold {
+        /// The waypoint.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// Goals marked out of order.
+    #[error(
+        "waypoints[{index}].goal = {goal} comes after goal {before}: goals are reached in order"
+    )]
+    GoalOrder {
+        /// The waypoint.
+        index: usize,
+        /// Its goal.
+        goal: usize,
+        /// The goal marked before it.
+        before: usize,
+    },
 }
 
 impl ChainSection {
@@ -297,7 +324,11 @@ impl Waypoint {
     pub fn new(xi: [f64; 3], shape: &Shape) -> Self {
         let mut zeta = xi.to_vec();
         zeta.extend(shape.as_slice().iter().map(|&a| f32_decimal(a)));
-        Self { zeta }
+        Self {
+            zeta,
+            goal: None,
+            hold_s: None,
+        }
     }
 
     /// The head position.
@@ -394,8 +425,29 @@ impl Plan {
             if let Some(j) = w.zeta.iter().position(|v| !v.is_finite()) {
                 return Err(FormatError::NotFinite { index: i, at: j });
             }
+            if let Some(h) = w.hold_s.filter(|h| !(h.is_finite() && *h >= 0.0)) {
+                return Err(FormatError::Hold { index: i, value: h });
+            }
         }
+        self.check_goal_order()?;
         Ok(params)
+    }
+
+    /// Goals marked on waypoints come in increasing order.
+    fn check_goal_order(&self) -> Result<(), FormatError> {
+        let mut before: Option<usize> = None;
+        for (index, w) in self.waypoints.iter().enumerate() {
+            let Some(goal) = w.goal else { continue };
+            if let Some(b) = before.filter(|b| goal <= *b) {
+                return Err(FormatError::GoalOrder {
+                    index,
+                    goal,
+                    before: b,
+                });
+            }
+            before = Some(goal);
+        }
+        Ok(())
     }
 
     /// Writes the plan as pretty JSON, atomically (`-`: to standard output).

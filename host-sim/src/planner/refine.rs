@@ -88,6 +88,14 @@ pub struct Quality {
 }
 
 impl Quality {
+    /// Adds `other`'s measures (plans flown one after the other).
+    pub fn add(&mut self, other: &Quality) {
+        self.head_path_m += other.head_path_m;
+        self.shape_motion_rad += other.shape_motion_rad;
+        self.shape_cost += other.shape_cost;
+        self.shape_changes += other.shape_changes;
+    }
+
     /// The measures of a plan's steps.
     pub fn of(steps: &[Step]) -> Self {
         let mut q = Self::default();

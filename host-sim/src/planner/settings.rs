@@ -17,11 +17,20 @@ pub enum Mode {
 
 /// What the planner prefers when several shapes fit.
 #[derive(
-    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    clap::ValueEnum,
+    serde::Serialize,
+    serde::Deserialize,
 )]
 #[serde(rename_all = "lowercase")]
 pub enum Preference {
     /// Keep the shape as long as it fits; cheapest change otherwise.
+    #[default]
     Least,
     /// Fly the sensor-coverage polygon PN wherever it fits (the silo demo).
     Coverage,

@@ -38,6 +38,10 @@ pub enum PlanningError {
     /// The query ran and found no plan ([`NoPlan`] says why and what was tried).
     #[error(transparent)]
     NoPlan(Box<NoPlan>),
+    /// A mission's goal that cannot be used for the chain (bad input); the text names
+    /// the field.
+    #[error("{0}")]
+    Mission(String),
     /// The goal's yaw and shape give no valid configuration at the goal (bad input).
     #[error("the goal configuration ({pose}) is not valid at ({x:.3}, {y:.3}, {z:.3}): {why}", x = at[0], y = at[1], z = at[2])]
     GoalPose {

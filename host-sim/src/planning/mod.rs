@@ -14,6 +14,7 @@
 
 mod arrival;
 mod error;
+mod mission;
 mod options;
 
 use std::sync::atomic::AtomicUsize;
@@ -24,6 +25,7 @@ use aerial_chain_core::ChainParams;
 
 pub use arrival::Arrival;
 pub use error::{NoPlan, PlanningError};
+pub use mission::{plan_mission, LegError, MissionPlanned};
 pub use options::{PlanOptions, DEFAULT_TIME_LIMIT_S, MAX_TIME_LIMIT_S};
 
 use crate::collision::CollisionContext;

@@ -49,16 +49,16 @@ const FIT_ROUNDS: usize = 200;
 /// A timed trajectory: its samples, and the analytic motion they were taken from.
 #[derive(Clone, Debug)]
 pub struct Trajectory {
-    params: ChainParams,
-    settings: Settings,
-    reference: Reference,
-    times: Vec<f64>,
-    zetas: Vec<Vec<f64>>,
-    corners: usize,
-    blended: usize,
-    merged: usize,
-    stop_go: f64,
-    head_path: f64,
+    pub(super) params: ChainParams,
+    pub(super) settings: Settings,
+    pub(super) reference: Reference,
+    pub(super) times: Vec<f64>,
+    pub(super) zetas: Vec<Vec<f64>>,
+    pub(super) corners: usize,
+    pub(super) blended: usize,
+    pub(super) merged: usize,
+    pub(super) stop_go: f64,
+    pub(super) head_path: f64,
 }
 
 impl Trajectory {
@@ -112,9 +112,27 @@ impl Trajectory {
 /// Times `plan` within `settings` and blends its corners where the blended motion is
 /// admissible on `grid` (whose choice about unknown space is the one checked). Fails when
 /// the plan breaks its format, cannot be timed, or is not admissible even without blends.
+///
+/// A mission's plan (waypoints that reach goals, docs/model.md "Missions") is timed
+/// leg by leg: every leg ends at rest on its goal, the chain holds there for the goal's
+/// `hold_s`, and the next leg starts on the next sample time.
 pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory, TrajectoryError> {
-    let params = plan.check()?;
+    plan.check()?;
     settings.validate()?;
+    let legs = super::legs::legs(plan);
+    if legs.len() == 1 && legs[0].hold_s == 0.0 {
+        return build_leg(plan, grid, settings);
+    }
+    let mut timed = Vec::with_capacity(legs.len());
+    for leg in &legs {
+        timed.push((build_leg(&leg.plan(plan), grid, settings)?, leg));
+    }
+    super::legs::join(plan, settings, &timed)
+}
+
+/// [`build`] of one leg: a plan whose goals, if any, are at its ends.
+fn build_leg(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory, TrajectoryError> {
+    let params = plan.check()?;
     let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
     let l = params.link_length as f64;
     let limits = settings.limits.to_reference();
@@ -253,7 +271,7 @@ fn merged_near(segments: &[Segment], merged: &[bool], v: &Violation, dt: f64) ->
 /// unblended edge starts on one, so the chain is sampled at rest at its waypoint).
 /// Blends are timed by the limits, not by the plan's stop-and-go length, so the
 /// budget is checked here again, before the samples are made.
-fn sample(r: &Reference, dt: f64) -> Result<(Vec<f64>, Vec<Vec<f64>>), TrajectoryError> {
+pub(super) fn sample(r: &Reference, dt: f64) -> Result<(Vec<f64>, Vec<Vec<f64>>), TrajectoryError> {
     let last = ((r.duration() / dt) - 1e-9).ceil().max(0.0);
     // `max` has made a NaN duration 0; `as` saturates an infinite one.
     if last >= MAX_SAMPLES as f64 {

@@ -15,6 +15,7 @@
 //! - `clock`: [`Trajectory::waypoint_times`], when it passes the plan's waypoints;
 //! - `check`: [`check_samples`], the exact check of sampled motion and its limits;
 //! - `group`: which edges fly together as one motion, and how a merge gives way;
+//! - `legs`: a mission's plan timed leg by leg, with the holds at its goals;
 //! - `merge`: what a merged motion demands of the limits, and which edges lie on a line;
 //! - `file`: [`TrajectoryFile`], the `arc-trajectory/1` JSON file and its CSV form.
 
@@ -23,6 +24,7 @@ mod check;
 mod clock;
 mod file;
 mod group;
+mod legs;
 mod merge;
 #[cfg(test)]
 mod tests;

@@ -11,6 +11,7 @@ use super::common::{
 use super::trajectory::{read_trajectory, LimitArgs};
 use super::{CliError, CliResult};
 use aerial_chain::collision::{verify_plan, VerifyOptions};
+use aerial_chain::mission::Mission;
 use aerial_chain::plan_file::Plan;
 use aerial_chain::trajectory::check_samples;
 
@@ -38,6 +39,11 @@ pub struct VerifyArgs {
     /// The yaw and shape the plan must end in (within 1e-6 rad, docs/model.md).
     #[command(flatten)]
     pose: GoalPoseArgs,
+    /// A mission (arc-mission/1): the plan must reach its goals in order, each within
+    /// its tolerance and, where asked, in its yaw and shape; its last goal replaces
+    /// the scenario's.
+    #[arg(long, conflicts_with_all = ["goal", "goal_yaw_deg", "goal_shape"])]
+    mission: Option<std::path::PathBuf>,
 }
 
 /// A point for messages: `(x, y, z)`.
@@ -63,8 +69,18 @@ pub fn run(a: VerifyArgs) -> CliResult {
     let looser = looser_assumption(&plan, &a.map);
     let loaded = a.map.load()?;
     let sc = loaded.scenario.as_ref();
-    let start = a.start.or(sc.map(|s| s.start.into()));
-    let goal = a.goal.or(sc.map(|s| s.goal.into()));
+    let mission = match &a.mission {
+        Some(p) => Some(Mission::read(p).map_err(|e| CliError::input(e.to_string()))?),
+        None => None,
+    };
+    let start = match mission.as_ref().and_then(|m| m.start.as_ref()) {
+        Some(s) => Some(s.position),
+        None => a.start.or(sc.map(|s| s.start.into())),
+    };
+    let goal = match &mission {
+        Some(_) => None,
+        None => a.goal.or(sc.map(|s| s.goal.into())),
+    };
     let report = verify_plan(&loaded.grid, &plan);
     println!(
         "{}: {} waypoints, {} edges ({} translations, {} shape changes), {} configurations checked exactly (unknown space {})",
@@ -111,7 +127,42 @@ pub fn run(a: VerifyArgs) -> CliResult {
         return Err(CliError::failed("INVALID"));
     }
     ends_in_pose(&plan, &a.pose)?;
+    if let Some(m) = &mission {
+        reaches_in_order(&plan, m)?;
+    }
     println!("  VALID");
+    Ok(())
+}
+
+/// Checks that the plan reaches the mission's goals in order: for each goal, a later
+/// waypoint than the one that reached the goal before whose head is within the goal's
+/// tolerance and whose shape is the goal's yaw and shape where asked. The plan's own
+/// goal marks are not trusted; they are checked against what is found.
+fn reaches_in_order(plan: &Plan, mission: &Mission) -> CliResult {
+    let params = plan.check().map_err(|e| CliError::input(e.to_string()))?;
+    let mut from = 0;
+    for (k, g) in mission.goals.iter().enumerate() {
+        let pose = mission.pose(k, &params).map_err(CliError::input)?;
+        let found = plan.waypoints[from..]
+            .iter()
+            .position(|w| dist(w.xi(), g.position) <= g.tolerance && pose.holds(w.eta()));
+        let Some(i) = found.map(|i| i + from) else {
+            return Err(CliError::failed(format!(
+                "INVALID: goals[{k}] at {} (tolerance {} m{}) is not reached after waypoint {from}",
+                point(g.position),
+                g.tolerance,
+                match pose.is_any() {
+                    true => String::new(),
+                    false => format!(
+                        ", {}",
+                        pose.describe(g.shape.as_ref().and_then(|s| s.name()))
+                    ),
+                }
+            )));
+        };
+        println!("  goals[{k}] reached at waypoint {i}");
+        from = i;
+    }
     Ok(())
 }
 

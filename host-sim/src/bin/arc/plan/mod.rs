@@ -8,6 +8,8 @@ use std::time::Instant;
 use aerial_chain_core::ChainParams;
 use clap::Args;
 
+mod mission;
+
 use super::checks;
 use super::common::{write_plan, GoalPoseArgs, ProblemArgs, Report};
 use super::trajectory::TimingArgs;
@@ -95,6 +97,10 @@ pub struct PlanArgs {
     time_limit: f64,
     #[command(flatten)]
     pose: GoalPoseArgs,
+    /// A mission (JSON, arc-mission/1): plan from its start (or the scenario's) through
+    /// its goals in order, into one plan whose waypoints mark the goals.
+    #[arg(long, conflicts_with_all = ["goal_yaw_deg", "goal_shape"])]
+    mission: Option<PathBuf>,
     /// Output plan (JSON, arc-plan/1); `-` writes it to standard output.
     #[arg(long)]
     out: PathBuf,
@@ -247,6 +253,9 @@ fn options(a: &PlanArgs) -> Result<PlanOptions, CliError> {
 pub fn run(a: PlanArgs) -> CliResult {
     check(&a)?;
     let options = options(&a)?;
+    if let Some(path) = &a.mission {
+        return mission::run(&a, path, &options);
+    }
     // Setup (map, distance field, shape tables) is timed apart: the time limit
     // covers what follows it (docs/promises.md).
     let setup = Instant::now();
