@@ -399,6 +399,7 @@ pub fn plan(
         field: Arc::new(DistanceField::new(map.grid.clone())),
         params,
         query,
+        pose: Default::default(),
         map: MapSection::of(&map.grid).with_source(map.source.clone()),
     };
     let planned = py.detach(|| planning::plan(&request, None, &options));
