@@ -173,6 +173,12 @@ def test_tlog_setpoints_per_unit_in_ned(case):
     assert np.allclose(np.diff(beats), 1.0) and beats[0] == 0.0
     hold = 1.0
     v = np.gradient(p, t, axis=0)
+    h = np.diff(t)
+    a = np.zeros_like(p)
+    a[1:-1] = 2 * ((p[2:] - p[1:-1]) / h[1:, None, None] - (p[1:-1] - p[:-2]) / h[:-1, None, None]) / (
+        t[2:] - t[:-2]
+    )[:, None, None]
+    yaw_rate = np.gradient(zeta[:, 3], t)
     for u in range(n):
         sp = [m for m in ms if m.get_type() == "SET_POSITION_TARGET_LOCAL_NED" and m.target_system == 7 + u]
         times = np.array([m._timestamp for m in sp])
@@ -190,7 +196,10 @@ def test_tlog_setpoints_per_unit_in_ned(case):
             assert m.time_boot_ms == round((hold + t[k]) * 1e3)
             assert np.allclose([m.x, m.y, m.z], [p[k, u, 1], p[k, u, 0], -p[k, u, 2]], atol=MM, rtol=0)
             assert np.allclose([m.vx, m.vy, m.vz], [v[k, u, 1], v[k, u, 0], -v[k, u, 2]], atol=1e-4)
+            assert np.allclose([m.afx, m.afy, m.afz], [a[k, u, 1], a[k, u, 0], -a[k, u, 2]], atol=1e-3)
             assert abs(wrap(m.yaw - (math.pi / 2 - zeta[k, 3]))) < DEG
+            assert abs(m.yaw_rate + yaw_rate[k]) < 1e-4
+            assert m.type_mask == 0  # position, velocity, acceleration, yaw, yaw rate
 
 
 def test_tlog_arms_after_a_second_of_setpoints(window):
