@@ -39,6 +39,16 @@ def yaw_of(x, y, z, w):
     return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
+def second_differences(p, t):
+    """docs/model.md's acceleration of a trajectory: the second divided difference at
+    every inner sample, zero at the ends; `p` is (T, N, 3)."""
+    h = np.diff(t)
+    a = np.zeros_like(p)
+    inner = (p[2:] - p[1:-1]) / h[1:, None, None] - (p[1:-1] - p[:-2]) / h[:-1, None, None]
+    a[1:-1] = 2 * inner / (t[2:] - t[:-2])[:, None, None]
+    return a
+
+
 def stamp(t):
     return t.sec + t.nanosec * 1e-9
 
@@ -106,11 +116,7 @@ def test_bag_trajectory_velocities_paths_markers(case):
     assert msg.joint_names == [f"unit_{i + 1}" for i in range(n)]
     assert len(msg.points) == len(t)
     v = np.gradient(p, t, axis=0)  # central differences, one-sided at the ends
-    h = np.diff(t)
-    a = np.zeros_like(p)
-    a[1:-1] = 2 * ((p[2:] - p[1:-1]) / h[1:, None, None] - (p[1:-1] - p[:-2]) / h[:-1, None, None]) / (
-        t[2:] - t[:-2]
-    )[:, None, None]
+    a = second_differences(p, t)
     yaw_rate = np.gradient(zeta[:, 3], t)
     for k, point in enumerate(msg.points):
         assert abs(stamp(point.time_from_start) - (t[k] - t[0])) < 1e-9
@@ -173,11 +179,7 @@ def test_tlog_setpoints_per_unit_in_ned(case):
     assert np.allclose(np.diff(beats), 1.0) and beats[0] == 0.0
     hold = 1.0
     v = np.gradient(p, t, axis=0)
-    h = np.diff(t)
-    a = np.zeros_like(p)
-    a[1:-1] = 2 * ((p[2:] - p[1:-1]) / h[1:, None, None] - (p[1:-1] - p[:-2]) / h[:-1, None, None]) / (
-        t[2:] - t[:-2]
-    )[:, None, None]
+    a = second_differences(p, t)
     yaw_rate = np.gradient(zeta[:, 3], t)
     for u in range(n):
         sp = [m for m in ms if m.get_type() == "SET_POSITION_TARGET_LOCAL_NED" and m.target_system == 7 + u]
