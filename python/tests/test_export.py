@@ -70,6 +70,9 @@ def case(request, tmp_path_factory):
     name = request.param
     d = tmp_path_factory.mktemp(name)
     arc("plan", "--scenario", name, "--out", d / "plan.json")
+    arc("export", "--scenario", name, "--plan", d / "plan.json", "--to", d / "plan.mcap")
+    arc("export", "--scenario", name, "--plan", d / "plan.json", "--to", d / "plan.tlog",
+        "--sysid-base", 7)
     return load(d, name, ac.Map.scenario(name), d / "plan.json")
 
 
@@ -91,7 +94,6 @@ def bag(path):
 
 def test_bag_decodes_field_by_field(case):
     d, t, p, zeta, n = case["dir"], case["t"], case["p"], case["zeta"], case["n"]
-    arc("export", "--scenario", case["name"], "--plan", d / "plan.json", "--to", d / "plan.mcap")
     topics = bag(d / "plan.mcap")
     paths = {f"/arc/unit_{i + 1}/path" for i in range(n)}
     assert set(topics) == {"/arc/map", "/arc/trajectory", "/tf", "/arc/chain"} | paths
@@ -170,8 +172,6 @@ def messages(path):
 
 def test_tlog_setpoints_per_unit_in_ned(case):
     d, t, p, zeta, n = case["dir"], case["t"], case["p"], case["zeta"], case["n"]
-    arc("export", "--scenario", case["name"], "--plan", d / "plan.json", "--to", d / "plan.tlog",
-        "--sysid-base", 7)
     ms = messages(d / "plan.tlog")
     assert all(m.get_srcSystem() == 255 and m.get_srcComponent() == 191 for m in ms)
     assert not [m for m in ms if m.get_type() == "COMMAND_LONG"]  # only with --arm
