@@ -196,10 +196,14 @@ def plan(
     clearance: float = ...,
     time_limit: Optional[float] = ...,
     smooth: bool = True,
+    goal_yaw: Optional[float] = None,
+    goal_shape: Optional[Union[str, Sequence[float]]] = None,
+    mission: Optional[_Path] = None,
 ) -> Plan:
     """Plans on ``map`` with the ARCplanner and the defaults of ``arc plan`` (a time
-    limit of 60 s; ``None``: none); raises ``PlanError`` for bad input and when no plan
-    is found."""
+    limit of 60 s; ``None``: none); ``goal_yaw`` (rad) and ``goal_shape`` end the plan
+    in that configuration, ``mission`` (an ``arc-mission/1`` file) plans through its
+    goals; raises ``PlanError`` for bad input and when no plan is found."""
 
 def verify(
     map: Map,

@@ -10,7 +10,9 @@ use numpy::{IntoPyArray, PyArray2, PyArray3};
 use pyo3::prelude::*;
 
 use aerial_chain::collision::{verify_plan, EdgeKind, DEFAULT_CLEARANCE};
+use aerial_chain::goal::{parse_shape, GoalPose};
 use aerial_chain::map::DistanceField;
+use aerial_chain::mission::Mission;
 use aerial_chain::plan_file::MapSection;
 use aerial_chain::planner::{Query, Settings};
 use aerial_chain::planning::{
@@ -339,13 +341,17 @@ fn query(map: &Map, params: &ChainParams, asked: Asked) -> PyResult<Query> {
 /// `Settings::default()`, post-processing on, a time limit of 60 s), for a chain of
 /// `units` (default: the scenario's). `start`, `goal` (m) and `start_yaw` (rad)
 /// default to the scenario's; `start_shape` is 2N - 1 angles (default: straight
-/// behind the head); `time_limit=None` plans without a limit.
+/// behind the head); `time_limit=None` plans without a limit. `goal_yaw` (rad) and
+/// `goal_shape` (a library name such as `"PN"`, or 2N - 1 angles) end the plan in that
+/// configuration (docs/model.md, "Goal configurations"); `mission`, the path of an
+/// `arc-mission/1` file, plans through its goals instead of to `goal`.
 /// Raises `PlanError` for bad input and when no plan is found (the message says why).
 #[pyfunction]
 #[pyo3(signature = (
     map, units = None, start = None, goal = None, start_yaw = None, start_shape = None,
     goal_tol = 0.3, seed = 1, srs = 500, srs_seed = 1, clearance = DEFAULT_CLEARANCE,
-    time_limit = Some(DEFAULT_TIME_LIMIT_S), smooth = true
+    time_limit = Some(DEFAULT_TIME_LIMIT_S), smooth = true, goal_yaw = None,
+    goal_shape = None, mission = None
 ))]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each with a default.
 pub fn plan(
@@ -363,11 +369,23 @@ pub fn plan(
     clearance: f64,
     time_limit: Option<f64>,
     smooth: bool,
+    goal_yaw: Option<f64>,
+    goal_shape: Option<Bound<'_, PyAny>>,
+    mission: Option<PathBuf>,
 ) -> PyResult<Plan> {
+    let mission = match &mission {
+        Some(p) => Some(Mission::read(p).map_err(err::<PlanError>)?),
+        None => None,
+    };
     let units = units
+        .or(mission.as_ref().and_then(|m| m.units).map(i64::from))
         .or(map.scenario.as_ref().map(|s| i64::from(s.default_units)))
         .ok_or_else(|| err::<PlanError>("units is required with a map file"))?;
     let params = chain(units)?;
+    let goal = match &mission {
+        Some(m) => Some(m.goals[0].position),
+        None => goal,
+    };
     let asked = Asked {
         start,
         goal,
@@ -395,17 +413,66 @@ pub fn plan(
             "time_limit = {limit}: a positive time (s), at most {MAX_TIME_LIMIT_S:e}"
         ))
     })?;
-    let request = Request {
+    let pose = goal_pose(&params, goal_yaw, goal_shape)?;
+    let mut request = Request {
         field: Arc::new(DistanceField::new(map.grid.clone())),
         params,
         query,
-        pose: Default::default(),
+        pose,
         map: MapSection::of(&map.grid).with_source(map.source.clone()),
     };
+    if let Some(m) = &mission {
+        if let Some((at, shape)) = m.start_of(&params).map_err(err::<PlanError>)? {
+            request.query.start = at;
+            request.query.start_shape = shape;
+        }
+        let planned = py.detach(|| planning::plan_mission(&request, m, None, &options));
+        let planned = planned.map_err(|e| err::<PlanError>(format!("{}: {e}", map.name)))?;
+        return Plan::checked(planned.plan);
+    }
     let planned = py.detach(|| planning::plan(&request, None, &options));
     let planned = planned.map_err(|e| match e {
         PlanningError::NoPlan(_) => err::<PlanError>(format!("{}: {e}", map.name)),
         e => err::<PlanError>(e.to_string()),
     })?;
     Plan::checked(planned.plan)
+}
+
+/// The goal's yaw and shape from `plan()`'s `goal_yaw` (rad) and `goal_shape` (a
+/// library name or a sequence of 2N - 1 angles).
+fn goal_pose(
+    params: &ChainParams,
+    yaw: Option<f64>,
+    shape: Option<Bound<'_, PyAny>>,
+) -> PyResult<GoalPose> {
+    if let Some(y) = yaw.filter(|y| !y.is_finite()) {
+        return Err(err::<PlanError>(format!(
+            "goal_yaw = {y}: a finite angle (rad)"
+        )));
+    }
+    let shape = match shape {
+        None => None,
+        Some(s) => {
+            let text = match s.extract::<String>() {
+                Ok(name) => name,
+                Err(_) => s
+                    .extract::<Vec<f64>>()
+                    .map_err(|_| {
+                        err::<PlanError>("goal_shape: a library name or a list of angles")
+                    })?
+                    .iter()
+                    .map(f64::to_string)
+                    .collect::<Vec<_>>()
+                    .join(","),
+            };
+            Some(
+                parse_shape(params, &text)
+                    .map_err(|e| err::<PlanError>(format!("goal_shape: {e}")))?,
+            )
+        }
+    };
+    Ok(GoalPose {
+        yaw: yaw.map(|y| y as f32),
+        shape,
+    })
 }

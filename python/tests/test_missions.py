@@ -46,3 +46,20 @@ def test_a_mission_plan_reads_verifies_flies_and_exports(tmp_path):
         assert np.count_nonzero(near) * np.median(np.diff(flight.t)) >= hold
     written = ac.export(world, plan, tmp_path / "silos.tlog")
     assert written > 0
+
+
+def test_python_plans_a_goal_pose_and_a_mission():
+    world = ac.Map.scenario("window")
+    plan = ac.plan(world, units=5, goal_shape="PN", goal_yaw=0.5)
+    assert abs(plan.waypoints[-1, 3] - 0.5) < 1e-6
+    assert ac.verify(world, plan).ok
+    maze = ac.Map.scenario("maze")
+    mission = ac.plan(maze, mission=REPO / "missions" / "maze.json")
+    raw = json.loads(mission.to_json())
+    assert [w["goal"] for w in raw["waypoints"] if "goal" in w] == list(range(6))
+    try:
+        ac.plan(world, units=5, goal_shape="XX")
+    except ac.PlanError as e:
+        assert "goal_shape" in str(e)
+    else:
+        raise AssertionError("a goal shape that is no shape was taken")
