@@ -9,6 +9,8 @@
 use aerial_chain_core::lsc::LscKind;
 use aerial_chain_core::{ChainParams, Shape};
 
+use crate::collision::verify::wrap;
+
 /// How close a configuration must come to the goal's yaw and shape (rad, every angle
 /// after wrapping to (-pi, pi]): the contract's tolerance, far above the rounding of
 /// `f32` shapes written as decimals.
@@ -47,16 +49,6 @@ pub enum GoalShapeError {
         /// Numbers a shape of this chain has.
         expected: usize,
     },
-}
-
-/// `a` wrapped to (-pi, pi].
-fn wrap(a: f64) -> f64 {
-    let w = a.rem_euclid(std::f64::consts::TAU);
-    if w > std::f64::consts::PI {
-        w - std::f64::consts::TAU
-    } else {
-        w
-    }
 }
 
 /// A goal shape for the chain `params`: a library name (any case), or `2N - 1`

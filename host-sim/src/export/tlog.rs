@@ -24,6 +24,7 @@ use mavlink::MavHeader;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 use super::motion::{Command, Motion, Tick, UnitState};
+use crate::collision::verify::wrap;
 use super::ExportError;
 
 /// The sender's system id: a ground station's.
@@ -129,16 +130,6 @@ pub struct TlogSummary {
 /// A vector of W (ENU) in NED.
 pub fn ned(v: &Vector3<f64>) -> [f32; 3] {
     [v.y as f32, v.x as f32, -v.z as f32]
-}
-
-/// An angle wrapped to (-pi, pi].
-fn wrap(a: f64) -> f64 {
-    let w = a.rem_euclid(std::f64::consts::TAU);
-    if w > std::f64::consts::PI {
-        w - std::f64::consts::TAU
-    } else {
-        w
-    }
 }
 
 /// The unit's heading in W: the yaw of its body x axis.
