@@ -312,7 +312,7 @@ fn simulated_scans_fuse_as_octomap_fuses_them() {
             let attitude = UnitQuaternion::from_euler_angles(
                 rng.gen_range(-0.3..0.3),
                 rng.gen_range(-0.3..0.3),
-                rng.gen_range(-3.14..3.14),
+                rng.gen_range(-std::f64::consts::PI..std::f64::consts::PI),
             );
             let pose = UnitPose {
                 position: Point3::from(p),

@@ -233,7 +233,7 @@ impl OccupancyMap {
         cloud: &PointCloud,
         max_range: f64,
     ) -> Result<Vec<VoxelChange>, FusionError> {
-        if !(max_range > 0.0) {
+        if max_range.is_nan() || max_range <= 0.0 {
             return Err(refuse(
                 "max_range",
                 max_range,

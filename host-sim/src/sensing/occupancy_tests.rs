@@ -158,7 +158,7 @@ fn the_seen_map_becomes_a_grid_and_a_tree() {
         }
     }
     let tree = m.to_octree().unwrap();
-    assert_eq!(tree.counts().0 + tree.counts().1 > 0, true);
+    assert!(tree.counts().0 > 0 && tree.counts().1 > 0);
     let back = Grid::from_octree(&tree, true).unwrap();
     assert!(back.cells().eq(seen.cells()));
     assert!(matches!(

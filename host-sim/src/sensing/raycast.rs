@@ -102,7 +102,7 @@ pub fn first_obstacle(
     d: &Vector3<f64>,
     max_range: f64,
 ) -> Option<(f64, [i32; 3])> {
-    if !(max_range >= 0.0) || !o.iter().chain(d.iter()).all(|v| v.is_finite()) {
+    if max_range.is_nan() || max_range < 0.0 || !o.iter().chain(d.iter()).all(|v| v.is_finite()) {
         return None;
     }
     let mut best: Option<(f64, [i32; 3])> = None;
