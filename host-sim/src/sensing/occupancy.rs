@@ -356,6 +356,7 @@ impl OccupancyMap {
                 }
             }
         }
+        changes.sort_unstable_by_key(|c| c.voxel);
         Ok(changes)
     }
 

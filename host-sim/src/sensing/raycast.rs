@@ -8,14 +8,17 @@
 //! pass through unknown space.
 //!
 //! The traversal is Amanatides and Woo's voxel walk; at every voxel it visits, the
-//! obstacle voxels among it and its 26 neighbours are tested with the slab test on
-//! their closed cubes `[i r_v, (i + 1) r_v]`. Every closed cube the ray touches at
-//! parameter `t` contains the point `o + t d`, so it is a neighbour of the voxel the walk
-//! is in at `t` (which contains that point too): the candidates cover every cube the ray
-//! touches, including those it only grazes along a face, edge or corner, which the walk
-//! itself steps past. The walk stops once it is past the nearest entry found, or past
-//! the maximum range. The result is the smallest slab entry distance over the obstacle
-//! cubes, the same number a test of every cube gives (a property test holds it to that).
+//! obstacle voxels among the cubes that contain the point where the walk enters it are
+//! tested with the slab test on their closed cubes `[i r_v, (i + 1) r_v]`: the voxel
+//! itself and, along each axis where that point lies on (or within `1e-6 r_v` of) a
+//! face, the neighbour across it. Between two such points the ray is strictly inside
+//! the walk's voxel along every axis it moves in, and along an axis it does not move in
+//! it keeps the coordinate it has at every entry point; so every closed cube the ray
+//! touches, including those it only grazes along a face, edge or corner (which the walk
+//! itself steps past), contains one of those points and is tested. The walk stops once
+//! it is past the nearest entry found, or past the maximum range. The result is the
+//! smallest slab entry distance over the obstacle cubes, the same number a test of every
+//! cube gives (a property test holds it to that).
 //!
 //! Returns closer than the sensor's minimum range are reported as
 //! [`RayReturn::TooClose`], not dropped as no return: a depth camera sees nothing valid
@@ -108,12 +111,12 @@ pub fn first_obstacle(
     let mut best: Option<(f64, [i32; 3])> = None;
     let mut walk = Walk::new(grid, o, d, max_range);
     while let Some((voxel, t_in)) = walk.next() {
-        // A cube first touched later lies around a voxel the walk enters later.
+        // A cube first touched later contains a point where the walk enters later.
         let limit = best.map_or(max_range, |b| b.0);
         if t_in > limit + 1e-9 * (1.0 + limit) {
             break;
         }
-        for n in neighbours(voxel) {
+        for n in touching(voxel, &(o + d * t_in), grid.resolution()) {
             if !grid.is_obstacle(n) {
                 continue;
             }
@@ -132,11 +135,33 @@ pub fn first_obstacle(
     best
 }
 
-/// The voxel and its 26 neighbours.
-fn neighbours(v: [i32; 3]) -> impl Iterator<Item = [i32; 3]> {
-    (0..27).map(move |k| {
-        let off = [k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1];
-        [0, 1, 2].map(|a| v[a].saturating_add(off[a]))
+/// How close to a face (as a fraction of the voxel edge) a point counts as on it: far
+/// above the rounding of the walk's entry points, so no touched cube is missed (a cube
+/// too many is harmless: the slab test decides).
+const FACE_TOLERANCE: f64 = 1e-6;
+
+/// Voxel `v` and the neighbours whose closed cubes contain `p` (a point in or on `v`'s
+/// cube), by the faces `p` lies on within [`FACE_TOLERANCE`].
+fn touching(v: [i32; 3], p: &Point3<f64>, r: f64) -> impl Iterator<Item = [i32; 3]> {
+    let eps = FACE_TOLERANCE * r;
+    let range = |a: usize| {
+        let lo = f64::from(v[a]) * r;
+        let hi = (f64::from(v[a]) + 1.0) * r;
+        let from = if p[a] <= lo + eps { -1 } else { 0 };
+        let to = if p[a] >= hi - eps { 1 } else { 0 };
+        (from, to)
+    };
+    let (x, y, z) = (range(0), range(1), range(2));
+    (z.0..=z.1).flat_map(move |k| {
+        (y.0..=y.1).flat_map(move |j| {
+            (x.0..=x.1).map(move |i| {
+                [
+                    v[0].saturating_add(i),
+                    v[1].saturating_add(j),
+                    v[2].saturating_add(k),
+                ]
+            })
+        })
     })
 }
 
