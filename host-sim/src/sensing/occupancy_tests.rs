@@ -166,3 +166,64 @@ fn the_seen_map_becomes_a_grid_and_a_tree() {
         Err(GridError::Empty)
     ));
 }
+
+/// Every state of every voxel the map knows, unknown ones left out.
+fn snapshot(m: &OccupancyMap) -> std::collections::BTreeMap<[i32; 3], Cell> {
+    m.voxels().collect()
+}
+
+/// The changes an operation reports are exactly the voxels whose state differs.
+fn assert_changes_are_the_difference(
+    before: &std::collections::BTreeMap<[i32; 3], Cell>,
+    m: &OccupancyMap,
+    changes: &[VoxelChange],
+) -> Result<(), proptest::test_runner::TestCaseError> {
+    let after = snapshot(m);
+    let mut expected: Vec<VoxelChange> = after
+        .iter()
+        .filter_map(|(&voxel, &new)| {
+            let old = before.get(&voxel).copied().unwrap_or(Cell::Unknown);
+            (old != new).then_some(VoxelChange { voxel, old, new })
+        })
+        .collect();
+    expected.sort_unstable_by_key(|c| c.voxel);
+    prop_assert!(
+        before.keys().all(|k| after.contains_key(k)),
+        "a voxel became unknown"
+    );
+    prop_assert_eq!(changes, &expected[..]);
+    Ok(())
+}
+
+use proptest::prelude::*;
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// Insertions and free spheres report exactly the voxels whose state they changed.
+    #[test]
+    fn changes_are_exactly_the_state_differences(
+        steps in proptest::collection::vec(
+            (
+                proptest::array::uniform3(-0.5f32..0.5),
+                proptest::collection::vec(proptest::array::uniform3(-1.5f32..1.5), 1..12),
+                0.2f64..2.0,
+                proptest::option::of((proptest::array::uniform3(-1.0f64..1.0), 0.0f64..0.4)),
+            ),
+            1..12,
+        ),
+        res in prop_oneof![Just(0.1f64), Just(0.087), Just(0.2)],
+    ) {
+        let mut m = OccupancyMap::new(res).unwrap();
+        for (origin, points, max_range, sphere) in steps {
+            let before = snapshot(&m);
+            let changes = m.insert(&cloud(origin, &points), max_range).unwrap();
+            assert_changes_are_the_difference(&before, &m, &changes)?;
+            if let Some((c, r)) = sphere {
+                let before = snapshot(&m);
+                let changes = m.mark_free_sphere(c, r).unwrap();
+                assert_changes_are_the_difference(&before, &m, &changes)?;
+            }
+        }
+    }
+}
