@@ -75,9 +75,10 @@ impl Default for DepthSensor {
     }
 }
 
-/// Sensor settings that cannot be used: the field, its value and the rule it breaks.
+/// Sensor settings (or a unit pose) that cannot be used: the field, its value and the
+/// rule it breaks.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("sensor setting {field} = {value}: {rule}")]
+#[error("{field} = {value}: {rule}")]
 pub struct SensorError {
     /// The setting's name, as in the settings file.
     pub field: &'static str,
@@ -109,6 +110,29 @@ pub struct UnitPose {
 }
 
 impl UnitPose {
+    /// A pose from a position and an attitude `[w, x, y, z]` as flight and trajectory
+    /// files record it (`q`, docs/model.md), normalised. Refused, naming the field, when
+    /// a number is not finite or the quaternion's norm is off 1 by more than 1e-3 (more
+    /// than the `f32` rounding of a recorded attitude).
+    pub fn new(position: [f64; 3], attitude: [f64; 4]) -> Result<UnitPose, SensorError> {
+        if position.iter().any(|v| !v.is_finite()) {
+            return Err(refuse("pose.position", position, "must be finite (m)"));
+        }
+        let norm = attitude.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(norm.is_finite() && (norm - 1.0).abs() <= 1e-3) {
+            return Err(refuse(
+                "pose.attitude",
+                attitude,
+                format!("must be a unit quaternion [w, x, y, z] (norm {norm})"),
+            ));
+        }
+        let [w, x, y, z] = attitude;
+        Ok(UnitPose {
+            position: position.into(),
+            attitude: UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)),
+        })
+    }
+
     /// A pose from a position and a yaw about z (no tilt), as every unit of a
     /// trajectory holds it.
     pub fn level(position: impl Into<Point3<f64>>, yaw: f64) -> UnitPose {
@@ -380,6 +404,18 @@ mod tests {
         );
         let w = s.world_rays(&pose)[19 * 59 + 29];
         assert!((w - Vector3::new(-1.0, 0.0, 0.0)).norm() < 1e-12, "{w}");
+        // The same pose from a recorded [w, x, y, z]; bad records are refused by name.
+        let q = pose.attitude.quaternion();
+        let recorded = UnitPose::new([1.0, 2.0, 3.0], [q.w, q.i, q.j, q.k]).unwrap();
+        assert!((s.world_rays(&recorded)[19 * 59 + 29] - w).norm() < 1e-12);
+        let e = UnitPose::new([0.0; 3], [1.0, 0.1, 0.0, 0.0])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("pose.attitude = [1.0, 0.1, 0.0, 0.0]: must be"),
+            "{e}"
+        );
+        assert!(UnitPose::new([f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]).is_err());
         // A level pose at yaw 0 leaves the body rays as they are.
         let level = UnitPose::level([0.0, 0.0, 1.0], 0.0);
         assert_eq!(
