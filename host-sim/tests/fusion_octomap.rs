@@ -4,7 +4,8 @@
 //! `tests/fixtures/octomap/fusion.cpp` is compiled with g++ against the installed OctoMap
 //! library; it inserts the same clouds (every number passed as its bits) and prints every
 //! voxel of its tree at depth 16 with its log-odds and state. The free, occupied and
-//! unknown voxels, and every log-odds value, must be identical to ours. Random clouds
+//! unknown voxels, and every log-odds value, must be identical to ours, and so must the
+//! bytes of the `.bt` each writes of the seen map. Random clouds
 //! (hits, misses beyond the range, end points on voxel faces and in the origin's voxel,
 //! axis-aligned rays) at 0.05, 0.1 and 0.087 m are inserted repeatedly, so that the
 //! hit/miss arithmetic and the clamping are exercised; scans cast by our simulated
@@ -57,13 +58,12 @@ fn program() -> &'static Result<PathBuf, String> {
     })
 }
 
-/// Runs the OctoMap program on `commands`; its standard output.
-fn octomap(commands: &str) -> String {
+/// Runs the OctoMap program on `commands` in `dir`; its standard output.
+fn octomap_in(dir: &Path, commands: &str) -> String {
     let exe = program()
         .as_ref()
         .unwrap_or_else(|why| panic!("the OctoMap fusion check cannot run: {why}"));
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("commands.txt");
+    let file = dir.join("commands.txt");
     std::fs::write(&file, commands).unwrap();
     let out = Command::new(exe).arg(&file).output().unwrap();
     assert!(
@@ -72,6 +72,11 @@ fn octomap(commands: &str) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8(out.stdout).unwrap()
+}
+
+/// Runs the OctoMap program on `commands`; its standard output.
+fn octomap(commands: &str) -> String {
+    octomap_in(tempfile::tempdir().unwrap().path(), commands)
 }
 
 fn f32_hex(v: f32) -> String {
@@ -130,8 +135,10 @@ fn compare(name: &str, resolution: f64, clouds: &[(PointCloud, f64)]) -> (usize,
         commands.push_str(&scan_command(cloud, *max_range));
         ours.insert(cloud, *max_range).unwrap();
     }
-    commands.push_str("dump\n");
-    let (params, theirs) = parse_dump(&octomap(&commands));
+    let dir = tempfile::tempdir().unwrap();
+    let (their_bt, our_bt) = (dir.path().join("octomap.bt"), dir.path().join("ours.bt"));
+    writeln!(commands, "dump\nwrite {}", their_bt.display()).unwrap();
+    let (params, theirs) = parse_dump(&octomap_in(dir.path(), &commands));
     let p = ours.params();
     assert_eq!(
         params,
@@ -160,6 +167,12 @@ fn compare(name: &str, resolution: f64, clouds: &[(PointCloud, f64)]) -> (usize,
     for (k, v) in &theirs {
         assert_eq!(mine[k], *v, "{name}: voxel {k:?} (log-odds bits, occupied)");
     }
+    // The seen map as a .bt: the bytes of OctoMap's writeBinary of its own tree.
+    ours.write_bt(&our_bt).unwrap();
+    assert!(
+        std::fs::read(&our_bt).unwrap() == std::fs::read(&their_bt).unwrap(),
+        "{name}: our .bt of the seen map differs from OctoMap's writeBinary"
+    );
     let occupied = theirs.values().filter(|v| v.1).count();
     eprintln!(
         "{name}: {} clouds, {} voxels identical ({occupied} occupied, {} free)",
