@@ -9,6 +9,23 @@ fn cloud(origin: [f32; 3], points: &[[f32; 3]]) -> PointCloud {
 }
 
 #[test]
+fn packed_keys_keep_their_order() {
+    let keys = [
+        [-32768, 5, -1],
+        [-1, 32767, 0],
+        [0, -32768, 7],
+        [0, 0, -32768],
+        [32767; 3],
+    ];
+    for w in keys.windows(2) {
+        assert!(pack(w[0]) < pack(w[1]), "{w:?}");
+    }
+    for k in keys {
+        assert_eq!(unpack(pack(k)), k);
+    }
+}
+
+#[test]
 fn defaults_are_octomaps_in_log_odds() {
     let p = OccupancyParams::default().log_odds().unwrap();
     assert!((p.hit - 0.847_298).abs() < 1e-5);
