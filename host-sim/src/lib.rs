@@ -27,7 +27,10 @@
 //!   setpoints (`.tlog`);
 //! - [`planning`]: [`planning::plan`], the facade: plan as `arc plan` does (search,
 //!   post-processing, the plan file, optionally its trajectory) under one
-//!   [`planning::PlanOptions`].
+//!   [`planning::PlanOptions`];
+//! - [`sensing`]: [`sensing::DepthSensor`] on the units, exact ray casting into the true
+//!   map ([`sensing::raycast::scan`]) and the map that grows,
+//!   [`sensing::OccupancyMap`] (OctoMap's occupancy model).
 //!
 //! Plan through the `window` scenario as `arc plan --scenario window --units 5` does,
 //! then check the plan with the exact verifier rather than trust the planner:
@@ -66,6 +69,7 @@ pub mod plan_picture;
 pub mod planner;
 pub mod planning;
 pub mod problem;
+pub mod sensing;
 mod shape_index;
 pub mod sim;
 pub mod tables;

@@ -1,0 +1,426 @@
+//! A depth sensor fixed to a unit's body: its settings, its rays in the body frame and,
+//! for a unit pose, its origin and rays in the world frame W.
+//!
+//! Frames (docs/model.md): the body frame has x forward, y left, z up; a unit's attitude
+//! is the quaternion rotating its body frame into W. The sensor's own frame has x along
+//! the optical axis, y left, z up; its mounting pose ([`Mount`]) rotates and offsets that
+//! frame in the body frame. Today every unit holds the head's yaw (docs/model.md,
+//! "Trajectories"), so every sensor with the default mount looks along the head's heading.
+
+use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Most rays one sensor may cast per scan (a 100 x 100 degree field at 0.3 degrees):
+/// settings that ask for more are refused, so a scan's cost stays bounded.
+pub const MAX_RAYS: usize = 100_000;
+
+/// How far a mounting quaternion's norm may be from 1 (it is normalised after the check).
+const QUATERNION_NORM_TOLERANCE: f64 = 1e-6;
+
+/// Where the sensor sits on the unit's body.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Mount {
+    /// Rotation of the sensor frame into the body frame, `[w, x, y, z]` (Hamilton, unit
+    /// norm). Default identity: the optical axis along body +x.
+    pub rotation: [f64; 4],
+    /// The sensor's origin in the body frame (m). Default the unit's centre.
+    pub offset: [f64; 3],
+}
+
+impl Default for Mount {
+    fn default() -> Self {
+        Mount {
+            rotation: [1.0, 0.0, 0.0, 0.0],
+            offset: [0.0; 3],
+        }
+    }
+}
+
+/// Depth sensor settings: a rectangular frustum of rays, as a small depth camera's.
+///
+/// Ray `(j, k)` has horizontal angle `a_j = (j - (n_h - 1) / 2) * resolution` (positive
+/// to the left) and vertical angle `e_k = (k - (n_v - 1) / 2) * resolution` (positive
+/// up), with `n = floor(fov / resolution) + 1` rays per direction, so the rays are
+/// centred on the optical axis and span the field of view to within one step. Its
+/// direction in the sensor frame is `(1, tan a_j, tan e_k)` normalised: the point on the
+/// image plane at those angles, as a camera's pixels lie on a plane.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DepthSensor {
+    /// Horizontal field of view (degrees), in (0, 180). Default 87.
+    pub fov_h_deg: f64,
+    /// Vertical field of view (degrees), in (0, 180). Default 58.
+    pub fov_v_deg: f64,
+    /// Nearest distance the sensor measures (m). Default 0.2.
+    pub min_range: f64,
+    /// Farthest distance the sensor measures (m). Default 5.
+    pub max_range: f64,
+    /// Angle between neighbouring rays, horizontally and vertically (degrees). Default 1.5.
+    pub resolution_deg: f64,
+    /// Mounting pose on the unit's body.
+    pub mount: Mount,
+}
+
+impl Default for DepthSensor {
+    fn default() -> Self {
+        DepthSensor {
+            fov_h_deg: 87.0,
+            fov_v_deg: 58.0,
+            min_range: 0.2,
+            max_range: 5.0,
+            resolution_deg: 1.5,
+            mount: Mount::default(),
+        }
+    }
+}
+
+/// Sensor settings (or a unit pose) that cannot be used: the field, its value and the
+/// rule it breaks.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{field} = {value}: {rule}")]
+pub struct SensorError {
+    /// The setting's name, as in the settings file.
+    pub field: &'static str,
+    /// The value given, as text.
+    pub value: String,
+    /// What the value must be.
+    pub rule: String,
+}
+
+fn refuse(
+    field: &'static str,
+    value: impl std::fmt::Debug,
+    rule: impl Into<String>,
+) -> SensorError {
+    SensorError {
+        field,
+        value: format!("{value:?}"),
+        rule: rule.into(),
+    }
+}
+
+/// A unit's pose in W: the body's centre and its attitude (tilt included).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UnitPose {
+    /// The unit's centre in W (m).
+    pub position: Point3<f64>,
+    /// Rotation of the body frame into W.
+    pub attitude: UnitQuaternion<f64>,
+}
+
+impl UnitPose {
+    /// A pose from a position and an attitude `[w, x, y, z]` as flight and trajectory
+    /// files record it (`q`, docs/model.md), normalised. Refused, naming the field, when
+    /// a number is not finite or the quaternion's norm is off 1 by more than 1e-3 (more
+    /// than the `f32` rounding of a recorded attitude).
+    pub fn new(position: [f64; 3], attitude: [f64; 4]) -> Result<UnitPose, SensorError> {
+        if position.iter().any(|v| !v.is_finite()) {
+            return Err(refuse("pose.position", position, "must be finite (m)"));
+        }
+        let norm = attitude.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(norm.is_finite() && (norm - 1.0).abs() <= 1e-3) {
+            return Err(refuse(
+                "pose.attitude",
+                attitude,
+                format!("must be a unit quaternion [w, x, y, z] (norm {norm})"),
+            ));
+        }
+        let [w, x, y, z] = attitude;
+        Ok(UnitPose {
+            position: position.into(),
+            attitude: UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)),
+        })
+    }
+
+    /// A pose from a position and a yaw about z (no tilt), as every unit of a
+    /// trajectory holds it.
+    pub fn level(position: impl Into<Point3<f64>>, yaw: f64) -> UnitPose {
+        UnitPose {
+            position: position.into(),
+            attitude: UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw),
+        }
+    }
+}
+
+impl DepthSensor {
+    /// Checks every setting; the error names the first bad field and its value.
+    pub fn validate(&self) -> Result<(), SensorError> {
+        for (field, v) in [("fov_h_deg", self.fov_h_deg), ("fov_v_deg", self.fov_v_deg)] {
+            if !(v.is_finite() && v > 0.0 && v < 180.0) {
+                return Err(refuse(field, v, "must be in (0, 180) degrees"));
+            }
+        }
+        if !(self.min_range.is_finite() && self.min_range >= 0.0) {
+            return Err(refuse("min_range", self.min_range, "must be >= 0 m"));
+        }
+        if !(self.max_range.is_finite() && self.max_range > self.min_range) {
+            return Err(refuse(
+                "max_range",
+                self.max_range,
+                format!("must be finite and above min_range ({} m)", self.min_range),
+            ));
+        }
+        let r = self.resolution_deg;
+        if !(r.is_finite() && r > 0.0) {
+            return Err(refuse("resolution_deg", r, "must be a positive angle"));
+        }
+        let n = self.columns().saturating_mul(self.rows());
+        if n > MAX_RAYS {
+            return Err(refuse(
+                "resolution_deg",
+                r,
+                format!("gives {n} rays per scan, more than {MAX_RAYS}"),
+            ));
+        }
+        self.validate_mount()
+    }
+
+    fn validate_mount(&self) -> Result<(), SensorError> {
+        let q = self.mount.rotation;
+        let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(norm.is_finite() && (norm - 1.0).abs() <= QUATERNION_NORM_TOLERANCE) {
+            return Err(refuse(
+                "mount.rotation",
+                q,
+                format!("must be a unit quaternion [w, x, y, z] (norm {norm})"),
+            ));
+        }
+        if self.mount.offset.iter().any(|v| !v.is_finite()) {
+            return Err(refuse(
+                "mount.offset",
+                self.mount.offset,
+                "must be finite (m)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Rays per row (horizontal): `floor(fov_h / resolution) + 1`.
+    pub fn columns(&self) -> usize {
+        count(self.fov_h_deg, self.resolution_deg)
+    }
+
+    /// Rays per column (vertical): `floor(fov_v / resolution) + 1`.
+    pub fn rows(&self) -> usize {
+        count(self.fov_v_deg, self.resolution_deg)
+    }
+
+    /// The mounting rotation (sensor frame into body frame), normalised.
+    fn mount_rotation(&self) -> UnitQuaternion<f64> {
+        let [w, x, y, z] = self.mount.rotation;
+        UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z))
+    }
+
+    /// The unit ray directions in the body frame, row by row from the bottom, each row
+    /// from the right (negative horizontal angle) to the left. Call [`Self::validate`]
+    /// first: invalid settings give no rays.
+    pub fn body_rays(&self) -> Vec<Vector3<f64>> {
+        if self.validate().is_err() {
+            return Vec::new();
+        }
+        let step = self.resolution_deg.to_radians();
+        let (nh, nv) = (self.columns(), self.rows());
+        let angle = |j: usize, n: usize| (j as f64 - (n as f64 - 1.0) / 2.0) * step;
+        let mount = self.mount_rotation();
+        let mut rays = Vec::with_capacity(nh * nv);
+        for k in 0..nv {
+            let tan_e = angle(k, nv).tan();
+            for j in 0..nh {
+                let d = Vector3::new(1.0, angle(j, nh).tan(), tan_e).normalize();
+                rays.push(mount * d);
+            }
+        }
+        rays
+    }
+
+    /// The sensor's origin in W for a unit at `pose`.
+    pub fn origin(&self, pose: &UnitPose) -> Point3<f64> {
+        pose.position + pose.attitude * Vector3::from(self.mount.offset)
+    }
+
+    /// The unit ray directions in W for a unit at `pose` (in [`Self::body_rays`]'s order).
+    pub fn world_rays(&self, pose: &UnitPose) -> Vec<Vector3<f64>> {
+        self.body_rays()
+            .into_iter()
+            .map(|d| pose.attitude * d)
+            .collect()
+    }
+}
+
+/// `floor(fov / step) + 1`, saturating; a tiny tolerance keeps `87 / 1.5 = 58` whole.
+fn count(fov: f64, step: f64) -> usize {
+    let q = fov / step;
+    if !q.is_finite() || q < 0.0 {
+        return usize::MAX;
+    }
+    let n = (q + 1e-9).floor();
+    if n >= (MAX_RAYS as f64) {
+        usize::MAX
+    } else {
+        n as usize + 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    fn defaults_are_a_small_depth_camera() {
+        let s = DepthSensor::default();
+        assert_eq!(s.validate(), Ok(()));
+        assert_eq!((s.columns(), s.rows()), (59, 39));
+        let rays = s.body_rays();
+        assert_eq!(rays.len(), 59 * 39);
+        // The corners of the frustum: +-43.5 deg horizontally, +-28.5 deg vertically.
+        let c = rays[0];
+        assert!((c.y / c.x - (-43.5f64).to_radians().tan()).abs() < 1e-12);
+        assert!((c.z / c.x - (-28.5f64).to_radians().tan()).abs() < 1e-12);
+        // The middle ray is the optical axis, body +x.
+        let mid = rays[19 * 59 + 29];
+        assert!((mid - Vector3::x()).norm() < 1e-12);
+        assert!(rays
+            .iter()
+            .all(|d| (d.norm() - 1.0).abs() < 1e-12 && d.x > 0.0));
+    }
+
+    #[test]
+    fn bad_settings_name_the_field_and_value() {
+        let cases: Vec<(DepthSensor, &str)> = vec![
+            (
+                DepthSensor {
+                    fov_h_deg: 180.0,
+                    ..Default::default()
+                },
+                "fov_h_deg = 180.0",
+            ),
+            (
+                DepthSensor {
+                    fov_v_deg: 0.0,
+                    ..Default::default()
+                },
+                "fov_v_deg = 0.0",
+            ),
+            (
+                DepthSensor {
+                    fov_v_deg: f64::NAN,
+                    ..Default::default()
+                },
+                "fov_v_deg = NaN",
+            ),
+            (
+                DepthSensor {
+                    min_range: -0.1,
+                    ..Default::default()
+                },
+                "min_range = -0.1",
+            ),
+            (
+                DepthSensor {
+                    max_range: 0.2,
+                    ..Default::default()
+                },
+                "max_range = 0.2",
+            ),
+            (
+                DepthSensor {
+                    resolution_deg: 0.0,
+                    ..Default::default()
+                },
+                "resolution_deg = 0.0",
+            ),
+            (
+                DepthSensor {
+                    resolution_deg: 0.1,
+                    ..Default::default()
+                },
+                "resolution_deg = 0.1: gives 506051 rays per scan, more than 100000",
+            ),
+            (
+                DepthSensor {
+                    mount: Mount {
+                        rotation: [1.0, 1.0, 0.0, 0.0],
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                },
+                "mount.rotation = [1.0, 1.0, 0.0, 0.0]",
+            ),
+            (
+                DepthSensor {
+                    mount: Mount {
+                        offset: [0.0, f64::INFINITY, 0.0],
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                },
+                "mount.offset = [0.0, inf, 0.0]",
+            ),
+        ];
+        for (s, expected) in cases {
+            let e = s.validate().expect_err(expected).to_string();
+            assert!(e.contains(expected), "{e:?} should say {expected:?}");
+            assert!(s.body_rays().is_empty());
+        }
+    }
+
+    #[test]
+    fn settings_read_from_json_with_defaults() {
+        let s: DepthSensor =
+            serde_json::from_str(r#"{"max_range": 3.0, "mount": {"offset": [0.1, 0, 0]}}"#)
+                .unwrap();
+        assert_eq!(s.max_range, 3.0);
+        assert_eq!(s.fov_h_deg, 87.0);
+        assert_eq!(s.mount.rotation, [1.0, 0.0, 0.0, 0.0]);
+        assert!(serde_json::from_str::<DepthSensor>(r#"{"fov": 3}"#).is_err());
+    }
+
+    #[test]
+    fn world_rays_follow_the_tilted_body_and_the_mount() {
+        // Looking down: the mount pitches the optical axis by +90 deg about body y.
+        let half = std::f64::consts::FRAC_PI_4;
+        let s = DepthSensor {
+            mount: Mount {
+                rotation: [half.cos(), 0.0, half.sin(), 0.0],
+                offset: [0.1, 0.0, -0.05],
+            },
+            ..Default::default()
+        };
+        let axis = s.body_rays()[19 * 59 + 29];
+        assert!((axis - Vector3::new(0.0, 0.0, -1.0)).norm() < 1e-12);
+        // The unit yawed by 90 deg and rolled by 90 deg (tilt): body x -> W y, body z -> W x.
+        let pose = UnitPose {
+            position: Point3::new(1.0, 2.0, 3.0),
+            attitude: UnitQuaternion::from_axis_angle(&Vector3::z_axis(), FRAC_PI_2)
+                * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), FRAC_PI_2),
+        };
+        let o = s.origin(&pose);
+        // offset (0.1, 0, -0.05): body x -> W y, body z -> W x.
+        assert!(
+            (o - Point3::new(1.0 - 0.05, 2.1, 3.0)).norm() < 1e-12,
+            "{o}"
+        );
+        let w = s.world_rays(&pose)[19 * 59 + 29];
+        assert!((w - Vector3::new(-1.0, 0.0, 0.0)).norm() < 1e-12, "{w}");
+        // The same pose from a recorded [w, x, y, z]; bad records are refused by name.
+        let q = pose.attitude.quaternion();
+        let recorded = UnitPose::new([1.0, 2.0, 3.0], [q.w, q.i, q.j, q.k]).unwrap();
+        assert!((s.world_rays(&recorded)[19 * 59 + 29] - w).norm() < 1e-12);
+        let e = UnitPose::new([0.0; 3], [1.0, 0.1, 0.0, 0.0])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("pose.attitude = [1.0, 0.1, 0.0, 0.0]: must be"),
+            "{e}"
+        );
+        assert!(UnitPose::new([f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]).is_err());
+        // A level pose at yaw 0 leaves the body rays as they are.
+        let level = UnitPose::level([0.0, 0.0, 1.0], 0.0);
+        assert_eq!(
+            DepthSensor::default().world_rays(&level),
+            DepthSensor::default().body_rays()
+        );
+    }
+}
