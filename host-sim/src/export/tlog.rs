@@ -24,8 +24,8 @@ use mavlink::MavHeader;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 use super::motion::{Command, Motion, Tick, UnitState};
-use crate::collision::verify::wrap;
 use super::ExportError;
+use crate::collision::verify::wrap;
 
 /// The sender's system id: a ground station's.
 pub const SENDER_SYSTEM: u8 = 255;

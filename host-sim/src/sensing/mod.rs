@@ -9,7 +9,9 @@
 //!   takes;
 //! - [`ray_keys`]: OctoMap's keys and its ray traversal (`computeRayKeys`), to the bit;
 //! - [`occupancy`]: [`OccupancyMap`], log-odds per voxel fused as OctoMap fuses them,
-//!   with the voxels each insertion changed, exported as a grid or a `.bt`.
+//!   with the voxels each insertion changed, exported as a grid or a `.bt`;
+//! - [`survey`]: [`Survey`], every unit's sensor scanning at its rate along a recorded
+//!   flight, and the map it draws.
 //!
 //! The rules are in docs/maps.md ("Sensing") and the contract bits in docs/model.md.
 
@@ -18,8 +20,10 @@ pub mod occupancy;
 pub mod ray_keys;
 pub mod raycast;
 pub mod sensor;
+pub mod survey;
 
 pub use cloud::PointCloud;
 pub use occupancy::{OccupancyMap, OccupancyParams, VoxelChange};
 pub use raycast::{RayReturn, Scan};
 pub use sensor::{DepthSensor, Mount, SensorError, UnitPose};
+pub use survey::{Survey, SurveyError, SurveyStats};

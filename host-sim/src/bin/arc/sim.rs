@@ -62,6 +62,13 @@ pub struct SimArgs {
     /// Keep one recorded step in this many in the JSON output.
     #[arg(long, default_value_t = 10)]
     record_every: usize,
+    /// Write the map the units' depth sensors saw along the flight (.bt, OctoMap's
+    /// fusion; docs/maps.md, "Sensing").
+    #[arg(long)]
+    map_out: Option<PathBuf>,
+    /// Scans per second of every unit's sensor, with --map-out (Hz).
+    #[arg(long, default_value_t = aerial_chain::sensing::survey::DEFAULT_RATE_HZ)]
+    sensor_rate: f64,
 }
 
 fn parse_gust(s: &str) -> Result<Gust, CliError> {
@@ -131,6 +138,23 @@ fn check(a: &SimArgs) -> Result<(), CliError> {
     checks::positive("--settle-time", a.settle_time)?;
     if a.record_every == 0 {
         return Err(checks::bad("--record-every", 0, "at least 1"));
+    }
+    let max = aerial_chain::sensing::survey::MAX_RATE_HZ;
+    if !(a.sensor_rate > 0.0 && a.sensor_rate <= max) {
+        return Err(checks::bad(
+            "--sensor-rate",
+            a.sensor_rate,
+            &format!("a positive number of scans per second, at most {max}"),
+        ));
+    }
+    if let Some(p) = &a.map_out {
+        let bt = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bt"));
+        if !bt {
+            return Err(CliError::input(format!(
+                "--map-out {}: the seen map is written as an OctoMap .bt file",
+                p.display()
+            )));
+        }
     }
     super::picture::check(a.picture.as_ref(), a.frame_step)
 }
@@ -204,6 +228,9 @@ pub fn run(a: SimArgs) -> CliResult {
         if !crate::fsutil::is_stdio(path) {
             say(format_args!("  wrote {}", path.display()));
         }
+    }
+    if let Some(path) = &a.map_out {
+        write_seen_map(path, &a, &loaded.grid, &params, &flight, &say)?;
     }
     if let Some(path) = a
         .picture
@@ -356,6 +383,37 @@ fn say_report(
         "  joint-limit excursions: pitch {:.3} deg, bend {:.3} deg, {:.3} s beyond",
         r.limits.max_pitch_excess_deg, r.limits.max_bend_excess_deg, r.limits.time_beyond
     ));
+}
+
+/// Writes the map the units' sensors saw along `flight` (`--map-out`), and says what
+/// it holds.
+fn write_seen_map(
+    path: &Path,
+    a: &SimArgs,
+    grid: &aerial_chain::map::Grid,
+    params: &aerial_chain_core::ChainParams,
+    flight: &aerial_chain::sim::Flight,
+    say: &dyn Fn(std::fmt::Arguments<'_>),
+) -> CliResult {
+    let survey = aerial_chain::sensing::Survey {
+        rate_hz: a.sensor_rate,
+        ..Default::default()
+    };
+    let free = params.unit_radius as f64 + aerial_chain::collision::DEFAULT_CLEARANCE;
+    let (seen, stats) = survey
+        .fly(grid, &flight.samples, free)
+        .map_err(|e| CliError::input(format!("--sensor-rate {}: {e}", a.sensor_rate)))?;
+    seen.write_bt(path)
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    say(format_args!(
+        "  seen map {}: {} voxels known from {} scans ({} rays) at {} Hz",
+        path.display(),
+        stats.known,
+        stats.scans,
+        stats.rays,
+        a.sensor_rate
+    ));
+    Ok(())
 }
 
 /// Writes the flight (`arc-sim/1` JSON, every `--record-every`-th sample).
