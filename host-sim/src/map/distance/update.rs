@@ -10,12 +10,14 @@
 //! - only the y columns through a voxel whose `g1` changed can have a new `g2`;
 //! - only the z columns through a voxel whose `g2` changed can have a new EDT value.
 //!
-//! The update runs the same 1D transform (same code, same arithmetic) on exactly those
-//! lines, in that order, comparing each output with what is kept, and converts the
-//! changed EDT values with the build's own conversion: equal to a recomputation by
-//! construction, which a property test checks to the bit. The row gaps depend on their
-//! row only and are redone for the flipped rows; the grid's block counts are kept by
-//! [`Grid::set`].
+//! On the rows and y columns the update redoes only the window of cells whose output
+//! may change (the `line` module: a cell further from every changed input than its
+//! old output's distance keeps it, and past the first such cell every one does), each
+//! value the exact minimum the transform computes; the z columns it transforms again in
+//! full, with the build's own 1D transform (their old values are not kept). Changed
+//! EDT values go through the build's own conversion: equal to a recomputation, which a
+//! property test checks to the bit. The row gaps depend on their row only and are
+//! redone for the flipped rows; the grid's block counts are kept by [`Grid::set`].
 //!
 //! # What is kept, and why not FIESTA's wavefronts
 //! Per voxel, `g1` and `g2` (`u32` each, 8 bytes). They play the role of FIESTA's
@@ -27,14 +29,13 @@
 //! its error against an exact EDT), and the field must equal a recomputation to the bit.
 //!
 //! # Cost
-//! A flipped voxel costs its row (`nx`), plus `ny` per changed `g1` and `nz` per changed
-//! `g2`: the reach of the change along each axis in turn, never the whole map unless
-//! the change reaches it (an obstacle added to an otherwise empty row of an open map
+//! A row costs its row gaps (`nx`) and its window; a y column its window; a z column
+//! through a changed `g2` costs `nz`: the reach of the change along each axis in turn,
+//! never the whole map unless the change reaches it (an obstacle added to an otherwise empty row of an open map
 //! changes that whole row's `g1`). The grid does not grow: a change outside it is an
 //! error.
 
-use super::super::edt::{pass_x, pass_y};
-use super::super::edt::{site, Scratch};
+use super::super::edt::{pass_x, pass_y, site, Scratch, NONE};
 use super::super::grid::{Cell, Grid};
 use super::super::row_gaps::row_gaps_of;
 use super::{stored_bound, DistanceField};
@@ -72,15 +73,16 @@ pub struct UpdateStats {
     /// Changes that flipped a voxel between obstacle and not (the rest change only the
     /// grid's state, e.g. free to unknown while unknown space is free).
     pub obstacle_flips: usize,
-    /// Rows along x transformed again (their row gaps too).
+    /// Rows along x redone (their row gaps in full).
     pub rows: usize,
-    /// Columns along y transformed again.
+    /// Columns along y redone.
     pub y_columns: usize,
-    /// Columns along z transformed again.
+    /// Columns along z transformed again, in full.
     pub z_columns: usize,
     /// Voxels whose stored bound changed.
     pub bounds_changed: usize,
-    /// Voxels the three passes visited: `rows nx + y_columns ny + z_columns nz`.
+    /// Values the three passes computed again: the windows of the rows and y columns
+    /// where the output may change, and `nz` per z column.
     pub voxels_visited: usize,
     /// Whether this update first had to build the kept passes (a full x and y pass; see
     /// [`DistanceField::prepare_updates`]).
@@ -128,9 +130,9 @@ impl DistanceField {
             ..UpdateStats::default()
         };
         self.prepare_updates();
-        let rows = self.apply(changes, &mut stats);
-        let y_cols = self.redo_rows(&rows, &mut stats);
-        let z_cols = self.redo_y_columns(&y_cols, &mut stats);
+        let flipped = self.apply(changes, &mut stats);
+        let g1_changed = self.redo_rows(&flipped, &mut stats);
+        let z_cols = self.redo_y_columns(&g1_changed, &mut stats);
         self.redo_z_columns(&z_cols, &mut stats);
         Ok(stats)
     }
@@ -155,80 +157,82 @@ impl DistanceField {
         }
     }
 
-    /// Writes the changes into the grid; the rows (`y + ny z`) where a voxel's obstacle
-    /// status flipped, sorted, once each.
+    /// Writes the changes into the grid; the voxels (linear indices) whose obstacle
+    /// status flipped, sorted, once each: by row, x ascending within a row.
     fn apply(&mut self, changes: &[([i32; 3], Cell)], stats: &mut UpdateStats) -> Vec<usize> {
-        let ny = self.grid.dims()[1];
-        let mut rows = Vec::new();
+        let mut flipped = Vec::new();
         for &(i, state) in changes {
             let was = self.grid.is_obstacle(i);
             self.grid.set(i, state);
             if self.grid.is_obstacle(i) != was {
                 stats.obstacle_flips += 1;
                 let l = self.grid.local(i).expect("checked inside");
-                rows.push(l[1] + ny * l[2]);
+                flipped.push(self.grid.linear(l));
             }
         }
-        rows.sort_unstable();
-        rows.dedup();
-        rows
+        flipped.sort_unstable();
+        flipped.dedup();
+        flipped
     }
 
-    /// The x pass and the row gaps of `rows`; the y columns (`x + nx z`) whose input
-    /// changed, sorted, once each.
-    fn redo_rows(&mut self, rows: &[usize], stats: &mut UpdateStats) -> Vec<usize> {
+    /// The x pass and the row gaps of the rows holding `flipped` voxels; the cells whose
+    /// `g1` changed, as keys `(x + nx z) ny + y` (by y column, y ascending), sorted.
+    fn redo_rows(&mut self, flipped: &[usize], stats: &mut UpdateStats) -> Vec<usize> {
         let [nx, ny, _] = self.grid.dims();
         let walls = self.grid.unknown_is_occupied();
         let kept = self.kept.as_mut().expect("prepared");
-        let mut s = Scratch::new(nx);
-        let mut cols = Vec::new();
-        for &row in rows {
+        let mut sites = vec![NONE; nx];
+        let mut changed = Vec::new();
+        for run in flipped.chunk_by(|i, j| i / nx == j / nx) {
+            let row = run[0] / nx;
             let (y, z) = (row % ny, row / ny);
-            for (c, obstacle) in s.row.iter_mut().zip(self.grid.obstacle_row(y, z)) {
+            for (c, obstacle) in sites.iter_mut().zip(self.grid.obstacle_row(y, z)) {
                 *c = site(obstacle);
             }
-            s.run(nx, walls);
             let start = row * nx;
-            for (x, (&new, old)) in s.out[..nx].iter().zip(&mut kept.g1[start..]).enumerate() {
-                if new != *old {
-                    *old = new;
-                    cols.push(x + nx * z);
+            let g1 = &mut kept.g1[start..start + nx];
+            let (a, b) = (run[0] - start, run[run.len() - 1] - start);
+            let (lo, hi) = line::window(nx, a, b, |q| g1[q]);
+            for x in lo..=hi {
+                let new = line::value_at(nx, walls, x, |p| sites[p]);
+                if new != g1[x] {
+                    g1[x] = new;
+                    changed.push((x + nx * z) * ny + y);
                 }
             }
             row_gaps_of(&self.grid, y, z, &mut self.row_gaps[start..start + nx]);
+            stats.rows += 1;
+            stats.voxels_visited += hi + 1 - lo;
         }
-        stats.rows = rows.len();
-        stats.voxels_visited += rows.len() * nx;
-        cols.sort_unstable();
-        cols.dedup();
-        cols
+        changed.sort_unstable();
+        changed
     }
 
-    /// The y pass of columns `cols` (`x + nx z`); the z columns (`x + nx y`) whose
-    /// input changed, sorted, once each.
-    fn redo_y_columns(&mut self, cols: &[usize], stats: &mut UpdateStats) -> Vec<usize> {
+    /// The y pass of the y columns holding `changed` cells (keys of [`Self::redo_rows`]);
+    /// the z columns (`x + nx y`) whose input changed, sorted, once each.
+    fn redo_y_columns(&mut self, changed: &[usize], stats: &mut UpdateStats) -> Vec<usize> {
         let [nx, ny, _] = self.grid.dims();
         let walls = self.grid.unknown_is_occupied();
         let kept = self.kept.as_mut().expect("prepared");
-        let mut s = Scratch::new(ny);
         let mut next = Vec::new();
-        for &col in cols {
+        for run in changed.chunk_by(|i, j| i / ny == j / ny) {
+            let col = run[0] / ny;
             let (x, z) = (col % nx, col / nx);
             let first = x + nx * ny * z;
-            for y in 0..ny {
-                s.row[y] = kept.g1[first + nx * y];
-            }
-            s.run(ny, walls);
-            for y in 0..ny {
-                let old = &mut kept.g2[first + nx * y];
-                if s.out[y] != *old {
-                    *old = s.out[y];
+            let (a, b) = (run[0] % ny, run[run.len() - 1] % ny);
+            let (g1, g2) = (&kept.g1, &mut kept.g2);
+            let (lo, hi) = line::window(ny, a, b, |q| g2[first + nx * q]);
+            for y in lo..=hi {
+                let new = line::value_at(ny, walls, y, |p| g1[first + nx * p]);
+                let old = &mut g2[first + nx * y];
+                if new != *old {
+                    *old = new;
                     next.push(x + nx * y);
                 }
             }
+            stats.y_columns += 1;
+            stats.voxels_visited += hi + 1 - lo;
         }
-        stats.y_columns = cols.len();
-        stats.voxels_visited += cols.len() * ny;
         next.sort_unstable();
         next.dedup();
         next
@@ -261,5 +265,6 @@ impl DistanceField {
     }
 }
 
+mod line;
 #[cfg(test)]
 mod tests;
