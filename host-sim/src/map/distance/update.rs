@@ -40,6 +40,9 @@ use super::super::grid::{Cell, Grid};
 use super::super::row_gaps::row_gaps_of;
 use super::{stored_bound, DistanceField};
 
+/// Windows of a y column at least this wide are redone by transforming the column.
+const WIDE_WINDOW: usize = 8;
+
 /// The partial transforms an update starts from: the EDT's x and y passes over the
 /// current grid (layout as the grid's cells).
 #[derive(Clone, Debug, PartialEq)]
@@ -181,7 +184,7 @@ impl DistanceField {
         let [nx, ny, _] = self.grid.dims();
         let walls = self.grid.unknown_is_occupied();
         let kept = self.kept.as_mut().expect("prepared");
-        let mut sites = vec![NONE; nx];
+        let (mut sites, mut fresh) = (vec![NONE; nx], vec![NONE; nx]);
         let mut changed = Vec::new();
         for run in flipped.chunk_by(|i, j| i / nx == j / nx) {
             let row = run[0] / nx;
@@ -190,19 +193,16 @@ impl DistanceField {
                 *c = site(obstacle);
             }
             let start = row * nx;
-            let g1 = &mut kept.g1[start..start + nx];
-            let (a, b) = (run[0] - start, run[run.len() - 1] - start);
-            let (lo, hi) = line::window(nx, a, b, |q| g1[q]);
-            for x in lo..=hi {
-                let new = line::value_at(nx, walls, x, |p| sites[p]);
-                if new != g1[x] {
-                    g1[x] = new;
+            line::row_pass(&sites, walls, &mut fresh);
+            for (x, (&new, old)) in fresh.iter().zip(&mut kept.g1[start..]).enumerate() {
+                if new != *old {
+                    *old = new;
                     changed.push((x + nx * z) * ny + y);
                 }
             }
             row_gaps_of(&self.grid, y, z, &mut self.row_gaps[start..start + nx]);
             stats.rows += 1;
-            stats.voxels_visited += hi + 1 - lo;
+            stats.voxels_visited += nx;
         }
         changed.sort_unstable();
         changed
@@ -214,6 +214,7 @@ impl DistanceField {
         let [nx, ny, _] = self.grid.dims();
         let walls = self.grid.unknown_is_occupied();
         let kept = self.kept.as_mut().expect("prepared");
+        let mut s = Scratch::new(ny);
         let mut next = Vec::new();
         for run in changed.chunk_by(|i, j| i / ny == j / ny) {
             let col = run[0] / ny;
@@ -222,8 +223,21 @@ impl DistanceField {
             let (a, b) = (run[0] % ny, run[run.len() - 1] % ny);
             let (g1, g2) = (&kept.g1, &mut kept.g2);
             let (lo, hi) = line::window(ny, a, b, |q| g2[first + nx * q]);
+            // A value costs a scan as long as its distance; past a few cells a window
+            // costs less as the whole column's transform (both exact: the same numbers).
+            let whole = hi - lo >= WIDE_WINDOW;
+            if whole {
+                for p in 0..ny {
+                    s.row[p] = g1[first + nx * p];
+                }
+                s.run(ny, walls);
+            }
             for y in lo..=hi {
-                let new = line::value_at(ny, walls, y, |p| g1[first + nx * p]);
+                let new = if whole {
+                    s.out[y]
+                } else {
+                    line::value_at(ny, walls, y, |p| g1[first + nx * p])
+                };
                 let old = &mut g2[first + nx * y];
                 if new != *old {
                     *old = new;
