@@ -10,30 +10,32 @@
 //! - only the y columns through a voxel whose `g1` changed can have a new `g2`;
 //! - only the z columns through a voxel whose `g2` changed can have a new EDT value.
 //!
-//! On the rows and y columns the update redoes only the window of cells whose output
-//! may change (the `line` module: a cell further from every changed input than its
-//! old output's distance keeps it, and past the first such cell every one does), each
-//! value the exact minimum the transform computes; the z columns it transforms again in
-//! full, with the build's own 1D transform (their old values are not kept). Changed
-//! EDT values go through the build's own conversion: equal to a recomputation, which a
-//! property test checks to the bit. The row gaps depend on their row only and are
-//! redone for the flipped rows; the grid's block counts are kept by [`Grid::set`].
+//! A flipped row is swept whole, once each way (its inputs are sites or nothing, so the
+//! squared distance to the nearest site is the transform's exact value). On a y column
+//! the update redoes only the window of cells whose output may change (the `line`
+//! module: a cell further from every changed input than its old output's distance
+//! keeps it, and past the first such cell every one does), each value the exact minimum
+//! the transform computes; the z columns it transforms again in full, with the build's
+//! own 1D transform (their old values are not kept). Changed EDT values go through the
+//! build's own conversion: equal to a recomputation, which a property test checks to
+//! the bit. The row gaps depend on their row only and are redone for the flipped rows;
+//! the grid's block counts are kept by [`Grid::set`].
 //!
 //! # What is kept, and why not FIESTA's wavefronts
 //! Per voxel, `g1` and `g2` (`u32` each, 8 bytes). They play the role of FIESTA's
 //! per-voxel nearest obstacle and its lists of dependents: a deleted obstacle's
 //! dependents are the voxels whose `g1` changes in its row, then whose `g2` changes in
 //! those columns, and so on; nothing else is visited. FIESTA and voxblox propagate sites
-//! between 6/24/26-neighbours by breadth-first wavefronts, which is not exact on a
-//! grid (a voxel's nearest site need not be any neighbour's nearest site; FIESTA reports
-//! its error against an exact EDT), and the field must equal a recomputation to the bit.
+//! between neighbours (6 or 24 of them) by breadth-first wavefronts, which is not exact
+//! on a grid in general (a voxel's nearest site need not be any neighbour's nearest
+//! site), and the field must equal a recomputation to the bit.
 //!
 //! # Cost
-//! A row costs its row gaps (`nx`) and its window; a y column its window; a z column
-//! through a changed `g2` costs `nz`: the reach of the change along each axis in turn,
-//! never the whole map unless the change reaches it (an obstacle added to an otherwise empty row of an open map
-//! changes that whole row's `g1`). The grid does not grow: a change outside it is an
-//! error.
+//! A row costs two sweeps and its row gaps (`nx` each); a y column its window; a z
+//! column through a changed `g2` costs `nz`: the reach of the change along each axis
+//! in turn, never the whole map unless the change reaches it (an obstacle added to an
+//! otherwise empty row of an open map changes that whole row's `g1`). The grid does not
+//! grow: a change outside it is an error.
 
 use super::super::edt::{pass_x, pass_y, site, Scratch, NONE};
 use super::super::grid::{Cell, Grid};
