@@ -1,6 +1,7 @@
 //! Map and collision benchmarks: loading a 20 m x 20 m x 5 m map at 0.1 m from a `.bt`
-//! file into a grid and distance field, and the planner's conservative checks of a
-//! 6-unit chain in clutter.
+//! file into a grid and distance field, the planner's conservative checks of a 6-unit
+//! chain in clutter, and the distance field's update after one depth scan against a
+//! recomputation (`field_update`).
 
 use std::hint::black_box;
 use std::sync::Arc;
@@ -10,7 +11,7 @@ use aerial_chain::map::DistanceField;
 use aerial_chain::map::OcTree;
 use aerial_chain::map::{Cell, Grid};
 use aerial_chain_core::{ChainParams, Shape};
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 
 /// A small deterministic generator (no dependency needed for a benchmark's clutter).
 struct Lcg(u64);
@@ -83,6 +84,13 @@ fn bench(c: &mut Criterion) {
         b.iter(|| black_box(DistanceField::new(big.clone())))
     });
     g.finish();
+    let mut f = DistanceField::new(big);
+    let plain = f.memory_bytes();
+    f.prepare_updates();
+    eprintln!(
+        "field_100x20x5: memory {plain} B, {} B with what updates keep",
+        f.memory_bytes()
+    );
 
     let field = Arc::new(DistanceField::new(grid));
     let ctx = CollisionContext::new(field, ChainParams::new(6), 0.05).unwrap();
@@ -173,5 +181,102 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+/// A room of 16 x 12 x 3 m at 0.1 m (160 x 120 x 30 voxels: floor, ceiling, walls, a
+/// row of pillars, a box floating at x = 6.1-6.3 m) and the map of it explored so far:
+/// the same for x < 6 m, unknown beyond.
+fn explored_room() -> (Grid, Grid) {
+    let mut world = Grid::new(0.1, [0, 0, 0], [160, 120, 30], Cell::Free, true).unwrap();
+    for (lo, hi) in [
+        ([0.0, 0.0, 0.0], [16.0, 12.0, 0.2]),
+        ([0.0, 0.0, 2.8], [16.0, 12.0, 3.0]),
+        ([0.0, 0.0, 0.0], [0.2, 12.0, 3.0]),
+        ([15.8, 0.0, 0.0], [16.0, 12.0, 3.0]),
+        ([0.0, 0.0, 0.0], [16.0, 0.2, 3.0]),
+        ([0.0, 11.8, 0.0], [16.0, 12.0, 3.0]),
+        ([6.1, 5.2, 1.2], [6.3, 5.5, 1.6]),
+    ] {
+        world.fill_box(lo, hi, Cell::Occupied);
+    }
+    for k in 0..7 {
+        let x = 1.5 + 2.0 * k as f64;
+        world.fill_box([x, 2.0, 0.0], [x + 0.4, 2.4, 3.0], Cell::Occupied);
+    }
+    let mut map = world.clone();
+    map.fill_box([6.0, 0.0, 0.0], [16.0, 12.0, 3.0], Cell::Unknown);
+    (world, map)
+}
+
+/// One simulated depth scan of `world` into `map` from (4, 6, 1.5) m looking along +x
+/// (87 x 58 degrees, 2.3 m range): every voxel whose centre is in the frustum and that
+/// `map` does not know takes its state in `world` (no occlusion: the frustum's shape
+/// and size are what matter here).
+fn depth_scan(world: &Grid, map: &Grid) -> Vec<([i32; 3], Cell)> {
+    let (s, range) = ([4.0, 6.0, 1.5], 2.3f64);
+    let (h, v) = (43.5f64.to_radians().tan(), 29f64.to_radians().tan());
+    let mut changes = Vec::new();
+    for z in 0..30 {
+        for y in 0..120 {
+            for x in 0..160 {
+                let i = [x, y, z];
+                let c = map.voxel_center(i);
+                let d = [c.x - s[0], c.y - s[1], c.z - s[2]];
+                let inside = d[0] > 0.0
+                    && d[1].abs() <= h * d[0]
+                    && d[2].abs() <= v * d[0]
+                    && d.iter().map(|v| v * v).sum::<f64>() <= range * range;
+                if inside && map.cell(i) == Cell::Unknown {
+                    changes.push((i, world.cell(i)));
+                }
+            }
+        }
+    }
+    changes
+}
+
+/// The field updated after one depth scan against the field recomputed.
+fn bench_update(c: &mut Criterion) {
+    let (world, map) = explored_room();
+    let changes = depth_scan(&world, &map);
+    let occupied = changes.iter().filter(|(_, s)| *s == Cell::Occupied).count();
+    let free = changes.len() - occupied;
+    assert!((100..1000).contains(&free) && (10..100).contains(&occupied));
+    let mut after = map.clone();
+    for &(i, s) in &changes {
+        after.set(i, s);
+    }
+    let mut field = DistanceField::new(map);
+    let plain = field.memory_bytes();
+    field.prepare_updates();
+    let mut updated = field.clone();
+    let stats = updated.update(&changes).unwrap();
+    let fresh = DistanceField::new(after.clone());
+    for i in (0..30).flat_map(|z| (0..120).flat_map(move |y| (0..160).map(move |x| [x, y, z]))) {
+        let (a, b) = (updated.voxel_clearance(i), fresh.voxel_clearance(i));
+        assert_eq!(a.to_bits(), b.to_bits(), "voxel {i:?}");
+    }
+    eprintln!(
+        "field_update: {free} voxels turned free, {occupied} occupied; {stats:?}; \
+         memory {plain} B, {} B with the kept passes",
+        field.memory_bytes()
+    );
+    let mut g = c.benchmark_group("field_update");
+    g.sample_size(30);
+    g.bench_function("one_scan_160x120x30", |b| {
+        b.iter_batched_ref(
+            || field.clone(),
+            |f| black_box(f.update(&changes).unwrap()),
+            BatchSize::LargeInput,
+        )
+    });
+    g.bench_function("recompute_160x120x30", |b| {
+        b.iter_batched(
+            || after.clone(),
+            |g| black_box(DistanceField::new(g)),
+            BatchSize::LargeInput,
+        )
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_update);
 criterion_main!(benches);

@@ -42,13 +42,22 @@
 //! clearance is 0. With unknown space free, outside is free and the bound above still
 //! holds with the nearest grid voxel's centre (the triangle inequality works with any
 //! centre). Unit centres must be inside the bounding box anyway (checked separately).
+//!
+//! # Updates
+//! [`DistanceField::update`] changes voxels of the grid and redoes the transform only
+//! on the lines the change reaches, keeping the x and y passes for that (see the
+//! `update` module and docs/maps.md); the result equals [`DistanceField::new`] of the
+//! changed grid to the bit.
 
-use rayon::prelude::*;
 use std::sync::OnceLock;
 
 use nalgebra::Point3;
 
+use super::edt::{squared_edt, NONE};
 use super::grid::{floor, Grid};
+
+mod update;
+pub use update::{UpdateError, UpdateStats};
 
 /// Size of the exact `G(n)` table.
 const G_TABLE: usize = 4096;
@@ -100,224 +109,6 @@ pub fn cube_distance_bound(n: u64) -> f64 {
     }
 }
 
-/// The squared-EDT value meaning "no obstacle at all".
-const NONE: u32 = u32::MAX;
-
-/// One Felzenszwalb-Huttenlocher pass over a row `f` (squared distances, `NONE` for
-/// infinity) with optional virtual obstacle sites just outside both ends. Writes the
-/// result into `out`. `v`, `z` are scratch of length `f.len() + 3`.
-fn edt_1d(f: &[u32], walls: bool, out: &mut [u32], v: &mut [i64], z: &mut [f64]) {
-    let n = f.len() as i64;
-    // Sites are positions q in -1..=n (the ends only with walls) and f(q) finite.
-    let fq = |q: i64| -> u32 {
-        if q < 0 || q >= n {
-            if walls {
-                0
-            } else {
-                NONE
-            }
-        } else {
-            f[q as usize]
-        }
-    };
-    let mut k: usize = 0;
-    let mut have = false;
-    for q in -1..=n {
-        let fv = fq(q);
-        if fv == NONE {
-            continue;
-        }
-        if !have {
-            v[0] = q;
-            z[0] = f64::NEG_INFINITY;
-            z[1] = f64::INFINITY;
-            have = true;
-            continue;
-        }
-        let val = fv as f64 + (q * q) as f64;
-        let s = loop {
-            let p = v[k];
-            let s = (val - (fq(p) as f64 + (p * p) as f64)) / (2 * (q - p)) as f64;
-            // z[0] is -infinity, so this stops at k = 0 at the latest.
-            if s <= z[k] {
-                k -= 1;
-            } else {
-                break s;
-            }
-        };
-        k += 1;
-        v[k] = q;
-        z[k] = s;
-        z[k + 1] = f64::INFINITY;
-    }
-    if !have {
-        out.fill(NONE);
-        return;
-    }
-    let mut k = 0usize;
-    for q in 0..n {
-        while z[k + 1] < q as f64 {
-            k += 1;
-        }
-        let p = v[k];
-        let d = (q - p) * (q - p) + fq(p) as i64;
-        out[q as usize] = d.min(NONE as i64 - 1) as u32;
-    }
-}
-
-/// Exact squared EDT (voxel units) of the grid's obstacles, `NONE` where there is no
-/// obstacle at all. Layout as the grid's cells (x fastest).
-pub(crate) fn squared_edt(grid: &Grid) -> Vec<u32> {
-    let [nx, ny, nz] = grid.dims();
-    let walls = grid.unknown_is_occupied();
-    let mut d: Vec<u32> = vec![NONE; nx * ny * nz];
-    // x: contiguous rows, the obstacles set first. The passes are separable, so each
-    // runs its 1D transforms in parallel (rayon), every thread with its own scratch.
-    d.par_chunks_exact_mut(nx).enumerate().for_each_init(
-        || Scratch::new(nx),
-        |s, (k, r)| {
-            let (y, z) = (k % ny, k / ny);
-            for (x, c) in r.iter_mut().enumerate() {
-                let occ = match grid.cell_local([x, y, z]) {
-                    super::grid::Cell::Occupied => true,
-                    super::grid::Cell::Free => false,
-                    super::grid::Cell::Unknown => walls,
-                };
-                *c = if occ { 0 } else { NONE };
-            }
-            s.transform(r, walls);
-        },
-    );
-    // y: stride nx inside each z slab; slabs in parallel.
-    d.par_chunks_exact_mut(nx * ny).for_each_init(
-        || Scratch::new(ny),
-        |s, slab| {
-            for x in 0..nx {
-                s.transform_strided(slab, x, nx, ny, walls);
-            }
-        },
-    );
-    // z: stride nx * ny. Columns of different y never share a cell, so each y is a
-    // task writing only its own cells (see `Columns`); 64 columns at a time, copied
-    // out by rows, for locality.
-    let plane = nx * ny;
-    let cols = Columns(d.as_mut_ptr(), d.len());
-    (0..ny).into_par_iter().for_each_init(
-        || (Scratch::new(nz), vec![0u32; nz * BLOCK]),
-        |(s, block), y| {
-            for x0 in (0..nx).step_by(BLOCK) {
-                let w = BLOCK.min(nx - x0);
-                // SAFETY: cells `x + nx y + plane z` for this task's `y` are written
-                // by this task only, and every index is below `d.len()`.
-                unsafe { cols.transform_block(s, block, x0 + nx * y, w, plane, nz, walls) };
-            }
-        },
-    );
-    d
-}
-
-/// Scratch space of the 1D transform for lines of up to `n` cells.
-struct Scratch {
-    row: Vec<u32>,
-    out: Vec<u32>,
-    v: Vec<i64>,
-    z: Vec<f64>,
-}
-
-impl Scratch {
-    fn new(n: usize) -> Self {
-        Self {
-            row: vec![0; n],
-            out: vec![0; n],
-            v: vec![0; n + 3],
-            z: vec![0.0; n + 4],
-        }
-    }
-
-    /// The 1D transform of `row[..n]` into `out[..n]`.
-    fn run(&mut self, n: usize, walls: bool) {
-        let (row, out) = (&self.row[..n], &mut self.out[..n]);
-        edt_1d(row, walls, out, &mut self.v, &mut self.z);
-    }
-
-    /// The 1D transform of the contiguous line `line`, in place.
-    fn transform(&mut self, line: &mut [u32], walls: bool) {
-        let n = line.len();
-        self.row[..n].copy_from_slice(line);
-        self.run(n, walls);
-        line.copy_from_slice(&self.out[..n]);
-    }
-
-    /// The 1D transform of the `n` cells `first + k stride` of `cells`, in place.
-    fn transform_strided(
-        &mut self,
-        cells: &mut [u32],
-        first: usize,
-        stride: usize,
-        n: usize,
-        walls: bool,
-    ) {
-        for k in 0..n {
-            self.row[k] = cells[first + k * stride];
-        }
-        self.run(n, walls);
-        for k in 0..n {
-            cells[first + k * stride] = self.out[k];
-        }
-    }
-}
-
-/// The field's cells, shared by the z pass's tasks, each of which touches only the
-/// columns of its own y.
-#[derive(Clone, Copy)]
-struct Columns(*mut u32, usize);
-
-// SAFETY: the tasks that share it write disjoint cells (see `squared_edt`).
-unsafe impl Send for Columns {}
-unsafe impl Sync for Columns {}
-
-/// Columns the z pass copies out together.
-const BLOCK: usize = 64;
-
-impl Columns {
-    /// The 1D transforms of the `w` columns starting at `first` (cells
-    /// `first + j + k stride`, `j < w`, `k < n`), in place, through `block`.
-    ///
-    /// # Safety
-    /// No other thread may touch these cells meanwhile, and they must all be below
-    /// the length.
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn transform_block(
-        &self,
-        s: &mut Scratch,
-        block: &mut [u32],
-        first: usize,
-        w: usize,
-        stride: usize,
-        n: usize,
-        walls: bool,
-    ) {
-        debug_assert!(n == 0 || first + w - 1 + (n - 1) * stride < self.1);
-        for k in 0..n {
-            let src = std::slice::from_raw_parts(self.0.add(first + k * stride), w);
-            block[k * BLOCK..k * BLOCK + w].copy_from_slice(src);
-        }
-        for j in 0..w {
-            for k in 0..n {
-                s.row[k] = block[k * BLOCK + j];
-            }
-            s.run(n, walls);
-            for k in 0..n {
-                block[k * BLOCK + j] = s.out[k];
-            }
-        }
-        for k in 0..n {
-            let dst = std::slice::from_raw_parts_mut(self.0.add(first + k * stride), w);
-            dst.copy_from_slice(&block[k * BLOCK..k * BLOCK + w]);
-        }
-    }
-}
-
 /// A local index from its value in `f64` (a whole number in `0..dims`), by way of
 /// `u32`: a grid spans fewer than 2^32 voxels along every axis (its lattice indices
 /// are `i32`), and the conversion to `u64` costs several times more.
@@ -349,6 +140,21 @@ pub struct DistanceField {
     /// The grid's dimensions as `f64`, which every query compares against (the
     /// conversion costs more than the comparison).
     extent: [f64; 3],
+    /// What [`Self::update`] keeps between updates (the EDT's x and y passes), built on
+    /// the first update or by [`Self::prepare_updates`]; `None` until then, since it
+    /// takes 8 bytes a voxel that a finished map never needs.
+    kept: Option<Box<update::Kept>>,
+}
+
+/// The stored bound of a voxel whose squared EDT value is `n` at resolution `r`: the
+/// one conversion both the full build and the update use, so that they agree to the bit.
+#[inline]
+fn stored_bound(n: u32, r: f64) -> f32 {
+    if n == NONE {
+        f32::INFINITY
+    } else {
+        f32_down(r * cube_distance_bound(n as u64))
+    }
 }
 
 impl DistanceField {
@@ -356,16 +162,7 @@ impl DistanceField {
     pub fn new(grid: Grid) -> DistanceField {
         let r = grid.resolution();
         let d = squared_edt(&grid);
-        let lb: Vec<f32> = d
-            .into_iter()
-            .map(|n| {
-                if n == NONE {
-                    f32::INFINITY
-                } else {
-                    f32_down(r * cube_distance_bound(n as u64))
-                }
-            })
-            .collect();
+        let lb: Vec<f32> = d.into_iter().map(|n| stored_bound(n, r)).collect();
         let row_gaps = super::row_gaps::row_gaps(&grid);
         let extent = grid.dims().map(|d| d as f64);
         DistanceField {
@@ -373,6 +170,7 @@ impl DistanceField {
             lb,
             row_gaps,
             extent,
+            kept: None,
         }
     }
 
@@ -515,9 +313,10 @@ impl DistanceField {
         &self.row_gaps[start..start + self.grid.dims()[0]]
     }
 
-    /// Bytes held by the grid and the field.
+    /// Bytes held by the grid and the field, with what updates keep once built.
     pub fn memory_bytes(&self) -> usize {
-        self.lb.len() * 4 + self.row_gaps.len() + self.grid.dims().iter().product::<usize>()
+        let kept = self.kept.as_ref().map_or(0, |k| k.memory_bytes());
+        self.lb.len() * 4 + self.row_gaps.len() + self.grid.dims().iter().product::<usize>() + kept
     }
 }
 

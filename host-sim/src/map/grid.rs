@@ -327,12 +327,6 @@ impl Grid {
         }
     }
 
-    /// State of grid-local voxel `l` (must be inside the grid).
-    #[inline]
-    pub(crate) fn cell_local(&self, l: [usize; 3]) -> Cell {
-        Cell::from_u8(self.cells[self.linear(l)])
-    }
-
     /// Sets lattice voxel `i`; ignored outside the grid.
     pub fn set(&mut self, i: [i32; 3], state: Cell) {
         if let Some(l) = self.local(i) {
@@ -359,6 +353,13 @@ impl Grid {
     /// that none of its voxels is one.
     pub(crate) fn block_may_hold_obstacle(&self, b: [i64; 3]) -> bool {
         self.blocks.may_hold(b, self.unknown_is_occupied)
+    }
+
+    /// Whether the block summary equals a recount of the cells (for tests of code
+    /// that writes the grid).
+    #[cfg(test)]
+    pub(crate) fn blocks_match_cells(&self) -> bool {
+        self.blocks == ObstacleBlocks::count(self.dims, &self.cells)
     }
 
     /// Whether the voxel containing `p` is an obstacle.

@@ -1,10 +1,11 @@
 //! Maps: OctoMap files, occupancy grids and distance fields.
 pub(crate) mod blocks;
 pub(crate) mod distance;
+pub(crate) mod edt;
 pub(crate) mod grid;
 pub(crate) mod octomap;
 pub(crate) mod row_gaps;
 
-pub use distance::DistanceField;
+pub use distance::{DistanceField, UpdateError, UpdateStats};
 pub use grid::{Cell, Grid, GridError};
 pub use octomap::{MapFileError, OcTree};

@@ -23,40 +23,39 @@ pub(crate) const FAR: u8 = u8::MAX;
 /// or more.
 pub(crate) fn row_gaps(grid: &Grid) -> Vec<u8> {
     let [nx, ny, _] = grid.dims();
-    let walls = grid.unknown_is_occupied();
     let mut gaps = vec![FAR; grid.dims().iter().product()];
     if nx == 0 {
         return gaps;
     }
     gaps.par_chunks_exact_mut(nx)
         .enumerate()
-        .for_each(|(k, row)| {
-            // The obstacle last seen on the left (-1: beyond the row's start).
-            let mut last: Option<i64> = walls.then_some(-1);
-            for (x, (g, obstacle)) in row
-                .iter_mut()
-                .zip(grid.obstacle_row(k % ny, k / ny))
-                .enumerate()
-            {
-                if obstacle {
-                    last = Some(x as i64);
-                }
-                if let Some(o) = last {
-                    *g = gap(x as i64 - o);
-                }
-            }
-            // Right to left: the obstacles are the voxels the first pass set to 0.
-            let mut next: Option<i64> = walls.then_some(nx as i64);
-            for x in (0..nx).rev() {
-                if row[x] == 0 {
-                    next = Some(x as i64);
-                }
-                if let Some(o) = next {
-                    row[x] = row[x].min(gap(o - x as i64));
-                }
-            }
-        });
+        .for_each(|(k, row)| row_gaps_of(grid, k % ny, k / ny, row));
     gaps
+}
+
+/// The gaps of row `(y, z)` (local indices) into `row` (its `dims[0]` voxels), whatever
+/// `row` held before: for the full build and for the rows an update changes.
+pub(crate) fn row_gaps_of(grid: &Grid, y: usize, z: usize, row: &mut [u8]) {
+    let walls = grid.unknown_is_occupied();
+    let nx = row.len();
+    // The obstacle last seen on the left (-1: beyond the row's start).
+    let mut last: Option<i64> = walls.then_some(-1);
+    for (x, (g, obstacle)) in row.iter_mut().zip(grid.obstacle_row(y, z)).enumerate() {
+        if obstacle {
+            last = Some(x as i64);
+        }
+        *g = last.map_or(FAR, |o| gap(x as i64 - o));
+    }
+    // Right to left: the obstacles are the voxels the first pass set to 0.
+    let mut next: Option<i64> = walls.then_some(nx as i64);
+    for x in (0..nx).rev() {
+        if row[x] == 0 {
+            next = Some(x as i64);
+        }
+        if let Some(o) = next {
+            row[x] = row[x].min(gap(o - x as i64));
+        }
+    }
 }
 
 /// A gap of `d >= 0` voxels, saturated at [`FAR`].
