@@ -12,6 +12,8 @@
 //! sensor into a truth map are inserted too. Without g++ or the OctoMap library this
 //! test fails and names the package to install (`./test` installs both).
 
+mod support;
+
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -31,30 +33,9 @@ const KEY0: i64 = 32768;
 fn program() -> &'static Result<PathBuf, String> {
     static PROGRAM: OnceLock<Result<PathBuf, String>> = OnceLock::new();
     PROGRAM.get_or_init(|| {
-        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/octomap/fusion.cpp");
-        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("octomap_fusion");
-        let tmp = out.with_extension(format!("tmp{}", std::process::id()));
-        let output = Command::new("g++")
-            .args(["-O1", "-std=c++17", "-o"])
-            .arg(&tmp)
-            .arg(&src)
-            .args(["-loctomap", "-loctomath"])
-            .output()
-            .map_err(|e| {
-                format!("cannot run g++ ({e}): install it (apt-get install -y g++), or run ./test, which does")
-            })?;
-        if !output.status.success() {
-            let stderr = String::from_utf8_lossy(&output.stderr);
-            if stderr.contains("octomap/") || stderr.contains("-loctoma") {
-                return Err(format!(
-                    "the OctoMap library is not installed (apt-get install -y liboctomap-dev, or run ./test, which does): {}",
-                    stderr.lines().find(|l| l.contains("octom")).unwrap_or("")
-                ));
-            }
-            panic!("g++ failed on {}:\n{stderr}", src.display());
-        }
-        std::fs::rename(&tmp, &out).unwrap();
-        Ok(out)
+        let src =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/octomap/fusion.cpp");
+        support::octomap_program(&src, "octomap_fusion")
     })
 }
 

@@ -13,6 +13,8 @@
 //!   fails and names the package to install (`./test` installs both): no test here
 //!   passes without running.
 
+mod support;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
@@ -249,45 +251,7 @@ fn real_map_geb079_reads_as_octomap_reads_it() {
 fn checker() -> &'static Result<PathBuf, String> {
     static CHECKER: OnceLock<Result<PathBuf, String>> = OnceLock::new();
     CHECKER.get_or_init(|| {
-        let src = fixtures().join("make_fixtures.cpp");
-        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("octomap_checker");
-        let fresh = match (std::fs::metadata(&out), std::fs::metadata(&src)) {
-            (Ok(o), Ok(s)) => match (o.modified(), s.modified()) {
-                (Ok(o), Ok(s)) => o > s,
-                _ => false,
-            },
-            _ => false,
-        };
-        if fresh {
-            return Ok(out);
-        }
-        let tmp = out.with_extension(format!("tmp{}", std::process::id()));
-        let result = Command::new("g++")
-            .args(["-O1", "-std=c++17", "-o"])
-            .arg(&tmp)
-            .arg(&src)
-            .args(["-loctomap", "-loctomath"])
-            .output();
-        let output = match result {
-            Ok(o) => o,
-            Err(e) => {
-                return Err(format!(
-                    "cannot run g++ ({e}): install it (apt-get install -y g++), or run ./test, which does"
-                ))
-            }
-        };
-        if !output.status.success() {
-            let stderr = String::from_utf8_lossy(&output.stderr);
-            if stderr.contains("octomap/") || stderr.contains("-loctoma") {
-                return Err(format!(
-                    "the OctoMap library is not installed (apt-get install -y liboctomap-dev, or run ./test, which does): {}",
-                    stderr.lines().find(|l| l.contains("octom")).unwrap_or("")
-                ));
-            }
-            panic!("g++ failed on {}:\n{stderr}", src.display());
-        }
-        std::fs::rename(&tmp, &out).unwrap();
-        Ok(out)
+        support::octomap_program(&fixtures().join("make_fixtures.cpp"), "octomap_checker")
     })
 }
 

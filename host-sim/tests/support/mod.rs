@@ -279,3 +279,40 @@ pub fn sealed_rooms(dir: &Path) -> PathBuf {
     g.to_octree().unwrap().write_bt(&path).unwrap();
     path
 }
+
+/// `src` (C++ against OctoMap's library) compiled with g++ into the tests' temporary
+/// directory as `name`, unless a build newer than the source is there; or why it cannot
+/// be: g++ or the OctoMap library missing, named with the package to install (`./test`
+/// installs both). A program that does not compile is a bug: it panics.
+pub fn octomap_program(src: &Path, name: &str) -> Result<PathBuf, String> {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let fresh = match (std::fs::metadata(&out), std::fs::metadata(src)) {
+        (Ok(o), Ok(s)) => matches!((o.modified(), s.modified()), (Ok(o), Ok(s)) if o > s),
+        _ => false,
+    };
+    if fresh {
+        return Ok(out);
+    }
+    let tmp = out.with_extension(format!("tmp{}", std::process::id()));
+    let output = Command::new("g++")
+        .args(["-O1", "-std=c++17", "-o"])
+        .arg(&tmp)
+        .arg(src)
+        .args(["-loctomap", "-loctomath"])
+        .output()
+        .map_err(|e| {
+            format!("cannot run g++ ({e}): install it (apt-get install -y g++), or run ./test, which does")
+        })?;
+    if !output.status.success() {
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        if stderr.contains("octomap/") || stderr.contains("-loctoma") {
+            return Err(format!(
+                "the OctoMap library is not installed (apt-get install -y liboctomap-dev, or run ./test, which does): {}",
+                stderr.lines().find(|l| l.contains("octom")).unwrap_or("")
+            ));
+        }
+        panic!("g++ failed on {}:\n{stderr}", src.display());
+    }
+    std::fs::rename(&tmp, &out).map_err(|e| format!("{}: {e}", out.display()))?;
+    Ok(out)
+}
