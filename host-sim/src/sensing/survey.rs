@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::occupancy::FusionError;
-use super::{DepthSensor, OccupancyMap, PointCloud, SensorError, UnitPose};
+use super::{DepthSensor, OccupancyMap, PointCloud, SensorError, UnitPose, VoxelChange};
 use crate::map::Grid;
 use crate::sim::Sample;
 
@@ -80,6 +80,18 @@ impl Survey {
         samples: &[Sample],
         free_radius: f64,
     ) -> Result<(OccupancyMap, SurveyStats), SurveyError> {
+        self.fly_with(truth, samples, free_radius, &mut |_| {})
+    }
+
+    /// [`Self::fly`], handing every insertion's changes of state to `on_change` as they
+    /// happen (to update a distance field, or a planner's structures, where they reach).
+    pub fn fly_with(
+        &self,
+        truth: &Grid,
+        samples: &[Sample],
+        free_radius: f64,
+        on_change: &mut dyn FnMut(&[VoxelChange]),
+    ) -> Result<(OccupancyMap, SurveyStats), SurveyError> {
         self.validate()?;
         let mut map = OccupancyMap::new(truth.resolution())?;
         let mut stats = SurveyStats::default();
@@ -92,13 +104,13 @@ impl Survey {
                     let scan = super::raycast::scan(truth, &self.sensor, &pose);
                     stats.rays += scan.rays.len();
                     let cloud = PointCloud::from_scan(&scan, truth.resolution());
-                    map.insert(&cloud, scan.max_range)?;
+                    on_change(&map.insert(&cloud, scan.max_range)?);
                     stats.scans += 1;
                 }
                 next += 1.0 / self.rate_hz;
             }
             for unit in &s.units {
-                map.mark_free_sphere(unit.p.map(f64::from), free_radius)?;
+                on_change(&map.mark_free_sphere(unit.p.map(f64::from), free_radius)?);
             }
         }
         stats.known = map.known();
@@ -110,7 +122,7 @@ impl Survey {
 mod tests {
     use super::*;
     use crate::flying::{fly, FlyOptions};
-    use crate::map::Cell;
+    use crate::map::{Cell, Grid};
     use crate::planner::Query;
     use crate::planning::{plan, PlanOptions, Request};
     use crate::problem::scenarios;
@@ -164,6 +176,56 @@ mod tests {
             let p = s.units[0].p.map(f64::from);
             assert_eq!(seen.state(sc.grid.lattice_index(p)), Cell::Free);
         }
+    }
+
+    #[test]
+    fn a_distance_field_updated_scan_by_scan_is_the_seen_maps_field() {
+        let sc = scenarios::build("maze").unwrap();
+        let params = ChainParams::new(5);
+        let query = Query::new(sc.start, sc.start_shape(5).unwrap(), sc.goal);
+        let request = Request::new(sc.grid.clone(), params, query);
+        let planned = plan(&request, None, &PlanOptions::default()).unwrap();
+        let (flight, _) = fly(
+            &planned.plan,
+            &sc.grid,
+            &FlyOptions::default(),
+            &Progress::default(),
+        )
+        .unwrap();
+        // The box of the truth, all unknown (occupied) at first, as a chain entering it
+        // knows it; the field follows every insertion.
+        let (o, d) = (sc.grid.origin(), sc.grid.dims());
+        let blank = Grid::new(sc.grid.resolution(), o, d, Cell::Unknown, true).unwrap();
+        let mut field = crate::map::DistanceField::new(blank);
+        field.prepare_updates();
+        let mut batches = 0;
+        let survey = Survey::default();
+        let (seen, _) = survey
+            .fly_with(&sc.grid, &flight.samples, 0.2, &mut |changes| {
+                let inside: Vec<([i32; 3], Cell)> = changes
+                    .iter()
+                    .filter(|c| field.grid().local(c.voxel).is_some())
+                    .map(|c| (c.voxel, c.new))
+                    .collect();
+                field.update(&inside).unwrap();
+                batches += 1;
+            })
+            .unwrap();
+        assert!(batches > 100);
+        let fresh = crate::map::DistanceField::new(field.grid().clone());
+        let mut checked = 0;
+        for z in 0..d[2] as i32 {
+            for y in 0..d[1] as i32 {
+                for x in 0..d[0] as i32 {
+                    let i = [o[0] + x, o[1] + y, o[2] + z];
+                    assert_eq!(field.grid().cell(i), seen.state(i), "{i:?}");
+                    let (a, b) = (field.voxel_clearance(i), fresh.voxel_clearance(i));
+                    assert_eq!(a.to_bits(), b.to_bits(), "{i:?}: {a} updated, {b} rebuilt");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 100_000);
     }
 
     #[test]
