@@ -126,23 +126,25 @@ mod tests {
     use crate::planner::Query;
     use crate::planning::{plan, PlanOptions, Request};
     use crate::problem::scenarios;
-    use crate::sim::Progress;
+    use crate::sim::{Flight, Progress};
     use aerial_chain_core::ChainParams;
+
+    /// Scenario `name`, planned for `units` units as `arc plan` plans it and flown as
+    /// `arc sim` flies it.
+    fn flown(name: &str, units: u8) -> (scenarios::Scenario, ChainParams, Flight) {
+        let sc = scenarios::build(name).unwrap();
+        let params = ChainParams::new(units);
+        let query = Query::new(sc.start, sc.start_shape(units).unwrap(), sc.goal);
+        let request = Request::new(sc.grid.clone(), params, query);
+        let planned = plan(&request, None, &PlanOptions::default()).unwrap();
+        let options = FlyOptions::default();
+        let (flight, _) = fly(&planned.plan, &sc.grid, &options, &Progress::default()).unwrap();
+        (sc, params, flight)
+    }
 
     #[test]
     fn what_the_units_see_along_a_flight_is_what_is_there() {
-        let sc = scenarios::build("window").unwrap();
-        let params = ChainParams::new(4);
-        let query = Query::new(sc.start, sc.start_shape(4).unwrap(), sc.goal);
-        let request = Request::new(sc.grid.clone(), params, query);
-        let planned = plan(&request, None, &PlanOptions::default()).unwrap();
-        let (flight, _) = fly(
-            &planned.plan,
-            &sc.grid,
-            &FlyOptions::default(),
-            &Progress::default(),
-        )
-        .unwrap();
+        let (sc, params, flight) = flown("window", 4);
         let survey = Survey::default();
         let r = params.unit_radius as f64 + crate::collision::DEFAULT_CLEARANCE;
         let (seen, stats) = survey.fly(&sc.grid, &flight.samples, r).unwrap();
@@ -180,18 +182,7 @@ mod tests {
 
     #[test]
     fn a_distance_field_updated_scan_by_scan_is_the_seen_maps_field() {
-        let sc = scenarios::build("maze").unwrap();
-        let params = ChainParams::new(5);
-        let query = Query::new(sc.start, sc.start_shape(5).unwrap(), sc.goal);
-        let request = Request::new(sc.grid.clone(), params, query);
-        let planned = plan(&request, None, &PlanOptions::default()).unwrap();
-        let (flight, _) = fly(
-            &planned.plan,
-            &sc.grid,
-            &FlyOptions::default(),
-            &Progress::default(),
-        )
-        .unwrap();
+        let (sc, _, flight) = flown("maze", 5);
         // The box of the truth, all unknown (occupied) at first, as a chain entering it
         // knows it; the field follows every insertion.
         let (o, d) = (sc.grid.origin(), sc.grid.dims());
