@@ -45,7 +45,7 @@ use std::path::Path;
 
 pub use bag::{BagSummary, FRAME};
 pub use motion::{
-    Command, Motion, Tick, UnitState, DEFAULT_RATE_HZ, MAX_RATE_HZ, MAX_TICKS, MIN_RATE_HZ,
+    Command, Motion, Tick, UnitState, DEFAULT_RATE_HZ, MAX_RATE_HZ, MAX_UNIT_STATES, MIN_RATE_HZ,
 };
 pub use tlog::{
     attitude_ned, ned, Autopilot, TlogOptions, TlogSummary, MAX_HOLD_S, PX4_MIN_HOLD_S,
@@ -63,13 +63,13 @@ pub enum ExportError {
     /// A rate outside `(MIN_RATE_HZ, MAX_RATE_HZ]`.
     #[error("rate {0} Hz must be above {MIN_RATE_HZ} Hz (PX4 leaves offboard below it) and at most {MAX_RATE_HZ} Hz")]
     Rate(f64),
-    /// More ticks than an export holds.
-    #[error(
-        "{ticks} ticks at {rate} Hz: more than the {MAX_TICKS} an export holds; lower the rate"
-    )]
+    /// More unit states than an export holds.
+    #[error("{ticks} ticks of {units} units at {rate} Hz: more than the {MAX_UNIT_STATES} unit states an export holds; lower the rate")]
     TooLong {
         /// Ticks the motion would need.
         ticks: usize,
+        /// Units of the chain.
+        units: usize,
         /// The rate asked for.
         rate: f64,
     },

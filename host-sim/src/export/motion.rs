@@ -27,8 +27,10 @@ pub const MAX_RATE_HZ: f64 = 1000.0;
 /// The rate of the exported stream by default (Hz): a trajectory's default sample
 /// rate (`trajectory::DEFAULT_DT` = 0.02 s), so every exported state is a sample.
 pub const DEFAULT_RATE_HZ: f64 = 50.0;
-/// Most ticks an export holds (about 5.5 hours at 50 Hz): the bound on its memory.
-pub const MAX_TICKS: usize = 1_000_000;
+/// Most unit states an export holds, ticks times units: the bound on its memory (a bag
+/// takes about 400 bytes a unit state, so about 0.8 GB; 1.8 hours of a 6-unit chain at
+/// 50 Hz).
+pub const MAX_UNIT_STATES: usize = 2_000_000;
 
 /// Times closer than this (s) are the same time: far below any sample step, far above
 /// the rounding of sums of steps.
@@ -91,7 +93,7 @@ impl Motion {
         let times: Vec<f64> = file.samples.iter().map(|s| s.t).collect();
         check_times(&times)?;
         let knots = TrajectoryKnots::new(file, params.link_length as f64);
-        let ticks = tick_times(&times, rate)?
+        let ticks = tick_times(&times, rate, file.chain.units as usize)?
             .into_iter()
             .map(|(t, j, f)| knots.at(t, j, f))
             .collect();
@@ -113,7 +115,7 @@ impl Motion {
             None => default_chain(file.report.units)?,
         };
         let knots = FlightKnots::new(file);
-        let ticks = tick_times(&times, rate)?
+        let ticks = tick_times(&times, rate, file.report.units)?
             .into_iter()
             .map(|(t, j, f)| knots.at(t, j, f))
             .collect();
@@ -156,15 +158,25 @@ fn check_times(times: &[f64]) -> Result<(), ExportError> {
 /// The ticks of `rate` Hz over the source's times: `(t, j, f)` with `t` on the
 /// source's clock, `j` the sample at or before it and `f` the fraction of the way to
 /// the next. The first tick is the first sample, then every `1 / rate` s after it, and
-/// the last sample is always a tick (a motion ends where its source ends).
-fn tick_times(times: &[f64], rate: f64) -> Result<Vec<(f64, usize, f64)>, ExportError> {
+/// the last sample is always a tick (a motion ends where its source ends). The ticks
+/// of `units` units must fit [`MAX_UNIT_STATES`].
+fn tick_times(
+    times: &[f64],
+    rate: f64,
+    units: usize,
+) -> Result<Vec<(f64, usize, f64)>, ExportError> {
     if !(rate > MIN_RATE_HZ && rate <= MAX_RATE_HZ) {
         return Err(ExportError::Rate(rate));
     }
     let (t0, end) = (times[0], times[times.len() - 1]);
+    // `as` saturates: an absurd duration is refused, not wrapped.
     let count = ((end - t0) * rate).floor() as usize + 1;
-    if count > MAX_TICKS {
-        return Err(ExportError::TooLong { ticks: count, rate });
+    if count.saturating_mul(units.max(1)) > MAX_UNIT_STATES {
+        return Err(ExportError::TooLong {
+            ticks: count,
+            units,
+            rate,
+        });
     }
     // A tick within a nanosecond of a sample is that sample (a flight recorded at the
     // rate has times that are multiples of its step only to within rounding), and one

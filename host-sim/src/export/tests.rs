@@ -145,6 +145,12 @@ fn ticks_fall_on_the_rate_and_end_at_the_end() {
         .all(|w| w[1] - w[0] > 1e-6 && w[1] - w[0] <= 1.0 / 30.0 + 1e-12));
     // Between samples the units are where paper Eq. 2 puts the interpolated zeta.
     assert!((m.ticks[1].units[0].p.x - 0.5 / 30.0).abs() < 1e-12);
+    // 30 000 s of a 2-unit chain at 50 Hz: 3 M unit states, over the budget.
+    let long = straight(0.0, 1000.0, 30);
+    assert!(matches!(
+        Motion::of_trajectory(&long, 50.0),
+        Err(ExportError::TooLong { units: 2, .. })
+    ));
     for rate in [MIN_RATE_HZ, 0.0, -1.0, f64::NAN, f64::INFINITY, 1e4] {
         assert!(matches!(
             Motion::of_trajectory(&file, rate),
