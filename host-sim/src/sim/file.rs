@@ -50,11 +50,7 @@ impl FlightFile {
 
     /// Reads and checks a flight file (`-`: standard input).
     pub fn read(path: &Path) -> Result<Self, FileError> {
-        let name = fsutil::input_name(path);
-        match fsutil::read_input(path) {
-            Ok(text) => Self::parse(&text, &name),
-            Err(source) => Err(FileError::Io { path: name, source }),
-        }
+        FileError::read(path, Self::parse)
     }
 
     /// Parses and checks a flight's text; `name` names it in errors.

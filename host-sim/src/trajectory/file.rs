@@ -95,6 +95,21 @@ pub enum FileError {
     },
 }
 
+impl FileError {
+    /// Reads the file at `path` (`-`: standard input) and gives its text and name to
+    /// `parse`; a file that cannot be read is [`FileError::Io`].
+    pub(crate) fn read<T>(
+        path: &Path,
+        parse: impl FnOnce(&str, &str) -> Result<T, FileError>,
+    ) -> Result<T, FileError> {
+        let name = fsutil::input_name(path);
+        match fsutil::read_input(path) {
+            Ok(text) => parse(&text, &name),
+            Err(source) => Err(FileError::Io { path: name, source }),
+        }
+    }
+}
+
 /// A rule of the `arc-trajectory/1` format that needs no map, broken: each names the
 /// field and the value at fault.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -202,11 +217,7 @@ impl TrajectoryFile {
 
     /// Reads and checks a trajectory file (`-`: standard input).
     pub fn read(path: &Path) -> Result<Self, FileError> {
-        let name = fsutil::input_name(path);
-        match fsutil::read_input(path) {
-            Ok(text) => Self::parse(&text, &name),
-            Err(source) => Err(FileError::Io { path: name, source }),
-        }
+        FileError::read(path, Self::parse)
     }
 
     /// Parses and checks a trajectory's text; `name` names it in errors.
