@@ -5,14 +5,17 @@
 //! - `still`: [`draw`], the plan's picture: the head path and the chain at waypoints
 //!   chosen so that no two drawn chains overlap, coloured by time;
 //! - `animation`: [`animate`], one frame per fixed time step of a [`Motion`] (a timed
-//!   trajectory or a flight).
+//!   trajectory or a flight);
+//! - `flight`: [`flight_svg`], the plots of a simulated flight (`arc sim --picture`).
 
 mod animation;
+mod flight;
 mod still;
 
 pub use animation::{
     animate, frame_count, AnimationError, AnimationOptions, Gif, Motion, FRAME_DELAY_CS, MAX_FRAMES,
 };
+pub use flight::{flight_svg, footprint, Footprint};
 pub(crate) use still::thinned;
 pub use still::{draw, waypoint_times, PictureOptions};
 

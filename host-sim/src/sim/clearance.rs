@@ -82,34 +82,3 @@ impl Obstacles for MapClearance<'_> {
         self.grid.resolution() / 4.0
     }
 }
-
-/// Obstacles seen from above for pictures: every column of voxels with an obstacle
-/// between heights `z_lo` and `z_hi` (m), merged into runs along x, as
-/// `[x0, y0, x1, y1]` rectangles.
-pub fn footprint(grid: &Grid, z_lo: f64, z_hi: f64) -> Vec<super::plot::Footprint> {
-    let r = grid.resolution();
-    let o = grid.origin();
-    let d = grid.dims();
-    let k0 = ((z_lo / r).floor() as i64).max(o[2] as i64);
-    let k1 = ((z_hi / r).floor() as i64).min(o[2] as i64 + d[2] as i64 - 1);
-    let mut out = Vec::new();
-    if k0 > k1 {
-        return out;
-    }
-    for j in o[1]..o[1] + d[1] as i32 {
-        let mut run: Option<i32> = None;
-        for i in o[0]..=o[0] + d[0] as i32 {
-            let occupied =
-                i < o[0] + d[0] as i32 && (k0..=k1).any(|k| grid.is_obstacle([i, j, k as i32]));
-            match (occupied, run) {
-                (true, None) => run = Some(i),
-                (false, Some(s)) => {
-                    out.push([s as f64 * r, j as f64 * r, i as f64 * r, (j + 1) as f64 * r]);
-                    run = None;
-                }
-                _ => {}
-            }
-        }
-    }
-    out
-}

@@ -1,5 +1,5 @@
 //! Chain simulation: the ARC's rigid multibody dynamics flown by its control stack
-//! along a plan. See `README.md` beside this file.
+//! along a plan (docs/simulation.md).
 //!
 //! - `model`: bodies, actuators and their default numbers;
 //! - `dynamics`: the multibody (rapier3d, spherical joints at the unit centres);
@@ -8,8 +8,9 @@
 //! - `controller`: link controllers, mixer and unit attitude loops (paper Fig. 3);
 //! - `flight`: [`simulate`], the recorded flight and its report;
 //! - `file`: [`FlightFile`], the `arc-sim/1` flight file;
-//! - `clearance`: the exact clearance of the flown chain to a map;
-//! - `plot`: SVG plots of a flight.
+//! - `clearance`: the exact clearance of the flown chain to a map.
+//!
+//! Drawing a flight is the picture layer's (`crate::plan_picture::flight_svg`).
 
 mod bodies;
 pub(crate) mod clearance;
@@ -19,7 +20,6 @@ mod file;
 pub(crate) mod flight;
 pub(crate) mod model;
 pub(crate) mod mpc;
-pub(crate) mod plot;
 pub(crate) mod reference;
 
 /// Simulation settings (controller, MPC, limits, model, run) outside their limits.
@@ -63,7 +63,7 @@ pub(crate) fn all_non_negative(values: &[f64]) -> bool {
     values.iter().all(|v| v.is_finite() && *v >= 0.0)
 }
 
-pub use clearance::{footprint, MapClearance};
+pub use clearance::MapClearance;
 
 // The type of `Sample::units` and `Sample::links`, so that users of a recorded flight
 // (the Python bindings) can name it.
@@ -78,7 +78,6 @@ pub use flight::{
 };
 pub use model::ChainModel;
 pub use mpc::{HeadMpc, MpcConfig, MpcRef};
-pub use plot::flight_svg;
 pub use reference::{Reference, ReferenceError, ReferenceLimits};
 
 #[cfg(test)]

@@ -14,10 +14,10 @@ use super::{CliError, CliResult};
 use aerial_chain::flying::{self, FlyError, FlyOptions, Timed, Timing};
 use aerial_chain::map::Grid;
 use aerial_chain::plan_file::Plan;
-use aerial_chain::sim::flight_svg;
+use aerial_chain::plan_picture::{flight_svg, footprint};
+use aerial_chain::sim::MapClearance;
 use aerial_chain::sim::Reference;
 use aerial_chain::sim::V3;
-use aerial_chain::sim::{footprint, MapClearance};
 use aerial_chain::sim::{simulate_reference, FlightFile, Gust, Progress, SimConfig};
 
 /// `arc sim`
