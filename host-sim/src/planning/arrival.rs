@@ -72,15 +72,15 @@ impl Arrival {
 }
 
 /// Checks that the request's pose gives a valid configuration at its goal (by the
-/// exact test, at some heading when no yaw is asked): else the goal is bad input.
-pub fn check_pose(request: &Request) -> Result<(), PlanningError> {
+/// exact test, at one of the `headings` the planner tries when no yaw is asked): else
+/// the goal is bad input.
+pub fn check_pose(request: &Request, headings: usize) -> Result<(), PlanningError> {
     let pose = &request.pose;
     if pose.is_any() {
         return Ok(());
     }
     let start = request.query.start_shape;
     let current = pose.shape.unwrap_or(start);
-    let headings = 8;
     let grid = request.grid();
     let mut why = String::new();
     for target in pose.targets(&current, headings) {

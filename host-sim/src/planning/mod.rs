@@ -136,7 +136,7 @@ pub fn plan(
     options: &PlanOptions,
 ) -> Result<Planned, PlanningError> {
     let stop = options.termination()?;
-    arrival::check_pose(request)?;
+    arrival::check_pose(request, options.planner.n_psi)?;
     let setup = Instant::now();
     let mut planner = planner(request, tables, options)?;
     let setup_s = setup.elapsed().as_secs_f64();
