@@ -63,6 +63,7 @@ mod fsutil;
 pub mod goal;
 pub mod map;
 pub mod mission;
+pub mod online;
 pub mod picture;
 pub mod plan_file;
 pub mod plan_picture;

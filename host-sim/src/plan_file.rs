@@ -370,6 +370,25 @@ impl Plan {
         }
     }
 
+    /// A plan through the configurations `zetas` (the start first) for chain `params`
+    /// on the map `map` describes, with no statistics.
+    pub fn from_zetas(params: &ChainParams, map: MapSection, zetas: Vec<Vec<f64>>) -> Self {
+        Plan {
+            format: FORMAT.into(),
+            chain: ChainSection::from_params(params),
+            map,
+            waypoints: zetas
+                .into_iter()
+                .map(|zeta| Waypoint {
+                    zeta,
+                    goal: None,
+                    hold_s: None,
+                })
+                .collect(),
+            stats: serde_json::Map::new(),
+        }
+    }
+
     /// Reads and checks a plan file (`-`: standard input): format tag, chain
     /// parameters, every waypoint's length and finiteness.
     pub fn read(path: &Path) -> Result<Self, PlanError> {

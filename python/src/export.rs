@@ -34,6 +34,7 @@ fn motion(map: &Map, source: &Bound<'_, PyAny>, rate: f64) -> PyResult<Motion> {
             report: f.report.clone(),
             record_every: f.record_every,
             samples: f.samples.clone(),
+            explore: None,
         };
         return Motion::of_flight(&file, rate).map_err(err::<ExportError>);
     }

@@ -311,6 +311,26 @@ impl OccupancyMap {
         (old != new).then_some(VoxelChange { voxel, old, new })
     }
 
+    /// Takes voxel `i` as known in `state` (a prior map's voxel): log-odds at the
+    /// clamping bound of that state; unknown forgets it. Returns the change, if any.
+    pub fn assume(&mut self, i: [i32; 3], state: Cell) -> Option<VoxelChange> {
+        let l = match state {
+            Cell::Occupied => self.params.max,
+            Cell::Free => self.params.min,
+            Cell::Unknown => {
+                let old = self.voxels.remove(&i)?;
+                let old = self.classify(old);
+                return Some(VoxelChange {
+                    voxel: i,
+                    old,
+                    new: Cell::Unknown,
+                });
+            }
+        };
+        let old = self.voxels.insert(i, l);
+        self.change(i, old, l)
+    }
+
     /// Marks as observed free every voxel whose closed cube lies inside the closed ball
     /// of `radius` around `centre` (all eight corners within `radius`): the space a body
     /// of the chain fills, or keeps clear, is free. Each such voxel's log-odds is set to
@@ -359,6 +379,85 @@ impl OccupancyMap {
         }
         changes.sort_unstable_by_key(|c| c.voxel);
         Ok(changes)
+    }
+
+    /// Marks as observed free every voxel whose closed cube comes within `radius` of the
+    /// segment `a b` (a ball when `a == b`): the space a body grown by a clearance keeps
+    /// clear where it is known to be valid with that clearance (the chain's start,
+    /// docs/model.md "Sensors and the seen map"). Log-odds as in
+    /// [`Self::mark_free_sphere`]; returns the changes of state, sorted by index.
+    pub fn mark_free_near(
+        &mut self,
+        a: impl Into<Point3<f64>>,
+        b: impl Into<Point3<f64>>,
+        radius: f64,
+    ) -> Result<Vec<VoxelChange>, FusionError> {
+        let (a, b) = (a.into(), b.into());
+        if !a.iter().chain(b.iter()).all(|v| v.is_finite()) {
+            return Err(refuse("segment", a.coords.as_slice(), "must be finite"));
+        }
+        if !(radius.is_finite() && radius >= 0.0) {
+            return Err(refuse(
+                "radius",
+                radius,
+                "must be a finite number of metres >= 0",
+            ));
+        }
+        let r = self.resolution;
+        let lo = [0, 1, 2].map(|k| ((a[k].min(b[k]) - radius) / r).floor());
+        let hi = [0, 1, 2].map(|k| ((a[k].max(b[k]) + radius) / r).floor());
+        let span: f64 = (0..3).map(|k| hi[k] - lo[k] + 1.0).product();
+        if span > MAX_SPHERE_VOXELS as f64 || lo.iter().chain(hi.iter()).any(|v| v.abs() > 32768.0)
+        {
+            return Err(refuse(
+                "radius",
+                radius,
+                "covers too many voxels or leaves OctoMap's key range",
+            ));
+        }
+        let mut changes = Vec::new();
+        for z in lo[2] as i32..=hi[2] as i32 {
+            for y in lo[1] as i32..=hi[1] as i32 {
+                for x in lo[0] as i32..=hi[0] as i32 {
+                    let i = [x, y, z];
+                    if self.segment_cube_distance(i, &a, &b) <= radius {
+                        let old = self.voxels.insert(i, self.params.min);
+                        changes.extend(self.change(i, old, self.params.min));
+                    }
+                }
+            }
+        }
+        changes.sort_unstable_by_key(|c| c.voxel);
+        Ok(changes)
+    }
+
+    /// Distance from the segment `a b` to voxel `i`'s closed cube. The distance from a
+    /// point moving along the segment to a convex set is convex in the parameter, so a
+    /// golden-section search finds its minimum (to far below a micrometre).
+    fn segment_cube_distance(&self, i: [i32; 3], a: &Point3<f64>, b: &Point3<f64>) -> f64 {
+        let res = self.resolution;
+        let to_cube = |t: f64| -> f64 {
+            let p = a + (b - a) * t;
+            (0..3)
+                .map(|k| {
+                    let lo = f64::from(i[k]) * res;
+                    let d = (lo - p[k]).max(p[k] - (lo + res)).max(0.0);
+                    d * d
+                })
+                .sum::<f64>()
+                .sqrt()
+        };
+        let g = (5f64.sqrt() - 1.0) / 2.0;
+        let (mut lo, mut hi) = (0.0, 1.0);
+        for _ in 0..60 {
+            let (m1, m2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+            if to_cube(m1) <= to_cube(m2) {
+                hi = m2;
+            } else {
+                lo = m1;
+            }
+        }
+        to_cube(0.0).min(to_cube(1.0)).min(to_cube((lo + hi) / 2.0))
     }
 
     /// The squared distance from `c` to the farthest corner of voxel `i`'s cube.

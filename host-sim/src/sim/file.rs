@@ -31,6 +31,11 @@ pub struct FlightFile {
     pub record_every: usize,
     /// The recorded samples, in time order.
     pub samples: Vec<Sample>,
+    /// The record of an exploration (`arc explore`: `"format": "arc-explore/1"`,
+    /// docs/model.md "Explorations"), kept as JSON so that the flight format does not
+    /// depend on the planner that made it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub explore: Option<serde_json::Value>,
 }
 
 impl FlightFile {
@@ -45,6 +50,7 @@ impl FlightFile {
             report: flight.report.clone(),
             record_every: every,
             samples: flight.samples.iter().step_by(every).cloned().collect(),
+            explore: None,
         }
     }
 

@@ -9,20 +9,17 @@
 //! has ended, or when it diverges.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
 
-use aerial_chain_core::control::{desired_attitude, Vec3};
-use aerial_chain_core::kinematics::Points;
-use aerial_chain_core::validity::visit_pairs;
-use aerial_chain_core::{ChainParams, MAX_UNITS};
-use nalgebra::{UnitQuaternion, Vector3};
+use aerial_chain_core::ChainParams;
+use nalgebra::UnitQuaternion;
 use serde::{Deserialize, Serialize};
 
 use super::controller::ControlOutput;
-use super::controller::{ChainController, ControllerConfig};
-use super::dynamics::{Actuator, BodyState, ChainDynamics, DynamicsError, V3};
+use super::controller::ControllerConfig;
+use super::dynamics::{BodyState, DynamicsError, V3};
 use super::model::ChainModel;
 use super::reference::{RefPoint, Reference, ReferenceError, ReferenceLimits};
+use super::run::FlightRun;
 use super::{all_positive, SettingsError};
 
 /// A disturbance force held on units for a while.
@@ -82,7 +79,7 @@ impl Default for SimConfig {
 
 impl SimConfig {
     /// The sum of the gusts acting on unit `i` at time `t` (world, N).
-    fn gust_force(&self, i: usize, t: f64) -> V3 {
+    pub(super) fn gust_force(&self, i: usize, t: f64) -> V3 {
         self.gusts
             .iter()
             .filter(|g| t >= g.start && t < g.start + g.duration && g.unit.is_none_or(|u| u == i))
@@ -139,47 +136,6 @@ pub const CLEARANCE_TOLERANCE: f64 = 1e-4;
 
 /// Most bytes a flight may record (every step is kept): 1 GiB.
 pub const MAX_RECORDED_BYTES: f64 = (1u64 << 30) as f64;
-
-/// Decides when the clearance must be measured again, and keeps the minimum.
-///
-/// Why skipping is safe: every point of the chain's bodies moves no farther than its
-/// farthest unit centre (a link is the segment between two centres, and a point of a
-/// segment moves by a convex combination of its ends' motions), and the distance to
-/// the map changes no faster than the point moves. So at any step the clearance is at
-/// least the last measured one minus the largest centre motion since; a step is
-/// skipped only when that floor is above both 0 and the minimum so far less
-/// [`CLEARANCE_TOLERANCE`].
-#[derive(Default)]
-struct ClearanceWatch {
-    /// Unit centres and clearance at the last measurement.
-    last: Option<(Vec<V3>, f64)>,
-    /// Smallest clearance, where, and when.
-    min: Option<(f64, String, f64)>,
-}
-
-impl ClearanceWatch {
-    /// Measures the clearance of `centres` at time `t` if it could be a new minimum
-    /// or a contact.
-    fn observe(&mut self, obs: &dyn Obstacles, centres: Vec<V3>, t: f64) {
-        if let Some((prev, c)) = &self.last {
-            let moved = prev
-                .iter()
-                .zip(&centres)
-                .map(|(a, b)| (a - b).norm())
-                .fold(0.0, f64::max);
-            let floor = c - moved;
-            let min = self.min.as_ref().map_or(f64::INFINITY, |m| m.0);
-            if moved < obs.check_spacing() && floor > (min - CLEARANCE_TOLERANCE).max(0.0) {
-                return;
-            }
-        }
-        let (c, at) = obs.clearance(&centres);
-        if self.min.as_ref().is_none_or(|m| c < m.0) {
-            self.min = Some((c, at, t));
-        }
-        self.last = Some((centres, c));
-    }
-}
 
 /// Bytes one recorded step of an `n`-unit chain takes, about.
 fn sample_bytes(n: usize) -> f64 {
@@ -358,11 +314,6 @@ pub enum SimError {
     Dynamics(#[from] DynamicsError),
 }
 
-/// Angle between two unit vectors (rad), robust near 0 and pi.
-fn angle_between(a: &V3, b: &V3) -> f64 {
-    a.cross(b).norm().atan2(a.dot(b))
-}
-
 /// Flies the plan `waypoints` (`zeta` vectors) of chain `params` with the default
 /// bodies of [`ChainModel::new`], checking clearance against `obstacles` if given.
 pub fn simulate(
@@ -437,319 +388,23 @@ fn fly(
     obstacles: Option<&dyn Obstacles>,
     progress: &Progress,
 ) -> Result<Flight, SimError> {
-    cfg.validate()?;
-    model.validate()?;
-    let params = model.params;
-    let n = model.units();
-    let start = &reference.zeta(0.0);
-    let mut dynamics = ChainDynamics::new(
-        model,
-        V3::new(start[0], start[1], start[2]),
-        &start[3..],
-        1.0 / cfg.rate,
-    )?;
-    let mut controller = start_in_trim(model, cfg, &mut dynamics, &reference)?;
-    let goal = Goal::of(&reference, n);
     let t_ref = reference.duration();
-    let steps = check_budget(n, t_ref, cfg)?;
+    let mut run = FlightRun::start(model, reference, cfg, obstacles, 0)?;
+    let steps = check_budget(model.units(), t_ref, cfg)?;
+    run.reserve(steps);
     progress.total.store(steps as u64, Ordering::Relaxed);
-
-    let wall = Instant::now();
-    let mut tally = Tally::new(&params, steps);
-    let end = run_steps(
-        &mut dynamics,
-        &mut controller,
-        &reference,
-        &goal,
-        cfg,
-        obstacles,
-        progress,
-        &mut tally,
-    );
-    let wall_seconds = wall.elapsed().as_secs_f64();
-    let report = tally.report(n, cfg, t_ref, end, controller.mpc_counts(), wall_seconds);
-    Ok(Flight {
-        params,
-        reference,
-        samples: tally.samples,
-        report,
-    })
-}
-
-/// Puts the chain in trim: each unit tilted as the controller wants it at rest and its
-/// motors already producing what it asks (a chain hovering in its start
-/// configuration). Returns a fresh controller to fly with.
-fn start_in_trim(
-    model: ChainModel,
-    cfg: &SimConfig,
-    dynamics: &mut ChainDynamics,
-    reference: &Reference,
-) -> Result<ChainController, SimError> {
-    let new_controller = || ChainController::new(model, cfg.controller);
-    let first = new_controller()?.step(0.0, &dynamics.unit_states(), reference);
-    for (i, f) in first.forces.iter().enumerate() {
-        let r = desired_attitude(
-            &Vec3::new(f.x as f32, f.y as f32, f.z as f32),
-            first.attitude_cmd[i][2] as f32,
-        );
-        dynamics.set_unit_attitude(i, &r.map(|x| x as f64));
-    }
-    let trim = new_controller()?.step(0.0, &dynamics.unit_states(), reference);
-    let act: Vec<Actuator> = trim
-        .commands
-        .iter()
-        .map(|c| Actuator {
-            thrust: c.thrust,
-            moment: c.moment,
-        })
-        .collect();
-    dynamics.set_actuators(&act);
-    Ok(new_controller()?)
-}
-
-/// Where the flight should end: the last waypoint's head and link directions.
-struct Goal {
-    head: V3,
-    link_dirs: Vec<V3>,
-}
-
-impl Goal {
-    fn of(reference: &Reference, n: usize) -> Self {
-        let end = reference.end();
-        Self {
-            head: V3::new(end[0], end[1], end[2]),
-            link_dirs: (0..n - 1)
-                .map(|k| super::dynamics::link_direction(end[4 + 2 * k], end[5 + 2 * k]))
-                .collect(),
+    let end = loop {
+        progress.done.store(run.steps() as u64, Ordering::Relaxed);
+        if let Some(end) = run.advance(true) {
+            break end;
         }
-    }
-}
-
-/// How the stepping loop ended.
-struct LoopEnd {
-    completed: Option<f64>,
-    diverged: bool,
-}
-
-/// Steps physics and control until the chain has settled at the goal, diverged, or
-/// run out of time, recording every step into `tally`.
-#[allow(clippy::too_many_arguments)]
-fn run_steps(
-    dynamics: &mut ChainDynamics,
-    controller: &mut ChainController,
-    reference: &Reference,
-    goal: &Goal,
-    cfg: &SimConfig,
-    obstacles: Option<&dyn Obstacles>,
-    progress: &Progress,
-    tally: &mut Tally,
-) -> LoopEnd {
-    let dt = 1.0 / cfg.rate;
-    let t_ref = reference.duration();
-    let t_max = t_ref.max(cfg.min_time) + cfg.settle_time;
-    let mut at_goal_since: Option<f64> = None;
-    let mut step = 0usize;
-    loop {
-        let t = step as f64 * dt;
-        progress.done.store(step as u64, Ordering::Relaxed);
-        let units = dynamics.unit_states();
-        let out = controller.step(t, &units, reference);
-        let r = reference.sample(t);
-        let (e_head, at_goal) = tally.observe(&units, &r, goal, cfg);
-        if let Some(obs) = obstacles {
-            tally
-                .watch
-                .observe(obs, units.iter().map(|u| u.p).collect(), t);
-        }
-        tally
-            .samples
-            .push(Sample::record(t, &units, &dynamics.link_states(), &r, &out));
-        if at_goal && t >= t_ref - cfg.settle_hold {
-            let since = *at_goal_since.get_or_insert(t);
-            if t >= t_ref.max(cfg.min_time) && t - since >= cfg.settle_hold {
-                return LoopEnd {
-                    completed: Some(since),
-                    diverged: false,
-                };
-            }
-        } else {
-            at_goal_since = None;
-        }
-        let finite = units.iter().all(|u| u.p.iter().all(|v| v.is_finite()));
-        if e_head > cfg.divergence || !finite {
-            return LoopEnd {
-                completed: None,
-                diverged: true,
-            };
-        }
-        if t >= t_max {
-            return LoopEnd {
-                completed: None,
-                diverged: false,
-            };
-        }
-        for i in 0..units.len() {
-            dynamics.set_external_force(i, cfg.gust_force(i, t));
-        }
-        if !dynamics.step(&out.commands) {
-            return LoopEnd {
-                completed: None,
-                diverged: true,
-            };
-        }
-        step += 1;
-    }
-}
-
-/// What the loop accumulates: tracking errors, limit excursions, self and map
-/// clearance, and the recorded samples.
-struct Tally {
-    params: ChainParams,
-    samples: Vec<Sample>,
-    head_sq: f64,
-    head_max: f64,
-    link_sq: f64,
-    link_max: f64,
-    link_count: usize,
-    limits: LimitExcursions,
-    watch: ClearanceWatch,
-    min_self_gap: f64,
-}
-
-impl Tally {
-    fn new(params: &ChainParams, steps: usize) -> Self {
-        Self {
-            params: *params,
-            samples: Vec::with_capacity(steps),
-            head_sq: 0.0,
-            head_max: 0.0,
-            link_sq: 0.0,
-            link_max: 0.0,
-            link_count: 0,
-            limits: LimitExcursions::default(),
-            watch: ClearanceWatch::default(),
-            min_self_gap: f64::INFINITY,
-        }
-    }
-
-    /// Tracking errors, limits and self-contact of one step; returns the head's
-    /// tracking error and whether the chain is at the goal.
-    fn observe(
-        &mut self,
-        units: &[BodyState],
-        r: &RefPoint,
-        goal: &Goal,
-        cfg: &SimConfig,
-    ) -> (f64, bool) {
-        let n = units.len();
-        let e_head = (units[0].p - r.p).norm();
-        self.head_sq += e_head * e_head;
-        self.head_max = self.head_max.max(e_head);
-        let dirs: Vec<V3> = (0..n - 1)
-            .map(|k| (units[k].p - units[k + 1].p).normalize())
-            .collect();
-        let mut at_goal = (units[0].p - goal.head).norm() <= cfg.goal_tolerance;
-        for (k, dir) in dirs.iter().enumerate() {
-            let lr = &r.links[k];
-            let e = angle_between(dir, &super::dynamics::link_direction(lr.pitch, lr.yaw));
-            self.link_sq += e * e;
-            self.link_count += 1;
-            self.link_max = self.link_max.max(e);
-            at_goal &= angle_between(dir, &goal.link_dirs[k]) <= cfg.angle_tolerance;
-        }
-        self.observe_limits(&dirs, 1.0 / cfg.rate);
-        self.observe_self_gap(units);
-        (e_head, at_goal)
-    }
-
-    /// Pitch and bend beyond the chain's limits.
-    fn observe_limits(&mut self, dirs: &[V3], dt: f64) {
-        let theta_max = self.params.theta_max as f64;
-        let beta_max = self.params.beta_max as f64;
-        let limits = &mut self.limits;
-        let mut beyond = false;
-        for k in 0..dirs.len() {
-            let pitch = (-dirs[k].z).clamp(-1.0, 1.0).asin();
-            let ex = pitch.abs() - theta_max;
-            if ex > 0.0 {
-                beyond = true;
-                limits.max_pitch_excess_deg = limits.max_pitch_excess_deg.max(ex.to_degrees());
-            }
-            if k + 1 < dirs.len() {
-                let ex = angle_between(&dirs[k], &dirs[k + 1]) - beta_max;
-                if ex > 0.0 {
-                    beyond = true;
-                    limits.max_bend_excess_deg = limits.max_bend_excess_deg.max(ex.to_degrees());
-                }
-            }
-        }
-        if beyond {
-            limits.time_beyond += dt;
-        }
-    }
-
-    /// Self-contact of the flown chain (core's exact pair test, relative positions).
-    fn observe_self_gap(&mut self, units: &[BodyState]) {
-        let mut pts: Points = [Vector3::zeros(); MAX_UNITS];
-        for (i, u) in units.iter().enumerate() {
-            let d = u.p - units[0].p;
-            pts[i] = Vector3::new(d.x as f32, d.y as f32, d.z as f32);
-        }
-        let min_self_gap = &mut self.min_self_gap;
-        visit_pairs(&self.params, units.len(), &pts, |_, _, gap| {
-            *min_self_gap = min_self_gap.min(gap as f64);
-            true
-        });
-    }
-
-    fn report(
-        &self,
-        n: usize,
-        cfg: &SimConfig,
-        t_ref: f64,
-        end: LoopEnd,
-        (mpc_solves, mpc_failures): (usize, usize),
-        wall_seconds: f64,
-    ) -> FlightReport {
-        let count = self.samples.len().max(1) as f64;
-        let simulated_time = self.samples.last().map_or(0.0, |s| s.t);
-        let min_clear = self.watch.min.as_ref();
-        FlightReport {
-            units: n,
-            rate_hz: cfg.rate,
-            planned_duration: t_ref,
-            time_to_complete: end.completed,
-            reached_goal: end.completed.is_some(),
-            simulated_time,
-            head_rms: (self.head_sq / count).sqrt(),
-            head_max: self.head_max,
-            link_rms_deg: (self.link_sq / self.link_count.max(1) as f64)
-                .sqrt()
-                .to_degrees(),
-            link_max_deg: self.link_max.to_degrees(),
-            min_clearance: min_clear.map(|m| m.0),
-            min_clearance_at: min_clear.map(|m| m.1.clone()),
-            min_clearance_time: min_clear.map(|m| m.2),
-            contact: min_clear.is_some_and(|m| m.0 <= 0.0),
-            min_self_gap: self.min_self_gap,
-            self_contact: self.min_self_gap <= 0.0,
-            limits: self.limits,
-            mpc_solves,
-            mpc_failures,
-            diverged: end.diverged,
-            wall_seconds,
-            realtime_factor: if wall_seconds > 0.0 {
-                simulated_time / wall_seconds
-            } else {
-                f64::INFINITY
-            },
-        }
-    }
+    };
+    Ok(run.finish(end))
 }
 
 impl Sample {
     /// The record of one step.
-    fn record(
+    pub(super) fn record(
         t: f64,
         units: &[BodyState],
         links: &[BodyState],

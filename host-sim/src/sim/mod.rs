@@ -7,6 +7,7 @@
 //! - `mpc`: the head's position MPC (a second-order-cone QP solved by clarabel);
 //! - `controller`: link controllers, mixer and unit attitude loops (paper Fig. 3);
 //! - `flight`: [`simulate`], the recorded flight and its report;
+//! - `run`: [`FlightRun`], one flight step by step, its reference growing if need be;
 //! - `file`: [`FlightFile`], the `arc-sim/1` flight file;
 //! - `clearance`: the exact clearance of the flown chain to a map.
 //!
@@ -21,6 +22,7 @@ pub(crate) mod flight;
 pub(crate) mod model;
 pub(crate) mod mpc;
 pub(crate) mod reference;
+mod run;
 
 /// Simulation settings (controller, MPC, limits, model, run) outside their limits.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -79,6 +81,7 @@ pub use flight::{
 pub use model::ChainModel;
 pub use mpc::{HeadMpc, MpcConfig, MpcRef};
 pub use reference::{Reference, ReferenceError, ReferenceLimits};
+pub use run::{FlightEnd, FlightRun};
 
 #[cfg(test)]
 mod tests;

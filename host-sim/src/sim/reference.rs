@@ -44,6 +44,15 @@ pub enum ReferenceError {
         /// The index of the edge's first waypoint.
         from: usize,
     },
+    /// A motion appended where it does not start, or before the motion it follows
+    /// ends.
+    #[error("a motion appended at {at} s must start where the motion ending at {end} s ends, at rest, no earlier")]
+    Join {
+        /// When it was to start (s).
+        at: f64,
+        /// When the motion it follows ends (s).
+        end: f64,
+    },
 }
 
 /// The limits every edge is timed within.
@@ -513,6 +522,52 @@ impl Reference {
             end: self.end.clone(),
             duration: self.duration + hold,
         }
+    }
+
+    /// This motion, then `next` from time `at` (s): the chain rests at this motion's
+    /// end until `at`, and `next` must start there (every number within 1e-6, angles
+    /// up to whole turns: they run on without a jump). Refuses another chain, an `at`
+    /// before this motion's end, or a `next` that starts elsewhere.
+    pub fn then(&self, at: f64, next: &Reference) -> Result<Reference, ReferenceError> {
+        let start = next.segments.first().map_or(&next.end, |s| &s.from);
+        let joined = next.units == self.units
+            && at.is_finite()
+            && at >= self.duration
+            && start.iter().zip(&self.end).enumerate().all(|(j, (a, b))| {
+                let d = a - b;
+                let d = if j >= 3 {
+                    crate::collision::verify::wrap(d)
+                } else {
+                    d
+                };
+                d.abs() <= 1e-6
+            });
+        if !joined {
+            return Err(ReferenceError::Join {
+                at,
+                end: self.duration,
+            });
+        }
+        let mut segments = self.segments.clone();
+        if at > self.duration {
+            segments.push(Segment {
+                kind: SegmentKind::Hold,
+                t0: self.duration,
+                duration: at - self.duration,
+                from: self.end.clone(),
+                delta: vec![0.0; self.end.len()],
+                to_waypoint: 0,
+                scaling: Scaling::default(),
+            });
+        }
+        segments.extend(next.segments.iter().cloned().map(|mut s| {
+            s.t0 += at;
+            s
+        }));
+        let first = self.segments.first().map_or(&self.end, |s| &s.from);
+        let mut joined = Self::from_segments(self.units, first, segments);
+        joined.duration = joined.duration.max(at);
+        Ok(joined)
     }
 
     /// The reference at time `t` (clamped to `[0, duration]`: at rest before and after).

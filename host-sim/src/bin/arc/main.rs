@@ -11,6 +11,7 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 mod bench;
 mod checks;
 mod common;
+mod explore;
 mod export;
 #[path = "../../fsutil.rs"]
 mod fsutil;
@@ -118,6 +119,9 @@ enum Command {
     /// Export a plan, trajectory or flight for robot software: a ROS 2 bag (.mcap) or
     /// per-unit MAVLink offboard setpoints (.tlog).
     Export(Box<export::ExportArgs>),
+    /// Fly into the unknown: the units' sensors draw the map while the chain flies, and
+    /// the online planner replans as it grows (the world map is read by the sensors only).
+    Explore(Box<explore::ExploreArgs>),
 }
 
 /// The command line, where every option that takes a value takes a negative number
@@ -185,6 +189,7 @@ where
         Command::Sim(a) => sim::run(a),
         Command::View(a) => view::run(a),
         Command::Export(a) => export::run(*a),
+        Command::Explore(a) => explore::run(*a),
     }
 }
 

@@ -1,0 +1,524 @@
+//! Flying into the unknown in simulation: the true map is read only by the units'
+//! simulated sensors; an [`OnlinePlanner`] plans from what they saw; the chain's
+//! dynamics fly what it commits (a [`FlightRun`] whose reference grows).
+//!
+//! # The loop
+//! At every physics step the unit centres that moved half a voxel since they were last
+//! marked mark the balls of `r_u` plus the clearance about them as seen free. Every
+//! `1 / rate_hz` s every unit's sensor scans the truth from the unit's flown pose (tilt
+//! included) and the clouds are fused; then the planner replans when one is due: the
+//! next piece when the committed motion ends within a deadline plus a sensor period
+//! ([`Trigger::CommitShort`]), else the route when a scan cut it or its period elapsed.
+//! A replan's measured wall time passes in the simulation before its piece is used:
+//! the piece joins the reference at the later of that time and the end of the
+//! committed motion (the chain rests there meanwhile).
+
+use std::time::Instant;
+
+use aerial_chain_core::ChainParams;
+use nalgebra::Point3;
+use serde::{Deserialize, Serialize};
+
+use super::planner::{OnlineError, OnlinePlanner, OnlineSettings, Outcome, ReplanRecord, Trigger};
+use crate::collision::{verify::verify_plan, CollisionContext, FK_TOLERANCE};
+use crate::flying::FlyOptions;
+use crate::map::{DistanceField, Grid};
+use crate::plan_file::{MapSection, Plan};
+use crate::sensing::{raycast, OccupancyMap, PointCloud, Survey, SurveyError, UnitPose};
+use crate::sim::{ChainModel, Flight, FlightEnd, FlightRun, MapClearance, Reference, SimError};
+use crate::tables::ShapeTables;
+
+/// Everything an exploration needs besides the maps, the chain and the query.
+#[derive(Clone, Debug, Default)]
+pub struct ExploreSettings {
+    /// The units' sensors and their rate.
+    pub survey: Survey,
+    /// How the online planner plans.
+    pub online: OnlineSettings,
+    /// How the chain is flown (physics, control, arrival); its timing limits time the
+    /// pieces too (they replace `online.trajectory.limits`).
+    pub fly: FlyOptions,
+    /// Simulated seconds before the run gives up.
+    pub time_limit_s: f64,
+    /// Keep the map of every commit and check every piece on it by the exact test.
+    pub audit: bool,
+}
+
+/// How an exploration ended.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum ExploreEnd {
+    /// The chain reached the goal and settled there.
+    Reached {
+        /// When it arrived and stayed (simulated s).
+        t: f64,
+    },
+    /// The goal is out of reach.
+    Sealed {
+        /// When that was proven (simulated s).
+        t: f64,
+        /// Why.
+        why: String,
+    },
+    /// The time budget ran out.
+    TimeLimit {
+        /// The budget (simulated s).
+        t: f64,
+        /// What was tried.
+        tried: String,
+    },
+    /// The flight failed: it diverged, or did not settle at the goal.
+    FlightFailed {
+        /// Simulated time (s).
+        t: f64,
+        /// What happened.
+        why: String,
+    },
+}
+
+impl ExploreEnd {
+    /// Whether the goal was reached.
+    pub fn reached(&self) -> bool {
+        matches!(self, Self::Reached { .. })
+    }
+}
+
+/// What the sensors did.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SensingStats {
+    /// Clouds fused (one per unit per sensor time).
+    pub scans: usize,
+    /// Rays cast.
+    pub rays: usize,
+    /// Voxels the seen map knows at the end.
+    pub known: usize,
+    /// Time to update both distance fields after each cloud that changed a voxel (s).
+    pub update_s: Vec<f64>,
+}
+
+/// An exploration's result.
+#[derive(Debug)]
+pub struct Exploration {
+    /// The flight, step by step (its report against the true map).
+    pub flight: Flight,
+    /// How it ended.
+    pub end: ExploreEnd,
+    /// Every replan.
+    pub replans: Vec<ReplanRecord>,
+    /// The committed pieces joined into one plan (on the true map's section).
+    pub plan: Plan,
+    /// Pieces committed.
+    pub pieces: usize,
+    /// The seen map at the end.
+    pub seen: OccupancyMap,
+    /// What the sensors did.
+    pub sensing: SensingStats,
+    /// With `audit`: per piece, the exact test's first violation on the map it was
+    /// committed on (unknown space occupied), `None` when valid.
+    pub audit: Option<Vec<Option<String>>>,
+    /// Time to build the commit field from scratch on the final seen map (s), with
+    /// `audit`: what an update is compared with.
+    pub rebuild_s: Option<f64>,
+}
+
+/// The record of an exploration kept in its flight file (docs/model.md,
+/// "Explorations").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ExploreRecord {
+    /// `"arc-explore/1"`.
+    pub format: String,
+    /// How it ended.
+    pub end: ExploreEnd,
+    /// Pieces committed.
+    pub pieces: usize,
+    /// Figures over the whole run.
+    pub summary: ExploreSummary,
+    /// Every replan, in order.
+    pub replans: Vec<ReplanRecord>,
+}
+
+/// An exploration's figures.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ExploreSummary {
+    /// Replans.
+    pub replans: usize,
+    /// Median, 95th percentile and largest replan wall time (s).
+    pub latency_median_s: f64,
+    /// 95th percentile replan wall time (s).
+    pub latency_p95_s: f64,
+    /// Largest replan wall time (s).
+    pub latency_max_s: f64,
+    /// Largest wall time of a replan that found nothing new (s).
+    pub nothing_new_max_s: f64,
+    /// Clouds fused.
+    pub scans: usize,
+    /// Voxels known at the end.
+    pub known: usize,
+    /// Median time to update both distance fields after one cloud (s).
+    pub update_median_s: f64,
+}
+
+/// The format tag of an exploration's record.
+pub const RECORD_FORMAT: &str = "arc-explore/1";
+
+impl Exploration {
+    /// The record kept in the flight file.
+    pub fn record(&self) -> ExploreRecord {
+        let mut lat: Vec<f64> = self.replans.iter().map(|r| r.wall_s).collect();
+        lat.sort_by(f64::total_cmp);
+        let mut upd = self.sensing.update_s.clone();
+        upd.sort_by(f64::total_cmp);
+        let nothing_new_max_s = self
+            .replans
+            .iter()
+            .filter(|r| r.outcome == Outcome::NothingNew)
+            .map(|r| r.wall_s)
+            .fold(0.0, f64::max);
+        ExploreRecord {
+            format: RECORD_FORMAT.into(),
+            end: self.end.clone(),
+            pieces: self.pieces,
+            summary: ExploreSummary {
+                replans: self.replans.len(),
+                latency_median_s: quantile(&lat, 0.5),
+                latency_p95_s: quantile(&lat, 0.95),
+                latency_max_s: lat.last().copied().unwrap_or(0.0),
+                nothing_new_max_s,
+                scans: self.sensing.scans,
+                known: self.sensing.known,
+                update_median_s: quantile(&upd, 0.5),
+            },
+            replans: self.replans.clone(),
+        }
+    }
+}
+
+/// The `q` quantile of sorted `v` (nearest rank; 0 when empty).
+pub fn quantile(v: &[f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let k = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
+    v[k - 1]
+}
+
+/// Why an exploration cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum ExploreError {
+    /// Bad sensor settings.
+    #[error("sensor: {0}")]
+    Survey(#[from] SurveyError),
+    /// The planner refused its inputs.
+    #[error(transparent)]
+    Online(#[from] OnlineError),
+    /// The simulation refused its inputs.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// The start is not valid on the true map with the clearance.
+    #[error("the start is not valid on the world map with the clearance {clearance} m: {why}")]
+    Start {
+        /// The clearance (m).
+        clearance: f64,
+        /// Why.
+        why: String,
+    },
+    /// A time limit that is not a positive number of seconds.
+    #[error("time limit {0} s must be a positive number of simulated seconds, at most 86400")]
+    TimeLimit(f64),
+}
+
+/// Flies the chain `params` from rest in configuration `start` (`zeta`) toward
+/// `goal` (head within `goal_tol`) through `truth`, knowing only `prior` (if given)
+/// and what its sensors see (see the module docs).
+#[allow(clippy::too_many_arguments)]
+pub fn explore(
+    truth: &Grid,
+    params: ChainParams,
+    tables: ShapeTables,
+    start: &[f64],
+    goal: Point3<f64>,
+    goal_tol: f64,
+    prior: Option<&Grid>,
+    settings: &ExploreSettings,
+) -> Result<Exploration, ExploreError> {
+    settings.survey.validate()?;
+    if !(settings.time_limit_s > 0.0 && settings.time_limit_s <= 86_400.0) {
+        return Err(ExploreError::TimeLimit(settings.time_limit_s));
+    }
+    let mut online = settings.online.clone();
+    online.trajectory.limits = settings.fly.timing.limits;
+    check_start(truth, &params, start, online.plan.clearance)?;
+    let mut planner = OnlinePlanner::new(
+        params,
+        tables,
+        start,
+        goal,
+        goal_tol,
+        truth,
+        prior,
+        online.clone(),
+        settings.survey.sensor.fov_h_deg,
+    )?;
+    planner.keep_maps(settings.audit);
+    let cfg = settings.fly.sim_config();
+    let l = params.link_length as f64;
+    let rest =
+        Reference::new(params.n(), l, &[start.to_vec()], &cfg.limits).map_err(SimError::from)?;
+    let obstacles = MapClearance::new(truth, &params);
+    let run = FlightRun::start(ChainModel::new(params), rest, &cfg, Some(&obstacles), 0)?;
+    let mut lp = Loop {
+        truth,
+        settings,
+        online,
+        planner,
+        run,
+        flown_radius: params.unit_radius as f64 + settings.online.plan.clearance,
+        marked: Vec::new(),
+        next_scan: 0.0,
+        pending: None,
+        sensing: SensingStats::default(),
+        goal,
+    };
+    let end = lp.fly()?;
+    lp.finish(end, start)
+}
+
+/// Refuses a start that is not valid on the truth with the clearance (grown by the
+/// FK tolerance, as the space about it is then marked seen free).
+fn check_start(
+    truth: &Grid,
+    params: &ChainParams,
+    start: &[f64],
+    clearance: f64,
+) -> Result<(), ExploreError> {
+    let field = std::sync::Arc::new(DistanceField::new(truth.clone()));
+    let bad = |why: String| ExploreError::Start { clearance, why };
+    let ctx = CollisionContext::new(field, *params, clearance + FK_TOLERANCE)
+        .map_err(|e| bad(e.to_string()))?;
+    let eta: Vec<f32> = start[3..].iter().map(|&v| v as f32).collect();
+    let shape = aerial_chain_core::Shape::from_slice(params.units, &eta)
+        .map_err(|e| bad(format!("{e:?}")))?;
+    ctx.check_config(super::planner::head(start), &shape)
+        .map_err(|e| bad(e.to_string()))
+}
+
+/// The simulation loop's state.
+struct Loop<'a> {
+    truth: &'a Grid,
+    settings: &'a ExploreSettings,
+    online: OnlineSettings,
+    planner: OnlinePlanner,
+    run: FlightRun<'a>,
+    flown_radius: f64,
+    marked: Vec<Point3<f64>>,
+    next_scan: f64,
+    pending: Option<(f64, Reference)>,
+    sensing: SensingStats,
+    goal: Point3<f64>,
+}
+
+impl Loop<'_> {
+    /// Steps until the flight ends or the run does; returns how the run ended.
+    fn fly(&mut self) -> Result<ExploreEnd, ExploreError> {
+        let period = 1.0 / self.settings.survey.rate_hz;
+        let mut first = true;
+        loop {
+            let t = self.run.time();
+            self.mark_flown()?;
+            if t + 1e-9 >= self.next_scan {
+                self.scan()?;
+                self.next_scan += period;
+                let trigger = if first {
+                    Some(Trigger::Start)
+                } else {
+                    self.due(t, period)
+                };
+                first = false;
+                if let Some(trigger) = trigger {
+                    if let Some(end) = self.replan(t, trigger) {
+                        return Ok(end);
+                    }
+                }
+            }
+            self.join_pending(t).map_err(SimError::from)?;
+            if t >= self.settings.time_limit_s {
+                return Ok(ExploreEnd::TimeLimit {
+                    t: self.settings.time_limit_s,
+                    tried: self.tried(),
+                });
+            }
+            let finite = self.pending.is_none() && self.planner.reached();
+            if let Some(end) = self.run.advance(finite) {
+                return Ok(flight_end(end, self.run.time()));
+            }
+        }
+    }
+
+    /// The replan due at `t`, if any.
+    fn due(&self, t: f64, period: f64) -> Option<Trigger> {
+        if self.pending.is_some() || self.planner.reached() {
+            return None;
+        }
+        let remaining = self.run.reference().duration() - t;
+        if remaining < self.online.deadline_s + period {
+            Some(Trigger::CommitShort)
+        } else if self.planner.route_cut() {
+            Some(Trigger::RouteCut)
+        } else if t - self.planner.route_searched_at() >= self.online.route_period_s {
+            Some(Trigger::Period)
+        } else {
+            None
+        }
+    }
+
+    /// Replans; a committed piece waits for the replan's wall time. `Some` ends the run.
+    fn replan(&mut self, t: f64, trigger: Trigger) -> Option<ExploreEnd> {
+        let before = self.planner.pieces().len();
+        let record = self.planner.replan(t, trigger);
+        if let Outcome::Sealed(why) = record.outcome {
+            return Some(ExploreEnd::Sealed { t, why });
+        }
+        if self.planner.pieces().len() > before {
+            let piece = self.planner.pieces().last().expect("committed");
+            let next = piece.trajectory.reference().clone();
+            self.pending = Some((t + record.wall_s, next));
+        }
+        None
+    }
+
+    /// Appends the pending piece once its replan's time has passed.
+    fn join_pending(&mut self, t: f64) -> Result<(), crate::sim::ReferenceError> {
+        if let Some((ready, next)) = self.pending.take() {
+            if t >= ready {
+                let at = ready.max(self.run.reference().duration());
+                self.run.extend(at, &next)?;
+            } else {
+                self.pending = Some((ready, next));
+            }
+        }
+        Ok(())
+    }
+
+    /// Marks the balls about the unit centres that moved half a voxel since last.
+    fn mark_flown(&mut self) -> Result<(), ExploreError> {
+        let half = self.truth.resolution() / 2.0;
+        let units = self.run.units();
+        let mut moved = Vec::new();
+        for (i, u) in units.iter().enumerate() {
+            let p = Point3::from(u.p);
+            match self.marked.get_mut(i) {
+                Some(m) if (p - *m).norm() < half => {}
+                Some(m) => {
+                    *m = p;
+                    moved.push(p);
+                }
+                None => {
+                    self.marked.push(p);
+                    moved.push(p);
+                }
+            }
+        }
+        if !moved.is_empty() {
+            self.planner.observe_flown(&moved, self.flown_radius)?;
+        }
+        Ok(())
+    }
+
+    /// Every unit's sensor scans the truth from the unit's flown pose.
+    fn scan(&mut self) -> Result<(), ExploreError> {
+        let sensor = &self.settings.survey.sensor;
+        for u in self.run.units() {
+            let q = nalgebra::UnitQuaternion::from_matrix(&u.r);
+            let attitude = [q.w, q.i, q.j, q.k];
+            let pose = UnitPose::new([u.p.x, u.p.y, u.p.z], attitude)
+                .map_err(|e| ExploreError::Survey(e.into()))?;
+            let scan = raycast::scan(self.truth, sensor, &pose);
+            self.sensing.rays += scan.rays.len();
+            let cloud = PointCloud::from_scan(&scan, self.truth.resolution());
+            let fused = self.planner.observe(&cloud, scan.max_range)?;
+            self.sensing.scans += 1;
+            if fused.voxels > 0 {
+                self.sensing.update_s.push(fused.update_s);
+            }
+        }
+        Ok(())
+    }
+
+    /// What was tried, for a run out of time.
+    fn tried(&self) -> String {
+        let records = self.planner.records();
+        let committed = records
+            .iter()
+            .filter(|r| r.outcome == Outcome::Committed)
+            .count();
+        let end = super::planner::head(self.planner.committed_end());
+        let left = self.planner.route().map_or(f64::NAN, |r| r.length());
+        format!(
+            "{} replans, {committed} pieces committed, the committed motion ends {:.2} m from \
+             the goal (route {left:.2} m from there), {} voxels seen",
+            records.len(),
+            (end - self.goal).norm(),
+            self.planner.belief().seen().known()
+        )
+    }
+
+    /// The result: the flight ended now as `end`.
+    fn finish(self, end: ExploreEnd, start: &[f64]) -> Result<Exploration, ExploreError> {
+        let flight_end = FlightEnd {
+            completed: match &end {
+                ExploreEnd::Reached { t } => Some(*t),
+                _ => None,
+            },
+            diverged: matches!(&end, ExploreEnd::FlightFailed { why, .. } if why.contains("diverged")),
+        };
+        let flight = self.run.finish(flight_end);
+        let planner = self.planner;
+        let plan = planner.joined_plan(start, MapSection::of(self.truth));
+        let audit = self.settings.audit.then(|| {
+            planner
+                .pieces()
+                .iter()
+                .map(|p| {
+                    let map = p.map.as_ref().expect("kept with audit");
+                    verify_plan(map, &p.plan).violation.map(|v| v.to_string())
+                })
+                .collect()
+        });
+        let rebuild_s = self.settings.audit.then(|| {
+            let grid = planner.belief().commit_field().grid().clone();
+            let began = Instant::now();
+            let field = DistanceField::new(grid);
+            let s = began.elapsed().as_secs_f64();
+            drop(field);
+            s
+        });
+        let mut sensing = self.sensing;
+        sensing.known = planner.belief().seen().known();
+        Ok(Exploration {
+            flight,
+            end,
+            replans: planner.records().to_vec(),
+            plan,
+            pieces: planner.pieces().len(),
+            seen: planner.belief().seen().clone(),
+            sensing,
+            audit,
+            rebuild_s,
+        })
+    }
+}
+
+/// How a flight that ended by itself ended.
+fn flight_end(end: FlightEnd, t: f64) -> ExploreEnd {
+    match end.completed {
+        Some(at) => ExploreEnd::Reached { t: at },
+        None if end.diverged => ExploreEnd::FlightFailed {
+            t,
+            why: "the flight diverged from its reference".into(),
+        },
+        None => ExploreEnd::FlightFailed {
+            t,
+            why: "the chain did not settle at the goal".into(),
+        },
+    }
+}

@@ -1,0 +1,37 @@
+//! Flying into the unknown: planning while the map grows (docs/online.md).
+//!
+//! - [`belief`]: [`Belief`], the seen map (OctoMap's fusion) and two distance fields
+//!   over the world's box that follow it voxel by voxel: unknown space occupied (what
+//!   a piece is committed on) and free (what the route is searched on);
+//! - [`route`]: the head's route to the goal with unknown space free, and the proof
+//!   that the goal is out of reach;
+//! - [`planner`]: [`OnlinePlanner`], the library's online planner: it observes point
+//!   clouds in the world frame, replans under a deadline, and commits pieces that lie
+//!   in space known free, pass the trajectory's exact check with unknown space
+//!   occupied, and end at rest;
+//! - [`explore`]: [`explore()`], the simulator as a client: sensors read the true map,
+//!   the chain's dynamics fly what is committed (`arc explore`).
+//!
+//! # The rule for what the chain may do
+//! The route to the goal is searched with unknown space free (optimistic, as FASTER
+//! does). What is committed is not: a piece goes from where the committed motion
+//! ends, at rest, to the farthest route point whose head sphere is known free (or a
+//! nearer one), planned by the ARCplanner on the map with unknown space occupied,
+//! timed and checked there, and ends at rest; so the chain can always stop, in known
+//! space. Where the route leaves the sensors' view the piece ends with the head yaw
+//! (which every unit holds, and so every sensor) turned along the route.
+
+pub mod belief;
+pub mod explore;
+pub mod planner;
+pub mod route;
+
+pub use belief::{Belief, Fused};
+pub use explore::{
+    explore, Exploration, ExploreEnd, ExploreError, ExploreRecord, ExploreSettings, ExploreSummary,
+    SensingStats, RECORD_FORMAT,
+};
+pub use planner::{
+    OnlineError, OnlinePlanner, OnlineSettings, Outcome, Piece, ReplanRecord, Trigger,
+};
+pub use route::{Radii, Route};

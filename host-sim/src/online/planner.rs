@@ -1,0 +1,598 @@
+//! [`OnlinePlanner`]: plans as the map grows, committing pieces that end at rest in
+//! space known free (see the module docs of `crate::online`).
+
+use std::time::Instant;
+
+use aerial_chain_core::{ChainParams, Shape};
+use nalgebra::Point3;
+use serde::{Deserialize, Serialize};
+
+use super::belief::{Belief, Fused};
+use super::route::{self, Found, Radii, Route};
+use crate::collision::FK_TOLERANCE;
+use crate::goal::GoalPose;
+use crate::map::Grid;
+use crate::plan_file::{MapSection, Plan};
+use crate::planner::Query;
+use crate::planning::{plan, PlanOptions, PlanningError, Request};
+use crate::sensing::occupancy::FusionError;
+use crate::sensing::PointCloud;
+use crate::tables::ShapeTables;
+use crate::trajectory::Trajectory;
+
+/// Wall time a replan may take by default (s): the built-in scenarios' pieces through
+/// their narrow places are found within it on 2 cores (docs/online.md).
+pub const DEFAULT_DEADLINE_S: f64 = 0.3;
+
+/// How the online planner plans.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OnlineSettings {
+    /// How every piece is planned (`arc plan`'s options; its time limit is replaced
+    /// by `deadline_s`, its trajectory settings by `trajectory`).
+    pub plan: PlanOptions,
+    /// How every piece is timed and checked.
+    pub trajectory: crate::trajectory::Settings,
+    /// Wall time a replan may take (s): what a piece's search and post-processing
+    /// get. Longer finds pieces through harder places; shorter keeps the chain from
+    /// waiting for its next piece. Default 0.3 s.
+    pub deadline_s: f64,
+    /// Period of the route's replans when nothing cuts it (s): how soon a shortcut
+    /// that sensing opened is taken. Default 1 s.
+    pub route_period_s: f64,
+}
+
+impl Default for OnlineSettings {
+    fn default() -> Self {
+        Self {
+            plan: PlanOptions::default(),
+            trajectory: crate::trajectory::Settings::default(),
+            deadline_s: DEFAULT_DEADLINE_S,
+            route_period_s: 1.0,
+        }
+    }
+}
+
+/// Why a replan ran.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Trigger {
+    /// The first plan, at the start.
+    Start,
+    /// A new observation cut the route.
+    RouteCut,
+    /// The route's period elapsed.
+    Period,
+    /// The committed motion ends soon: the next piece is due.
+    CommitShort,
+}
+
+/// What a replan did.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind", content = "why")]
+pub enum Outcome {
+    /// A piece was committed.
+    Committed,
+    /// A turn in place was committed, to look along the route.
+    Looked,
+    /// The route was searched again; nothing was committed (none was due).
+    Rerouted,
+    /// Nothing was seen since the last replan: nothing to do.
+    NothingNew,
+    /// The route leaves known space too soon for a piece: the chain waits to see more.
+    NoRoom,
+    /// The committed motion already ends at the goal.
+    Reached,
+    /// The goal cannot be reached: the reason.
+    Sealed(String),
+}
+
+/// The record of one replan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReplanRecord {
+    /// Simulated time when it began (s).
+    pub t: f64,
+    /// Why it ran.
+    pub trigger: Trigger,
+    /// What it did.
+    pub outcome: Outcome,
+    /// Wall time it took (s).
+    pub wall_s: f64,
+    /// Voxels inside the box whose state changed since the previous replan.
+    pub voxels_changed: usize,
+    /// Head path of the piece committed (m; 0 when none).
+    pub committed_m: f64,
+    /// Length of the route to the goal (m; 0 when none).
+    pub route_m: f64,
+}
+
+/// A committed piece: its plan, timed and checked on the map of its commit.
+#[derive(Clone, Debug)]
+pub struct Piece {
+    /// Its plan (`arc-plan/1`), from where the committed motion ended.
+    pub plan: Plan,
+    /// Its trajectory, from rest to rest.
+    pub trajectory: Trajectory,
+    /// The map it was planned and checked on (unknown space occupied), when the
+    /// planner keeps them ([`OnlinePlanner::keep_maps`]).
+    pub map: Option<Grid>,
+}
+
+/// Why the online planner cannot start or go on.
+#[derive(Debug, thiserror::Error)]
+pub enum OnlineError {
+    /// The box or the prior map cannot be used.
+    #[error("map: {0}")]
+    Map(String),
+    /// A fusion argument was refused.
+    #[error("sensing: {0}")]
+    Fusion(#[from] FusionError),
+    /// A planning input was refused (tables, settings).
+    #[error("planning: {0}")]
+    Planning(PlanningError),
+    /// A setting outside its range.
+    #[error("{field} = {value}: {rule}")]
+    Setting {
+        /// The setting.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// The rule it breaks.
+        rule: &'static str,
+    },
+}
+
+/// Plans a chain's motion toward a goal while the map grows (see the module docs).
+pub struct OnlinePlanner {
+    params: ChainParams,
+    tables: ShapeTables,
+    settings: OnlineSettings,
+    belief: Belief,
+    goal: Point3<f64>,
+    goal_tol: f64,
+    radii: Radii,
+    fov_h: f64,
+    end: Vec<f64>,
+    pieces: Vec<Piece>,
+    route: Option<Route>,
+    seen_at_last: usize,
+    route_at: f64,
+    reached: bool,
+    keep_maps: bool,
+    records: Vec<ReplanRecord>,
+}
+
+impl OnlinePlanner {
+    /// A planner for the chain `params` (with its shape `tables`) starting at rest in
+    /// configuration `start` (`zeta`), toward `goal` (head within `goal_tol`), in the
+    /// box of `bounds` (its contents are not read), knowing `prior` if given. The start
+    /// must be valid with the clearance of `settings` (every body grown by it, on the
+    /// true map): the space within that reach of its bodies counts as seen free. The
+    /// sensors' horizontal field of view `fov_h_deg` decides when the chain turns to
+    /// look along its route.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        params: ChainParams,
+        tables: ShapeTables,
+        start: &[f64],
+        goal: Point3<f64>,
+        goal_tol: f64,
+        bounds: &Grid,
+        prior: Option<&Grid>,
+        settings: OnlineSettings,
+        fov_h_deg: f64,
+    ) -> Result<Self, OnlineError> {
+        check_settings(&settings)?;
+        if let Some(p) = prior {
+            if p.resolution() != bounds.resolution() {
+                return Err(OnlineError::Map(format!(
+                    "the known map's resolution {} m is not the world's {} m",
+                    p.resolution(),
+                    bounds.resolution()
+                )));
+            }
+        }
+        let mut belief = Belief::new(bounds, prior).map_err(|e| OnlineError::Map(e.to_string()))?;
+        let c = settings.plan.clearance;
+        belief.mark_clear(&bodies(&params, start, c + 2.0 * FK_TOLERANCE))?;
+        let grown = params.unit_radius as f64 + c + FK_TOLERANCE;
+        Ok(Self {
+            params,
+            tables,
+            radii: Radii::new(grown, bounds.resolution()),
+            settings,
+            belief,
+            goal,
+            goal_tol,
+            fov_h: fov_h_deg.to_radians(),
+            end: start.to_vec(),
+            pieces: Vec::new(),
+            route: None,
+            seen_at_last: usize::MAX,
+            route_at: f64::NEG_INFINITY,
+            reached: false,
+            keep_maps: false,
+            records: Vec::new(),
+        })
+    }
+
+    /// Keeps the map every piece was committed on (for an audit of the pieces; each
+    /// costs a copy of the box).
+    pub fn keep_maps(&mut self, keep: bool) {
+        self.keep_maps = keep;
+    }
+
+    /// Fuses one sensor's cloud (world frame, from the sensor's origin).
+    pub fn observe(&mut self, cloud: &PointCloud, max_range: f64) -> Result<Fused, OnlineError> {
+        Ok(self.belief.fuse(cloud, max_range)?)
+    }
+
+    /// Marks the space the flown bodies fill as seen free: the balls of `radius`
+    /// (`r_u` plus the clearance) about the unit centres `centres`.
+    pub fn observe_flown(
+        &mut self,
+        centres: &[Point3<f64>],
+        radius: f64,
+    ) -> Result<Fused, OnlineError> {
+        Ok(self.belief.mark_flown(centres, radius)?)
+    }
+
+    /// Whether what was seen since the route was searched cuts it.
+    pub fn route_cut(&self) -> bool {
+        self.route
+            .as_ref()
+            .is_some_and(|r| !r.holds(self.belief.route_field()))
+    }
+
+    /// When the route was last searched (simulated s).
+    pub fn route_searched_at(&self) -> f64 {
+        self.route_at
+    }
+
+    /// Replans at simulated time `now` for `trigger`: searches the route again when
+    /// something was seen since, and with [`Trigger::Start`] or
+    /// [`Trigger::CommitShort`] commits the next piece.
+    pub fn replan(&mut self, now: f64, trigger: Trigger) -> ReplanRecord {
+        let began = Instant::now();
+        let changed = self.belief.changed();
+        let fresh = changed != self.seen_at_last;
+        let voxels_changed = if self.seen_at_last == usize::MAX {
+            changed
+        } else {
+            changed - self.seen_at_last
+        };
+        let commit = matches!(trigger, Trigger::Start | Trigger::CommitShort);
+        let (outcome, committed_m) = if self.reached {
+            (Outcome::Reached, 0.0)
+        } else if !fresh && self.route.is_some() {
+            self.route_at = now;
+            (Outcome::NothingNew, 0.0)
+        } else {
+            self.seen_at_last = changed;
+            self.route_at = now;
+            match self.search() {
+                Err(why) => (Outcome::Sealed(why), 0.0),
+                Ok(()) if !commit => (Outcome::Rerouted, 0.0),
+                Ok(()) => self.commit(began),
+            }
+        };
+        let record = ReplanRecord {
+            t: now,
+            trigger,
+            outcome,
+            wall_s: began.elapsed().as_secs_f64(),
+            voxels_changed,
+            committed_m,
+            route_m: self.route.as_ref().map_or(0.0, Route::length),
+        };
+        self.records.push(record.clone());
+        record
+    }
+
+    /// Searches the route from the committed motion's end; `Err` with the reason when
+    /// the goal is out of reach.
+    fn search(&mut self) -> Result<(), String> {
+        let from = head(&self.end);
+        let found = route::search(
+            self.belief.route_field(),
+            from,
+            self.goal,
+            self.goal_tol,
+            self.radii,
+        );
+        match found {
+            Found::Route(r) => {
+                self.route = Some(r);
+                Ok(())
+            }
+            Found::Sealed { reached } => {
+                self.route = None;
+                Err(format!(
+                    "no route for the head's sphere reaches within {} m of the goal {:?} even \
+                     with unknown space free: the {reached} voxels reachable from the chain at \
+                     {:.3} m of clearance hold no way there",
+                    self.goal_tol,
+                    [self.goal.x, self.goal.y, self.goal.z],
+                    self.radii.proof
+                ))
+            }
+        }
+    }
+
+    /// Commits the next piece along the route: to the goal when the route is known
+    /// free to its end, else to the farthest route point whose head sphere is known
+    /// free, or nearer; or a turn to look along the route.
+    fn commit(&mut self, began: Instant) -> (Outcome, f64) {
+        let route = self.route.clone().expect("searched");
+        let known = self.known_prefix(&route);
+        let last = route.points.len() - 1;
+        let candidates: Vec<usize> = if known == last {
+            vec![last]
+        } else {
+            [1.0, 2.0 / 3.0, 1.0 / 3.0]
+                .iter()
+                .map(|f| ((known as f64) * f).round() as usize)
+                .filter(|&k| k > 0)
+                .collect()
+        };
+        let r_v = self.belief.route_field().grid().resolution();
+        let count = candidates.len();
+        for (tried, k) in candidates.into_iter().enumerate() {
+            let final_piece = k == last;
+            let (goal, tol) = match final_piece {
+                true => (self.goal, self.goal_tol),
+                false => (route.points[k], r_v),
+            };
+            if !final_piece && (goal - head(&self.end)).norm() < 2.0 * r_v {
+                continue;
+            }
+            // The time left, shared by the candidates left: a far piece that cannot be
+            // found quickly leaves time for a nearer one.
+            let left = self.settings.deadline_s - began.elapsed().as_secs_f64();
+            let deadline = left / (count - tried) as f64;
+            if deadline <= 0.0 {
+                break;
+            }
+            let look = (!final_piece).then(|| self.look_yaw(&route, k));
+            if let Some(piece) = self.plan_piece(goal, tol, look, deadline) {
+                let m = piece.trajectory.head_path_m();
+                self.push(piece);
+                self.reached = final_piece;
+                return (Outcome::Committed, m);
+            }
+        }
+        match self.turn_to_look(&route) {
+            true => (Outcome::Looked, 0.0),
+            false => (Outcome::NoRoom, 0.0),
+        }
+    }
+
+    /// Index of the last route point up to which every point's head sphere is known
+    /// free (the first points, within a voxel of the head, are the head's own).
+    fn known_prefix(&self, route: &Route) -> usize {
+        let field = self.belief.commit_field();
+        let start = head(&self.end);
+        let r_v = field.grid().resolution();
+        let mut last = 0;
+        for (k, p) in route.points.iter().enumerate().skip(1) {
+            let own = (p - start).norm() <= r_v;
+            if field.clearance(*p) > self.radii.route {
+                last = k;
+            } else if !own {
+                break;
+            }
+        }
+        last
+    }
+
+    /// The head yaw that looks from route point `k` along the route: toward the point
+    /// one sensor reach ahead (a link length at least).
+    fn look_yaw(&self, route: &Route, k: usize) -> f32 {
+        let ahead = (self.params.link_length as f64).max(1.0);
+        let from = route.points[k];
+        let to = route.point_after(k, ahead);
+        let d = to - from;
+        if d.xy().norm() < 1e-9 {
+            return self.end[3] as f32;
+        }
+        d.y.atan2(d.x) as f32
+    }
+
+    /// Plans a piece from the committed end to within `tol` of `goal`, on the map with
+    /// unknown space occupied; where `look` lies out of the sensors' middle view, the
+    /// piece ends by turning the head yaw to it (a head yaw moves no body); timed and
+    /// checked on that map.
+    fn plan_piece(
+        &self,
+        goal: Point3<f64>,
+        tol: f64,
+        look: Option<f32>,
+        deadline: f64,
+    ) -> Option<Piece> {
+        let shape = Shape::from_slice(self.params.units, &eta(&self.end)).ok()?;
+        let mut query = Query::new(head(&self.end), shape, goal);
+        query.goal_tol = tol;
+        let field = self.belief.commit_field().clone();
+        let request = Request {
+            map: MapSection::of(field.grid()),
+            field,
+            params: self.params,
+            query,
+            pose: GoalPose::default(),
+        };
+        let mut options = self.settings.plan.clone();
+        options.time_limit_s = Some(deadline);
+        let mut plan = plan(&request, Some(self.tables.clone()), &options)
+            .ok()?
+            .plan;
+        if let Some(look) = look {
+            let end = plan.waypoints.last()?.zeta.clone();
+            if self.turn_needed(end[3] as f32, look) {
+                plan.waypoints.push(crate::plan_file::Waypoint {
+                    zeta: turned(&end, look),
+                    goal: None,
+                    hold_s: None,
+                });
+            }
+        }
+        let trajectory =
+            crate::trajectory::build(&plan, request.grid(), &self.settings.trajectory).ok()?;
+        let map = self.keep_maps.then(|| request.grid().clone());
+        Some(Piece {
+            plan,
+            trajectory,
+            map,
+        })
+    }
+
+    /// Whether a head yaw of `yaw` should turn to `look`: when `look` lies more than a
+    /// quarter of the horizontal field of view off it, the route ahead would leave the
+    /// middle half of the sensors' view.
+    fn turn_needed(&self, yaw: f32, look: f32) -> bool {
+        let d = crate::collision::verify::wrap((look - yaw) as f64);
+        d.abs() > self.fov_h / 4.0
+    }
+
+    /// Commits a turn in place of the head yaw toward the route, when the route leaves
+    /// the sensors' view. A head yaw moves no body, so the turn is always valid.
+    fn turn_to_look(&mut self, route: &Route) -> bool {
+        let look = self.look_yaw(route, 0);
+        if !self.turn_needed(self.end[3] as f32, look) {
+            return false;
+        }
+        let to = turned(&self.end, look);
+        let field = self.belief.commit_field();
+        let map = MapSection::of(field.grid());
+        let mut plan = Plan::from_zetas(&self.params, map, vec![self.end.clone(), to]);
+        plan.stats.insert("turn_to_look".into(), true.into());
+        let Ok(trajectory) =
+            crate::trajectory::build(&plan, field.grid(), &self.settings.trajectory)
+        else {
+            return false;
+        };
+        let map = self.keep_maps.then(|| field.grid().clone());
+        self.push(Piece {
+            plan,
+            trajectory,
+            map,
+        });
+        true
+    }
+
+    /// Appends a piece: the committed motion now ends where it ends.
+    fn push(&mut self, piece: Piece) {
+        if let Some(last) = piece.plan.waypoints.last() {
+            self.end.clone_from(&last.zeta);
+        }
+        self.pieces.push(piece);
+    }
+
+    /// The committed pieces, in order.
+    pub fn pieces(&self) -> &[Piece] {
+        &self.pieces
+    }
+
+    /// The configuration where the committed motion ends (at rest).
+    pub fn committed_end(&self) -> &[f64] {
+        &self.end
+    }
+
+    /// Whether the committed motion ends at the goal.
+    pub fn reached(&self) -> bool {
+        self.reached
+    }
+
+    /// The current route, if one was found.
+    pub fn route(&self) -> Option<&Route> {
+        self.route.as_ref()
+    }
+
+    /// Every replan so far.
+    pub fn records(&self) -> &[ReplanRecord] {
+        &self.records
+    }
+
+    /// What the planner believes of the world.
+    pub fn belief(&self) -> &Belief {
+        &self.belief
+    }
+
+    /// The committed pieces joined into one plan on the map `map` describes: each
+    /// piece's waypoints after its first, which is where the one before it ends.
+    pub fn joined_plan(&self, start: &[f64], map: MapSection) -> Plan {
+        let mut zetas = vec![start.to_vec()];
+        for piece in &self.pieces {
+            for w in piece.plan.waypoints.iter().skip(1) {
+                zetas.push(w.zeta.clone());
+            }
+        }
+        let mut plan = Plan::from_zetas(&self.params, map, zetas);
+        plan.stats.insert("pieces".into(), self.pieces.len().into());
+        plan
+    }
+}
+
+/// Head position of configuration `zeta`.
+pub(super) fn head(zeta: &[f64]) -> Point3<f64> {
+    Point3::new(zeta[0], zeta[1], zeta[2])
+}
+
+/// Configuration `zeta` with its head yaw turned to `yaw` the short way round.
+fn turned(zeta: &[f64], yaw: f32) -> Vec<f64> {
+    let mut to = zeta.to_vec();
+    to[3] = zeta[3] + crate::collision::verify::wrap(yaw as f64 - zeta[3]);
+    to
+}
+
+/// The shape of configuration `zeta`, as the chain's `f32` angles.
+fn eta(zeta: &[f64]) -> Vec<f32> {
+    zeta[3..].iter().map(|&v| v as f32).collect()
+}
+
+/// The chain's bodies in configuration `zeta`, each as a segment and a radius grown
+/// by `grow`: a ball per unit, a capsule per link.
+pub(super) fn bodies(
+    params: &ChainParams,
+    zeta: &[f64],
+    grow: f64,
+) -> Vec<(Point3<f64>, Point3<f64>, f64)> {
+    let head = crate::sim::V3::new(zeta[0], zeta[1], zeta[2]);
+    let centres: Vec<Point3<f64>> =
+        crate::sim::dynamics::unit_positions(params.link_length as f64, head, &zeta[3..])
+            .into_iter()
+            .map(Point3::from)
+            .collect();
+    let r_u = params.unit_radius as f64 + grow;
+    let r_l = params.link_radius as f64 + grow;
+    let mut out: Vec<_> = centres.iter().map(|c| (*c, *c, r_u)).collect();
+    out.extend(centres.windows(2).map(|w| (w[0], w[1], r_l)));
+    out
+}
+
+/// Refuses settings outside their ranges.
+fn check_settings(s: &OnlineSettings) -> Result<(), OnlineError> {
+    let positive = |field, value: f64, limit: f64, rule| {
+        if value.is_finite() && value > 0.0 && value <= limit {
+            Ok(())
+        } else {
+            Err(OnlineError::Setting { field, value, rule })
+        }
+    };
+    positive(
+        "deadline_s",
+        s.deadline_s,
+        60.0,
+        "a positive number of seconds, at most 60",
+    )?;
+    positive(
+        "route_period_s",
+        s.route_period_s,
+        3600.0,
+        "a positive number of seconds, at most 3600",
+    )?;
+    s.plan.termination().map_err(OnlineError::Planning)?;
+    s.trajectory
+        .validate()
+        .map_err(|e| OnlineError::Map(format!("trajectory settings: {e}")))?;
+    Ok(())
+}
