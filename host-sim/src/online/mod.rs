@@ -28,8 +28,8 @@ pub mod route;
 
 pub use belief::{Belief, Fused};
 pub use explore::{
-    explore, Exploration, ExploreEnd, ExploreError, ExploreRecord, ExploreSettings, ExploreSummary,
-    SensingStats, RECORD_FORMAT,
+    explore, quantile, Exploration, ExploreEnd, ExploreError, ExploreRecord, ExploreSettings,
+    ExploreSummary, SensingStats, RECORD_FORMAT,
 };
 pub use planner::{
     OnlineError, OnlinePlanner, OnlineSettings, Outcome, Piece, ReplanRecord, Trigger,

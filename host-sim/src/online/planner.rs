@@ -205,7 +205,7 @@ impl OnlinePlanner {
             goal,
             goal_tol,
             fov_h: fov_h_deg.to_radians(),
-            end: start.to_vec(),
+            end: as_written(start),
             pieces: Vec::new(),
             route: None,
             seen_at_last: usize::MAX,
@@ -520,7 +520,7 @@ impl OnlinePlanner {
     /// The committed pieces joined into one plan on the map `map` describes: each
     /// piece's waypoints after its first, which is where the one before it ends.
     pub fn joined_plan(&self, start: &[f64], map: MapSection) -> Plan {
-        let mut zetas = vec![start.to_vec()];
+        let mut zetas = vec![as_written(start)];
         for piece in &self.pieces {
             for w in piece.plan.waypoints.iter().skip(1) {
                 zetas.push(w.zeta.clone());
@@ -537,10 +537,23 @@ pub(super) fn head(zeta: &[f64]) -> Point3<f64> {
     Point3::new(zeta[0], zeta[1], zeta[2])
 }
 
+/// Configuration `zeta` with its angles as a plan file writes them (the shortest
+/// decimal of their `f32`), as every piece's waypoints hold them.
+fn as_written(zeta: &[f64]) -> Vec<f64> {
+    let mut out = zeta.to_vec();
+    for a in &mut out[3..] {
+        *a = crate::plan_file::f32_decimal(*a as f32);
+    }
+    out
+}
+
 /// Configuration `zeta` with its head yaw turned to `yaw` the short way round.
 fn turned(zeta: &[f64], yaw: f32) -> Vec<f64> {
     let mut to = zeta.to_vec();
-    to[3] = zeta[3] + crate::collision::verify::wrap(yaw as f64 - zeta[3]);
+    // As a plan file writes angles (the shortest decimal of an `f32`), so that the next
+    // piece, planned from this shape, starts exactly here.
+    let yaw = zeta[3] + crate::collision::verify::wrap(yaw as f64 - zeta[3]);
+    to[3] = crate::plan_file::f32_decimal(yaw as f32);
     to
 }
 

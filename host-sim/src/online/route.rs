@@ -278,7 +278,10 @@ mod tests {
         let from = Point3::new(0.5, 1.0, 1.0);
         let goal = Point3::new(3.5, 1.0, 1.0);
         let found = search(&walled(0.0), from, goal, 0.3, radii);
-        assert!(matches!(found, Found::Sealed { reached } if reached > 1000), "{found:?}");
+        assert!(
+            matches!(found, Found::Sealed { reached } if reached > 1000),
+            "{found:?}"
+        );
         // A one-voxel slit is too narrow for the head, but the proof radius is
         // conservative by two half diagonals: the route goes through it at that radius
         // and the piece planner, exact, finds no way.

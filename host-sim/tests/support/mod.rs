@@ -79,7 +79,7 @@ pub fn wait(child: Child, args: &[&str]) -> Outcome {
 }
 
 /// Waits for `child` at most `seconds` and collects its output.
-fn wait_at_most(mut child: Child, args: &[&str], seconds: u64) -> Outcome {
+pub fn wait_at_most(mut child: Child, args: &[&str], seconds: u64) -> Outcome {
     // Drain the pipes on threads, so a chatty child cannot block on a full pipe.
     let drain = |r: Option<Box<dyn Read + Send>>| {
         std::thread::spawn(move || {

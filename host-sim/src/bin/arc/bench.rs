@@ -34,6 +34,13 @@ pub enum BenchCommand {
     /// markdown and a plot of flight time against head path / speed.
     #[command(after_help = "Example:\n  arc bench flight --seeds 2 --out-dir out/flight")]
     Flight(FlightArgs),
+    /// Flying into the unknown from an empty map (`arc explore`'s defaults; window,
+    /// maze, silos, corridor, N = 4..6, and a sample of the robust family), against the
+    /// finished-map flight of the same query; CSV, markdown and a plot.
+    #[command(
+        after_help = "Example:\n  RAYON_NUM_THREADS=2 arc bench online --out-dir docs/bench"
+    )]
+    Online(OnlineArgs),
     /// One plan by the full-state lazy PRM baseline (arc-plan/1, verified exactly).
     #[command(
         after_help = "Example:\n  arc bench prm --scenario window --units 4 --vertices 15000 --out prm.json"
@@ -142,6 +149,28 @@ pub struct FlightArgs {
     seeds: u64,
     /// Also fly this many instances of `arc bench robust`'s family (its first ones,
     /// each with its own N and planner seed); 0: none.
+    #[arg(long, default_value_t = 20)]
+    robust: usize,
+    /// Where CSV, markdown and the plot go.
+    #[arg(long, default_value = "bench-out")]
+    out_dir: PathBuf,
+}
+
+/// `arc bench online`
+#[derive(Args, Debug)]
+pub struct OnlineArgs {
+    /// Scenarios, comma-separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "window,maze,silos,corridor"
+    )]
+    scenarios: Vec<String>,
+    /// Chain sizes, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "4,5,6")]
+    units: Vec<u8>,
+    /// Also explore this many instances of `arc bench robust`'s family (its first
+    /// ones, each with its own N); 0: none.
     #[arg(long, default_value_t = 20)]
     robust: usize,
     /// Where CSV, markdown and the plot go.
@@ -546,6 +575,65 @@ fn run_flight(a: FlightArgs) -> CliResult {
     Ok(())
 }
 
+fn run_online(a: OnlineArgs) -> CliResult {
+    for n in &a.units {
+        checks::count("--units", *n as usize, 2, 16, "units")?;
+    }
+    for s in &a.scenarios {
+        aerial_chain::problem::scenarios::build(s).map_err(|e| CliError::input(e.to_string()))?;
+    }
+    checks::count("--robust", a.robust, 0, 200, "instances")?;
+    let t = Instant::now();
+    let mut jobs: Vec<(String, u8)> = Vec::new();
+    for sc in &a.scenarios {
+        jobs.extend(a.units.iter().map(|&n| (sc.clone(), n)));
+    }
+    jobs.extend(
+        study::flight::robust_sample(a.robust)
+            .into_iter()
+            .map(|(sc, n, _)| (sc, n)),
+    );
+    let mut runs = Vec::new();
+    for (sc, n) in jobs {
+        let r = study::online::run_one(&sc, n);
+        eprintln!(
+            "{sc} N = {n}: {} in {:.1} s (finished map {:.1} s), {} replans, p95 {:.1} ms, max {:.1} ms",
+            r.end,
+            r.time_s,
+            r.finished_s,
+            r.replans,
+            r.latency_s[1] * 1e3,
+            r.latency_s[2] * 1e3
+        );
+        runs.push(r);
+    }
+    let md = format!(
+        "{}\n`arc explore`'s defaults from an empty map; the finished-map flight is `arc bench flight`'s trajectory flight of the same query (seed 1); {} build, {} worker threads; whole study {:.0} s.\n",
+        study::online::markdown(&runs),
+        if cfg!(debug_assertions) { "debug" } else { "release" },
+        std::env::var("RAYON_NUM_THREADS").unwrap_or_else(|_| "every core's".into()),
+        t.elapsed().as_secs_f64()
+    );
+    let files = [
+        study::write_out(
+            &a.out_dir,
+            "online_runs.csv",
+            study::online::csv(&runs).as_bytes(),
+        )?,
+        study::write_out(&a.out_dir, "online.md", md.as_bytes())?,
+        study::write_out(
+            &a.out_dir,
+            "online.svg",
+            study::online::figure(&runs).as_bytes(),
+        )?,
+    ];
+    println!("{md}");
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
 fn run_prm(a: PrmArgs) -> CliResult {
     let time_limit = check_prm(&a)?;
     let (ctx, params, query, map) = a.problem.context(a.clearance)?;
@@ -619,6 +707,7 @@ pub fn run(c: BenchCommand) -> CliResult {
         BenchCommand::Scale(a) => run_scale(a),
         BenchCommand::Robust(a) => run_robust(a),
         BenchCommand::Flight(a) => run_flight(a),
+        BenchCommand::Online(a) => run_online(a),
         BenchCommand::Prm(a) => run_prm(*a),
     }
 }
