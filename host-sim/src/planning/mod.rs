@@ -136,6 +136,7 @@ pub fn plan(
     options: &PlanOptions,
 ) -> Result<Planned, PlanningError> {
     let stop = options.termination()?;
+    options.validate_tuning()?;
     arrival::check_pose(request, options.planner.n_psi)?;
     let setup = Instant::now();
     let mut planner = planner(request, tables, options)?;
@@ -205,7 +206,9 @@ fn planner(
             )?
         }
     };
-    ArcPlanner::new(ctx, tables, options.planner.clone()).map_err(PlanningError::Refused)
+    ArcPlanner::new(ctx, tables, options.planner.clone())
+        .map(|p| p.with_refine(options.refine.clone()))
+        .map_err(PlanningError::Refused)
 }
 
 /// Why the query that began at `began` gave no plan: a query that cannot be asked is

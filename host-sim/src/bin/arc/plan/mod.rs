@@ -236,7 +236,9 @@ fn options(a: &PlanArgs) -> Result<PlanOptions, CliError> {
             follow_step: a.follow_step,
             clearance_min: a.clearance_min,
             head_lattice: a.head_lattice,
+            ..Settings::default()
         },
+        refine: Default::default(),
         clearance: a.clearance,
         no_smooth: a.no_smooth,
         time_limit_s: Some(a.time_limit),
