@@ -51,6 +51,10 @@ use crate::map::distance::DistanceField;
 const ROUND_EPS: f64 = 1e-6;
 
 /// Most blocks over the map's box (the block edge grows to stay below).
+///
+/// Tuning left a constant: it bounds the coarse graph's memory and labelling time on
+/// the largest maps (docs/promises.md), which a settings file should not lift; the
+/// smallest block is the setting `planner::LatticeSettings::min_block`.
 const MAX_BLOCKS: f64 = 100_000.0;
 
 /// One slab's union-find ([`Regions::join_rows`]).
