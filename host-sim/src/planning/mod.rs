@@ -16,6 +16,7 @@ mod arrival;
 mod error;
 mod mission;
 mod options;
+mod settings_file;
 
 use std::sync::atomic::AtomicUsize;
 use std::sync::Arc;
@@ -27,6 +28,7 @@ pub use arrival::Arrival;
 pub use error::{NoPlan, PlanningError};
 pub use mission::{plan_mission, LegError, MissionPlanned};
 pub use options::{PlanOptions, DEFAULT_TIME_LIMIT_S, MAX_TIME_LIMIT_S};
+pub use settings_file::{SettingsFile, SettingsFileError};
 
 use crate::collision::CollisionContext;
 use crate::goal::GoalPose;
