@@ -33,7 +33,7 @@ mod defaults {
     pub const WIDEN_OTHER_CANDIDATES: usize = 3;
     pub const WIDEN_TARGET_SHARE: f64 = 0.9;
     pub const WIDEN_SPLIT_MARGIN: f64 = 0.25;
-    pub const WIDEN_PROBE_SHIFTS: [f64; 7] = [0.0, 0.5, -0.5, 1.0, -1.0, 2.0, -2.0];
+    pub const WIDEN_PROBE_SHIFTS: [f64; 7] = [0.0, 0.05, -0.05, 0.1, -0.1, 0.2, -0.2];
 
     pub const THREAD_OPENING: f64 = 0.9;
     pub const THREAD_GAIN: f64 = 0.01;
@@ -205,11 +205,13 @@ pub struct WidenSettings {
     /// Largest share of a translation kept on either side of the stretch a split moves
     /// (the stretch is widened by two resolutions, up to this share).
     pub split_margin: f64,
-    /// Shifts along the edge, in map resolutions, at which a unit's passage is probed
-    /// for its middle (none first): a unit about to enter an opening is narrowest in
-    /// front of it, and the cross-section lies a voxel or two further along. Fitted as
-    /// 0.05, 0.1 and 0.2 m on the 0.1 m maps of the passages family, and scaled with
-    /// the resolution since (the same plans on the behaviour snapshot). More or larger
+    /// Shifts (m) along the edge at which a unit's passage is probed for its middle
+    /// (none first): a unit about to enter an opening is narrowest in front of it, and
+    /// the cross-section lies a little further along. Fitted on the 0.05 m maps of the
+    /// passages family (1, 2 and 4 voxels there). Not scaled with the resolution: the
+    /// rule that stands for (1, 2, 4 voxels) changes plans on the 0.1 m built-in
+    /// scenarios (`maze` N = 5 in the behaviour snapshot), and half that (0.5, 1, 2
+    /// voxels, the same on 0.1 m maps) would change the family's. More or larger
     /// shifts: passages found where a unit meets them obliquely, more sphere traces.
     pub probe_shifts: [f64; 7],
 }
@@ -440,7 +442,7 @@ impl RefineSettings {
         positive("widen.split_margin", w.split_margin)?;
         check(&name("widen.split_margin"), w.split_margin, 0.0, 0.5)?;
         for v in w.probe_shifts {
-            check(&name("widen.probe_shifts"), v, -MAX_ROUNDS, MAX_ROUNDS)?;
+            check(&name("widen.probe_shifts"), v, -MAX_REACH, MAX_REACH)?;
         }
         let t = &self.thread;
         length("thread.opening", t.opening)?;

@@ -57,16 +57,15 @@ fn middles<'b>(
     let r_u = ctx.params().unit_radius as f64;
     // A unit about to enter an opening is narrowest in front of it: the passage's
     // cross-section lies a little further along.
-    // (`WidenSettings::probe_shifts`, in resolutions, the first of which is no shift.)
+    // (`WidenSettings::probe_shifts`, the first of which is no shift.)
     let shifts: &[f64] = match along {
         Some(_) => &s.probe_shifts,
         None => &[0.0],
     };
     let u_along = along.unwrap_or_else(Vector3::zeros);
-    let r_v = ctx.field().grid().resolution();
     shifts
         .iter()
-        .map(move |&k| p + u_along * (k * r_v))
+        .map(move |&k| p + u_along * k)
         .flat_map(move |q| lines.iter().map(move |&u| (q, u)))
         .filter_map(move |(q, u)| Some(free_run(ctx, s, q, u)? + free_run(ctx, s, q, -u)?))
         .map(move |chord| chord / 2.0 - r_u)
