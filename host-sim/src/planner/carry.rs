@@ -9,6 +9,8 @@
 //! the stretch rigidly, on a head route of its own that keeps its body clear of the
 //! bays' walls and the gaps' ends: one change into it, one back (none at the goal).
 //!
+//! The numbers below are the defaults of `CarrySettings` (docs/settings.md).
+//!
 //! Every library shape at eight headings, the start's head yaw held
 //! (`super::shorten`), is a candidate. For each:
 //! 1. **Span.** The first waypoint `i` where the chain can change into it, and the

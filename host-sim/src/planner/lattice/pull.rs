@@ -61,7 +61,7 @@ impl HeadLattice {
     /// Pulls a lattice path taut: from each kept point, the farthest later point that
     /// one segment reaches, where the head's sphere can fly the segment (conservative,
     /// at the smallest clearance) and the segment keeps at least the smallest clearance
-    /// of the points it replaces (capped at the preferred radius plus `KEEP_CAP`).
+    /// of the points it replaces (capped at the preferred radius plus `LatticeSettings::keep_cap`).
     pub fn simplify(
         &self,
         ctx_min: &CollisionContext,
