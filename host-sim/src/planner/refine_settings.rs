@@ -190,20 +190,27 @@ pub struct WidenSettings {
     /// widened.
     pub same_pinch: f64,
     /// See `same_pinch` (m).
+    /// Larger: more edges given up with a stuck one.
     pub plateau: f64,
     /// Smallest gain (m) that counts as widening.
+    /// Larger: fewer, larger moves; smaller: more moves for millimetres.
     pub gain: f64,
     /// Samples farther apart than this (m) may lie in two passages: the second pass
     /// looks for the other passage of an edge judged by its narrowest sample.
+    /// Smaller: more samples taken as a passage of their own, for measurements.
     pub separate: f64,
     /// Samples of another passage looked at per edge, narrowest first, each at least
     /// `separate` from the ones before (a long tunnel holds several).
+    /// More: more passages of a long edge widened, for measurements.
     pub other_candidates: usize,
     /// Share of a passage's middle clearance widening aims at, up to the cap: a door
     /// 0.85 m wide leaves a unit 0.275 m in its middle, and 0.9 of that is the cap.
+    /// Higher: wider passages count (those up to `2 (cap / target_share + r_u)`), for
+    /// traces.
     pub target_share: f64,
     /// Largest share of a translation kept on either side of the stretch a split moves
     /// (the stretch is widened by two resolutions, up to this share).
+    /// Larger: longer stretches left unmoved at a split's ends.
     pub split_margin: f64,
     /// Shifts (m) along the edge at which a unit's passage is probed for its middle
     /// (none first): a unit about to enter an opening is narrowest in front of it, and
@@ -246,16 +253,21 @@ pub struct ThreadSettings {
     /// to the search. Higher: more routes threaded by the search.
     pub opening: f64,
     /// A threaded plan is taken when its worst pinch keeps at least this much larger a
-    /// share of the pinch middle's clearance than the other plan,
+    /// share of the pinch middle's clearance than the other plan, at least `share`, for
+    /// at most `motion` more shape motion per link. Higher: fewer plans threaded.
     pub gain: f64,
-    /// and at least this share: where threading cannot pass every pinch nearly as well
-    /// as its middle (`maze` and `corridor` reach 0.4-0.7) it is not worth its motion,
+    /// The share of a pinch middle's clearance a threaded plan must keep at every
+    /// pinch: where threading cannot pass every pinch nearly as well as its middle
+    /// (`maze` and `corridor` reach 0.4-0.7) it is not worth its motion. Higher: fewer
+    /// plans threaded, each nearer the middles.
     pub share: f64,
-    /// and it moves the angles by at most this much (rad) per link beyond the other
-    /// plan: an eighth of a turn, the price of lining the chain up with an opening.
+    /// The shape motion (rad per link) a threaded plan may add to the other plan's: an
+    /// eighth of a turn, the price of lining the chain up with an opening. Larger:
+    /// plans threaded for more shape motion.
     pub motion: f64,
     /// For the step length, a unit is inside a pinch where its distance to the map is
     /// under its radius plus this share of the pinch width (`planner::WIDEN_CAP`).
+    /// Larger: steps shortened farther from a pinch, for more steps.
     pub in_pinch: f64,
     /// How far (share of the resolution) a translation may carry a unit in a pinch
     /// off its track: a tenth of a 0.5 m opening's 0.1 m. Smaller: exacter tracks,
@@ -263,52 +275,73 @@ pub struct ThreadSettings {
     pub off_track: f64,
     /// Shortest step (share of the resolution): a unit that cannot stay on its track
     /// within this is left to the checks.
+    /// Smaller: tracks kept in sharper turns, for more steps.
     pub min_step: f64,
     /// A ray that runs this far (m) from a pinch's middle has left the pinch.
+    /// Longer: only longer free lines count, a narrower cone about the axis.
     pub escape: f64,
     /// A start whose front link points within this (rad, 30 degrees) of the route is
     /// slid along it as it lies; else it is turned first.
+    /// Larger: fewer starts turned before they slide, more trailing bodies.
     pub aligned: f32,
     /// Shares of the turn tried to align the start, the first that passes taken.
+    /// More shares: a turn found in tighter rooms, for checks.
     pub align_shares: [f32; 3],
     /// A pinch at least this long (m) is a tunnel: its axis runs through the middles of
     /// its ends.
+    /// Shorter: more pinches treated as tunnels.
     pub tunnel: f64,
     /// Where a tunnel's end cross-sections are taken: this share of the way out to
     /// either end.
+    /// Nearer 1: the axis through cross-sections nearer the ends, steadier in straight
+    /// tunnels.
     pub tunnel_ends: f64,
     /// A tunnel's axis is kept when its direction's cosine with the first guess is
     /// above this.
+    /// Lower: tunnel axes kept that turn farther from the first guess.
     pub tunnel_aligned: f64,
     /// Steps a threaded plan may have (it gives up beyond).
+    /// More: longer routes threaded, for memory and checks.
     pub max_steps: usize,
     /// How far back (and on) along the route, in route samples (half resolutions), a
     /// pinch's axis may be joined to the route.
+    /// More: axes joined farther along the route, for head checks.
     pub join_reach: usize,
     /// A unit within this distance (m) of a pinch's axis, between its ends, passes the
     /// pinch (where the threaded plan is measured against the middle).
+    /// Larger: more units measured against a pinch's middle.
     pub alongside: f64,
     /// Measured clearances are capped this far (m) above the pinch width, so that a
     /// unit at the cap still counts.
+    /// Larger: more units measured exactly, for time.
     pub measure_slack: f64,
     /// How far (m) out along a pinch's axis its ends are looked for.
+    /// Longer: longer pinches found whole, for distance queries.
     pub axis_reach: f64,
     /// Rounds of centring, finding the narrowest point and turning the axis.
+    /// More: a truer axis in skewed openings, for time.
     pub axis_rounds: usize,
     /// Half resolutions either way along the axis searched for its narrowest point.
+    /// More: the narrowest point found farther from the route's, for queries.
     pub narrowest_reach: i32,
     /// Spacing (degrees) of the grid of directions a pinch's axis is averaged over.
+    /// Smaller: a finer mean direction, for many more rays.
     pub grid_step_deg: f64,
     /// Grid steps either side of the first guess, in yaw and in pitch.
+    /// More: a wider grid (with `grid_step_deg`), for rays.
     pub grid_steps: i32,
     /// Directions steeper than this (degrees) are left out of the grid.
+    /// Lower: steep openings averaged over fewer directions.
     pub max_pitch_deg: f64,
     /// Directions more than this (degrees) from the first guess are left out.
+    /// Wider: axes turn farther from the route's heading.
     pub cone_deg: f64,
     /// Steps (shares of the resolution) of the gradient ascent that centres a point in
     /// its pinch, largest first.
+    /// Smaller last step: a point nearer the middle, for distance queries.
     pub centre_steps: [f64; 5],
     /// Most ascent steps at each step length.
+    /// More: farther moves at each step length, for queries.
     pub centre_rounds: usize,
 }
 
@@ -355,24 +388,31 @@ pub struct CarrySettings {
     /// Headings tried per library shape. More: more candidates, more time.
     pub headings: usize,
     /// Placements one shape's search may check.
+    /// More: longer detours found, for time.
     pub search_points: usize,
     /// Placements all shapes' searches together may check.
+    /// More: more candidates searched, for time.
     pub total_points: usize,
     /// The search keeps within this distance (m) of its guide.
+    /// Wider: routes farther from the plan's, for placements.
     pub tube: f64,
     /// Lattice spacings tried, in map resolutions: coarse, then fine.
+    /// Finer: tighter gaps passed, for placements.
     pub spacings: [f64; 2],
     /// Weight of the guide's estimate in the search: above 1 the search heads along the
     /// guide and checks fewer points, for a path that may be longer.
     pub greed: f64,
     /// The fit is tested at route points at least this far apart (m).
+    /// Smaller: fewer candidates pass the fit test only to fail the search, for checks.
     pub fit_spacing: f64,
     /// Motion (rad) carrying must save to be taken.
+    /// Larger: only larger savings are carried.
     pub saving: f64,
     /// A carried plan's head path may be at most `detour_m + detour_share` times the
     /// plan's (m): a long detour costs more flight than the changes it saves.
     pub detour_m: f64,
     /// See `detour_m`.
+    /// Larger: longer detours accepted.
     pub detour_share: f64,
 }
 

@@ -65,40 +65,55 @@ pub enum Preference {
 #[serde(default, deny_unknown_fields)]
 pub struct Settings {
     /// Head roadmap vertices `M_VT`.
+    /// More: the uniform roadmap finds ways through more of the map, for setup time and
+    /// memory (the lattice route comes first and needs none).
     pub vertices: usize,
     /// Head roadmap connection radius `r_T` (m).
+    /// Larger: longer head edges and more neighbours, for more checks per edge.
     pub r_t: f64,
     /// Most neighbours a vertex takes (the nearest within `r_T`).
+    /// More: shorter head paths, for memory and edges to check.
     pub max_neighbours: usize,
     /// Discrete headings per library shape and rotations of the current shape.
+    /// More: more shapes fit a narrow edge, for candidates to check.
     pub n_psi: usize,
     /// `G_Val` connection radius `d_c` (`C_T` metric); `None`: the roadmap radius
     /// `aerial_chain_core::srs::default_r_s` for the chain and the SRS size.
+    /// Larger: more random shapes connect in `G_Val`, for a slower SRSConnect.
     pub d_c: Option<f32>,
     /// Shape sources.
+    /// `lsc` or `srs` alone is the paper's ablation: fewer shapes, fewer plans.
     pub mode: Mode,
     /// Shape preference.
+    /// `coverage` trades shape changes for sensor coverage.
     pub prefer: Preference,
     /// Seed of the uniform roadmap's sampler (unused by a query that flies the
     /// lattice's head route alone).
+    /// Another seed: another roadmap, another plan where the roadmap is used.
     pub seed: u64,
     /// Replans (dropped head edges) allowed without progress (the chain reaching a
     /// vertex farther along its way than before) before the roadmap grows.
+    /// More: more tries on the same roadmap before it grows, for time.
     pub max_replans: usize,
     /// Times a failing query may double the roadmap and try again.
+    /// More: harder queries solved, for up to `2^max_growth` times the roadmap.
     pub max_growth: usize,
     /// How strongly head paths avoid passing close to obstacles (0: shortest paths,
     /// as in the paper); see `super::roadmap::Roadmap::build`.
+    /// Higher: head paths farther from walls, longer.
     pub clearance_weight: f64,
     /// Step (m) of follow-the-leader motion (`super::follow`), tried after the library
     /// and before SRSConnect; 0 turns it off (the paper's planner).
+    /// Smaller: long chains pass tighter bends, for more steps and checks.
     pub follow_step: f64,
     /// Smallest clearance margin (m) the planner may give way to where a passage is
     /// narrower than the context's (preferred) clearance; 0 is docs/model.md's exact
     /// contract. Values above the preferred clearance are taken as it.
+    /// Higher: never closer to walls, fewer passages passed.
     pub clearance_min: f64,
     /// Search a head route over the half-cell lattice of the map (`super::lattice`) and add
     /// it to the roadmap before each query; off: the paper's uniform roadmap only.
+    /// Off: the paper's planner, slower and weaker in narrow passages.
     pub head_lattice: bool,
     /// Where a query edge cannot pass at the preferred clearance, the search first
     /// gives way to this share of the head's own margin along the edge (rounded down to
@@ -157,13 +172,16 @@ pub struct LatticeSettings {
     /// Lattice points the first, straight-line-guided search may touch before the
     /// coarse guide is built. Higher: more queries answered without the guide.
     pub quick_budget: usize,
-    /// Lattice points one search may touch (about 2 GB of search state at most).
+    /// Lattice points one search may touch.
+    /// More: routes found in larger maps, for time and memory (a few tens of bytes a
+    /// point).
     pub budget: usize,
     /// A string-pulled segment keeps the clearance of the points it replaces up to this
     /// much above the preferred radius (m). Higher: routes pulled less taut, kept wider.
     pub keep_cap: f64,
     /// Clearance (lattice spacings above the preferred radius) up to which a route
     /// point is centred, and the cap of what centring measures.
+    /// Larger: route points centred in wider passages, for exact measurements.
     pub centre_reach: f64,
     /// A route point is centred along lattice directions whose cosine with the route
     /// is at most this (about 70 degrees and more from it).

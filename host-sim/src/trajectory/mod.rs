@@ -122,14 +122,19 @@ impl Limits {
 #[serde(default, deny_unknown_fields)]
 pub struct Settings {
     /// The limits.
+    /// Higher limits: faster flights, harder to track.
     pub limits: Limits,
     /// Sample spacing (s), in `(0, 0.1]`.
+    /// Smaller: finer samples, more of them to check and store.
     pub dt: f64,
     /// Blend consecutive edges where admissible (false: stop at every waypoint).
+    /// Off: every waypoint a stop, the slowest flight, nothing to check beyond the
+    /// plan.
     pub blend: bool,
     /// Clearance (m) every body keeps from the map wherever the motion is not the
     /// plan's own (a blend, a merge), so that a controller's tracking error cannot turn
     /// a shortcut into a contact; the planner's default margin.
+    /// Larger: fewer blends and merges pass, longer flights.
     pub clearance: f64,
     /// How far (m) a run's straight move may carry any unit from where the plan has it
     /// at the run's inner waypoints: a fraction of the planner's clearance margin
@@ -142,10 +147,12 @@ pub struct Settings {
     /// (seed 2, threaded): 55 s of flight where `run_tolerance` gave 94 s.
     pub step_run_tolerance: f64,
     /// Longest translation (m) of a run of short steps (threading's steps are 2-4 cm).
+    /// Longer: more runs take the larger tolerance.
     pub short_step: f64,
     /// Most edges one run joins. More: longer merged moves, more work per run.
     pub max_run: usize,
     /// Shortest part of a translation (m) a pair is made with, or shrunk to.
+    /// Smaller: pairs made with shorter pieces, more of them tried.
     pub min_piece: f64,
     /// How often a failed pair flies half as much of its translation before it gives
     /// up. More: more pairs kept, more checks.
