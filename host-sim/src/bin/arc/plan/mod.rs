@@ -33,26 +33,26 @@ pub struct PlanArgs {
     #[command(flatten)]
     problem: ProblemArgs,
     /// Shape sources: both (the ARCplanner), lsc or srs (the paper's ablation).
-    #[arg(long, value_enum, default_value_t = Mode::Both)]
+    #[arg(long, value_enum, default_value_t = defaults().mode)]
     mode: Mode,
     /// Shape preference: least (change only when needed) or coverage (PN where it fits).
-    #[arg(long, value_enum, default_value_t = Preference::Least)]
+    #[arg(long, value_enum, default_value_t = defaults().prefer)]
     prefer: Preference,
     /// Seed of the uniform head roadmap (a query that flies the lattice's head route
     /// alone builds none, and the seed does not change its plan).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = defaults().seed)]
     seed: u64,
     /// Head roadmap vertices M_VT.
-    #[arg(long, default_value_t = 1500)]
+    #[arg(long, default_value_t = defaults().vertices)]
     vertices: usize,
     /// Head roadmap radius r_T (m).
-    #[arg(long, default_value_t = 1.5)]
+    #[arg(long, default_value_t = defaults().r_t)]
     r_t: f64,
     /// Most neighbours per head roadmap vertex (the nearest within r_T).
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = defaults().max_neighbours)]
     max_neighbours: usize,
     /// Headings tried per shape (n_psi).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = defaults().n_psi)]
     n_psi: usize,
     /// G_Val connection radius d_c (C_T metric) [default: r_S for N and N_SRS].
     #[arg(long)]
@@ -71,24 +71,24 @@ pub struct PlanArgs {
     clearance: f64,
     /// Smallest clearance margin (m) the planner may give way to, only along a passage
     /// narrower than --clearance allows (0: the exact contract of docs/model.md).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = defaults().clearance_min)]
     clearance_min: f64,
     /// Head route search over the map's half-cell lattice (off: the paper's uniform
     /// head roadmap only).
-    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    #[arg(long, default_value_t = defaults().head_lattice, action = clap::ArgAction::Set)]
     head_lattice: bool,
     /// Step (m) of follow-the-leader motion, where the body is laid back along the
     /// head's track (long chains through windows and doors); 0 turns it off (the paper).
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = defaults().follow_step)]
     follow_step: f64,
     /// Head edges the planner may drop without progress before it grows the roadmap.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = defaults().max_replans)]
     max_replans: usize,
     /// How strongly head paths keep away from obstacles (0: shortest, as in the paper).
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = defaults().clearance_weight)]
     clearance_weight: f64,
     /// Times a failing query may double the head roadmap and try again.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = defaults().max_growth)]
     max_growth: usize,
     /// Keep the plan as the search made it: no shortcuts, no merged translations or
     /// dropped shape changes (see `planner::refine`).
@@ -131,6 +131,11 @@ pub struct PlanArgs {
 /// The ids of the flags given on the command line (not left at their defaults): where
 /// a settings file and a flag both set a value, the flag wins.
 pub type Given = BTreeSet<String>;
+
+/// The planner's defaults, the flags' (a settings file's fields left out take the same).
+fn defaults() -> Settings {
+    Settings::default()
+}
 
 /// Smallest follow-the-leader step (m) other than 0 (off).
 const MIN_FOLLOW_STEP: f64 = 1e-3;
