@@ -399,6 +399,7 @@ pub fn plan(
             seed,
             ..Settings::default()
         },
+        refine: Default::default(),
         clearance,
         no_smooth: !smooth,
         time_limit_s: time_limit,

@@ -51,7 +51,9 @@ use nalgebra::{Point3, Vector3};
 
 use crate::map::distance::DistanceField;
 
-pub use verify::{verify_plan, verify_plan_with, EdgeKind, VerifyOptions, VerifyReport};
+pub use verify::{
+    verify_plan, verify_plan_with, EdgeKind, VerifyOptions, VerifyReport, SAMPLES_PER_VOXEL,
+};
 
 /// Default clearance margin added to every body's radius by the planner's checks (m).
 pub const DEFAULT_CLEARANCE: f64 = 0.05;

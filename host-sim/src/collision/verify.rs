@@ -23,6 +23,10 @@ use aerial_chain_core::ChainParams;
 /// Tolerance for "stays" when classifying an edge (docs/model.md).
 pub const STAY_TOLERANCE: f64 = 1e-9;
 
+/// The model's sampling rule (docs/model.md): no point of the chain moves more than
+/// `r_v / SAMPLES_PER_VOXEL` between two samples of an edge. A contract, not tuning.
+pub const SAMPLES_PER_VOXEL: f64 = 4.0;
+
 /// Most sample intervals one edge may need (a 2.5 km translation at 0.1 m).
 pub const MAX_INTERVALS: usize = 100_000;
 
@@ -98,7 +102,7 @@ pub fn edge_intervals(
     b: &[f64],
     resolution: f64,
 ) -> usize {
-    let step = resolution / 4.0;
+    let step = resolution / SAMPLES_PER_VOXEL;
     let travel = match kind {
         EdgeKind::Translation => {
             ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()

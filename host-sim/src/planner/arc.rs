@@ -21,6 +21,7 @@ use serde_json::Value;
 use super::construction::Construction;
 use super::motion::source_label;
 use super::roadmap::Roadmap;
+use super::RefineSettings;
 use super::{
     expired, lattice, PlanError, Planner, Query, Settings, Solution, SolutionStats, Step,
     Termination,
@@ -82,12 +83,6 @@ pub struct Stats {
     pub roadmap_edges: usize,
 }
 
-/// The search threads the quick route ([`ArcPlanner::threaded_on_route`]) where it
-/// passes an opening that leaves a unit less than this share of widening's reach
-/// (`super::widen::CAP`) in its middle: a window or a door, not a wide passage where a
-/// follower would turn through every corner of the route.
-const THREAD_OPENING: f64 = 0.9;
-
 /// The planner: a map context, a chain's shape tables, settings, and the roadmap.
 pub struct ArcPlanner {
     /// The map and chain at the preferred clearance.
@@ -100,6 +95,8 @@ pub struct ArcPlanner {
     /// Per SRS shape: the yaw from the head to the centroid of its units.
     pub(super) trail_yaw: Vec<f32>,
     pub(super) settings: Settings,
+    /// Post-processing's tuning, and threading's, which the search uses too.
+    pub(super) refine: RefineSettings,
     roadmap: Option<Roadmap>,
     roadmap_s: f64,
 }
@@ -126,7 +123,8 @@ impl ArcPlanner {
         let mut ctx_min = CollisionContext::new(ctx.field_arc().clone(), *ctx.params(), c_min)
             .map_err(|e| PlanError::StartInvalid(format!("clearance_min: {e}")))?;
         ctx_min.set_min_step(ctx.min_step());
-        let lattice = lattice::HeadLattice::new(&ctx, c_min, settings.clearance_weight);
+        let lattice =
+            lattice::HeadLattice::tuned(&ctx, c_min, settings.clearance_weight, settings.lattice);
         Ok(Self {
             ctx,
             ctx_min,
@@ -134,9 +132,22 @@ impl ArcPlanner {
             tables,
             trail_yaw,
             settings,
+            refine: RefineSettings::default(),
             roadmap: None,
             roadmap_s: 0.0,
         })
+    }
+
+    /// The planner with post-processing's tuning `refine` (default:
+    /// `RefineSettings::default()`), which also tunes the search's threading.
+    pub fn with_refine(mut self, refine: RefineSettings) -> Self {
+        self.refine = refine;
+        self
+    }
+
+    /// Post-processing's tuning.
+    pub fn refine_settings(&self) -> &RefineSettings {
+        &self.refine
     }
 
     /// Builds what every query needs before it starts: the uniform head roadmap
@@ -330,7 +341,7 @@ impl ArcPlanner {
         let construction = Construction::new(self, &mut roadmap, query, Some(inner), stop, began);
         match construction.without_replans().run() {
             Ok((_, stats))
-                if stats.min_margin < self.ctx.clearance_margin() - 1e-9
+                if stats.min_margin < self.ctx.clearance_margin() - super::numeric::TIE
                     && route.narrowest_margin >= self.ctx.clearance_margin() =>
             {
                 Ok(None)
@@ -344,7 +355,9 @@ impl ArcPlanner {
     /// The chain following its head along the route in `built`, straightened through
     /// the axis of each pinch (`super::thread`), where the chain could not fly the
     /// route with whole shapes and the route passes an opening that leaves a unit less
-    /// than [`THREAD_OPENING`] of widening's reach in its middle: at an oblique window
+    /// than `RefineSettings::thread.opening` of widening's reach (`super::widen::CAP`)
+    /// in its middle (a window or a door, not a wide passage where a follower would
+    /// turn through every corner of the route): at an oblique window
     /// the chain lines up with the opening and threads it, where the roadmap would
     /// sample the room for another way in. `None` where the route has no such opening
     /// or a step fails the checks.
@@ -361,8 +374,8 @@ impl ArcPlanner {
             .iter()
             .map(|&p| p.into())
             .collect();
-        let threading = super::thread::Threading::along(&self.ctx, &points)?;
-        if threading.narrowest_middle() >= THREAD_OPENING * super::widen::CAP {
+        let threading = super::thread::Threading::along(&self.ctx, &points, &self.refine.thread)?;
+        if threading.narrowest_middle() >= self.refine.thread.opening * super::widen::CAP {
             return None;
         }
         let (steps, checks) = threading.follow(

@@ -52,7 +52,7 @@ pub fn headings(edge_yaw: f32, n_psi: usize) -> impl Iterator<Item = f32> {
 pub fn rotations(current: &Shape, edge_yaw: f32, n_psi: usize) -> Vec<Candidate> {
     let mut out: Vec<Candidate> = headings(edge_yaw, n_psi)
         .map(|h| current.rotated(aerial_chain_core::angle::diff(current.head_yaw(), h)))
-        .filter(|s| s.max_angle_diff(current) > 1e-4)
+        .filter(|s| s.max_angle_diff(current) > super::numeric::DISTINCT_SHAPE)
         .map(|shape| Candidate {
             shape,
             source: Source::Rotation,

@@ -9,6 +9,8 @@
 //! the stretch rigidly, on a head route of its own that keeps its body clear of the
 //! bays' walls and the gaps' ends: one change into it, one back (none at the goal).
 //!
+//! The numbers below are the defaults of `CarrySettings` (docs/settings.md).
+//!
 //! Every library shape at eight headings, the start's head yaw held
 //! (`super::shorten`), is a candidate. For each:
 //! 1. **Span.** The first waypoint `i` where the chain can change into it, and the
@@ -48,42 +50,18 @@ use nalgebra::{Point3, Vector3};
 
 use super::candidates::{headings, Source};
 use super::lattice::{offsets26, KeyHasher};
+use super::numeric::{SAME_HEADING, TIE};
 use super::refine::{differs, shape_motion, Quality};
-use super::{Checker, Step};
+use super::{CarrySettings, Checker, Step};
 
-/// Plans with fewer shape changes are left as they are: carrying replaces changes by
-/// at most two, and shortening already makes one or two changes as small as they go.
-const MIN_CHANGES: usize = 3;
+/// Costs of the search are kept in micrometres, so that its heap orders integers: an
+/// encoding, not tuning (a micrometre is far below any step of the lattice).
+const PER_MICROMETRE: f64 = 1e6;
 
-/// Headings tried per library shape.
-const HEADINGS: usize = 8;
-
-/// Placements a shape's search may check.
-const SEARCH_POINTS: usize = 25_000;
-
-/// Placements all shapes' searches together may check.
-const TOTAL_POINTS: usize = 80_000;
-
-/// The search keeps within this distance (m) of its guide.
-const TUBE: f64 = 1.0;
-
-/// Lattice spacings tried, in map resolutions: coarse, then fine.
-const SPACINGS: [f64; 2] = [2.0, 1.0];
-
-/// Weight of the guide's estimate in the search: above 1, the search heads along the
-/// guide and checks fewer points, for a path that may be longer (the taut pull and
-/// the detour bound deal with that).
-const GREED: f64 = 2.0;
-
-/// The fit is tested at route points at least this far apart (m).
-const FIT_SPACING: f64 = 0.3;
-
-/// Motion (rad) carrying must save to be taken.
-const SAVING: f64 = 1e-3;
-
-/// A carried plan's head path may be at most this much longer than the plan's (m,
-/// and share): a long detour costs more flight than the shape changes it saves.
-const DETOUR: (f64, f64) = (1.0, 1.25);
+/// The search tries the goal once it is within this many lattice spacings: derived,
+/// one diagonal step of the lattice (`sqrt 2` spacings, rounded up to a half), so that
+/// a search that reaches the goal's cell by any in-plane step tries it.
+const GOAL_REACH: f64 = 1.5;
 
 /// A stretch of a plan flown in one library shape.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -111,25 +89,26 @@ pub(super) fn carried(
     checker: &mut Checker,
     library: &[LscEntry],
     steps: &[Step],
+    s: &CarrySettings,
 ) -> Option<(Vec<Step>, Carried)> {
-    if Quality::of(steps).shape_changes < MIN_CHANGES {
+    if Quality::of(steps).shape_changes < s.min_changes {
         return None;
     }
-    let mut tried = takeovers(checker, library, steps);
+    let mut tried = takeovers(checker, library, steps, s);
     // The coarse lattice first; where it found no way at all (rather than running out
     // of placements), the fine one may pass a spot the coarse one steps over.
     let r_v = checker.ctx.field().grid().resolution();
     let mut spent = 0;
-    for spacing in SPACINGS {
+    for spacing in s.spacings {
         let mut closed = Vec::new();
         for t in tried {
-            if spent >= TOTAL_POINTS {
+            if spent >= s.total_points {
                 return None;
             }
             let route = head_route(&steps[t.i..=t.j]);
-            let guide = Guide::new(&route, middle(checker, &t.x));
-            let budget = SEARCH_POINTS.min(TOTAL_POINTS - spent);
-            let (found, used) = search(checker, &guide, &t.x, spacing * r_v, budget);
+            let guide = Guide::new(&route, middle(checker, &t.x), s.tube);
+            let budget = s.search_points.min(s.total_points - spent);
+            let (found, used) = search(checker, &guide, &t.x, spacing * r_v, budget, s.greed);
             spent += used;
             let path = match found {
                 Found::Path(path) => path,
@@ -145,7 +124,7 @@ pub(super) fn carried(
             let length =
                 |p: &[Point3<f64>]| p.windows(2).map(|w| (w[1] - w[0]).norm()).sum::<f64>();
             let head_path_m = length(&path);
-            if head_path_m > DETOUR.0 + DETOUR.1 * length(&route) {
+            if head_path_m > s.detour_m + s.detour_share * length(&route) {
                 continue;
             }
             let carried = Carried {
@@ -162,18 +141,23 @@ pub(super) fn carried(
 
 /// Every library shape that could take over somewhere in the plan and fits along the
 /// route there, the largest saving first.
-fn takeovers(checker: &mut Checker, library: &[LscEntry], steps: &[Step]) -> Vec<Takeover> {
+fn takeovers(
+    checker: &mut Checker,
+    library: &[LscEntry],
+    steps: &[Step],
+    s: &CarrySettings,
+) -> Vec<Takeover> {
     // Shape motion of the plan up to each waypoint.
     let mut upto = vec![0.0; steps.len()];
     for k in 1..steps.len() {
         upto[k] = upto[k - 1] + shape_motion(&steps[k - 1].shape, &steps[k].shape);
     }
     let mut out = Vec::new();
-    for (x, kind) in shapes(library, &steps[0].shape) {
-        let Some((i, j, saving)) = span(checker, steps, &upto, &x) else {
+    for (x, kind) in shapes(library, &steps[0].shape, s.headings) {
+        let Some((i, j, saving)) = span(checker, steps, &upto, &x, s.saving) else {
             continue;
         };
-        if fits_along(checker, &head_route(&steps[i..=j]), &x) {
+        if fits_along(checker, &head_route(&steps[i..=j]), &x, s.fit_spacing) {
             out.push(Takeover {
                 saving,
                 i,
@@ -196,6 +180,7 @@ fn span(
     steps: &[Step],
     upto: &[f64],
     x: &Shape,
+    saving: f64,
 ) -> Option<(usize, usize, f64)> {
     let last = steps.len() - 1;
     let into = |k: usize| shape_motion(&steps[k].shape, x);
@@ -208,12 +193,12 @@ fn span(
     };
     // A change at `i` can only pay where the rest of the plan moves more than it.
     let i = (0..last).find(|&i| {
-        into(i) + SAVING < upto[last] - upto[i]
+        into(i) + saving < upto[last] - upto[i]
             && checker.placement(steps[i].xi, x)
             && checker.shape_change(steps[i].xi, &steps[i].shape, x)
     })?;
     let j = (i + 1..=last).rev().find(|&j| {
-        into(i) + back(j) + SAVING < upto[j] - upto[i]
+        into(i) + back(j) + saving < upto[j] - upto[i]
             && checker.placement(steps[j].xi, x)
             && (j == last || checker.shape_change(steps[j].xi, x, &steps[j].shape))
     })?;
@@ -258,7 +243,7 @@ fn splice(
 fn head_route(steps: &[Step]) -> Vec<Point3<f64>> {
     let mut route: Vec<Point3<f64>> = Vec::with_capacity(steps.len());
     for s in steps {
-        if route.last().is_none_or(|p| (s.xi - p).norm() > 1e-9) {
+        if route.last().is_none_or(|p| (s.xi - p).norm() > TIE) {
             route.push(s.xi);
         }
     }
@@ -267,15 +252,16 @@ fn head_route(steps: &[Step]) -> Vec<Point3<f64>> {
 
 /// The library's shapes at every heading, the start's head yaw held, least motion
 /// from `start` first (ties keep the library's order), each once.
-fn shapes(library: &[LscEntry], start: &Shape) -> Vec<(Shape, LscKind)> {
+/// (`headings` per shape).
+fn shapes(library: &[LscEntry], start: &Shape, headings_per_shape: usize) -> Vec<(Shape, LscKind)> {
     let mut out: Vec<(f64, Shape, LscKind)> = Vec::new();
     for e in library {
-        for h in headings(0.0, HEADINGS) {
+        for h in headings(0.0, headings_per_shape) {
             let mut x = e
                 .shape
                 .rotated(aerial_chain_core::angle::diff(e.shape.head_yaw(), h));
             x.set_head_yaw(start.head_yaw());
-            let same = out.iter().any(|o| o.1.max_angle_diff(&x) <= 1e-5);
+            let same = out.iter().any(|o| o.1.max_angle_diff(&x) <= SAME_HEADING);
             if !same {
                 out.push((shape_motion(start, &x), x, e.kind));
             }
@@ -297,12 +283,12 @@ fn middle(checker: &Checker, x: &Shape) -> Vector3<f64> {
     (lo + hi) / 2.0
 }
 
-/// Whether the chain in shape `x` can be at every point of the route, [`FIT_SPACING`]
-/// apart (the tightest, where the head is nearest the map, first): some unit at the
+/// Whether the chain in shape `x` can be at every point of the route, `fit_spacing`
+/// (m) apart (the tightest, where the head is nearest the map, first): some unit at the
 /// point or one map resolution from it along or across the axes, the rest of the body
 /// clear. A carried chain takes its body through every passage the route takes its
 /// head through; this turns away, before any search, a shape that is too wide for one.
-fn fits_along(checker: &mut Checker, route: &[Point3<f64>], x: &Shape) -> bool {
+fn fits_along(checker: &mut Checker, route: &[Point3<f64>], x: &Shape, fit_spacing: f64) -> bool {
     let r_v = checker.ctx.field().grid().resolution();
     let mut samples: Vec<(f64, Point3<f64>)> = Vec::new();
     for w in route.windows(2) {
@@ -316,7 +302,7 @@ fn fits_along(checker: &mut Checker, route: &[Point3<f64>], x: &Shape) -> bool {
     let units = offsets(checker.ctx.params(), x);
     let mut tested: Vec<Point3<f64>> = Vec::new();
     for &(_, p) in &samples {
-        if tested.iter().any(|t| (t - p).norm() < FIT_SPACING) {
+        if tested.iter().any(|t| (t - p).norm() < fit_spacing) {
             continue;
         }
         tested.push(p);
@@ -340,10 +326,12 @@ struct Guide {
     points: Vec<Point3<f64>>,
     /// Length of the guide from each point to its end.
     rest: Vec<f64>,
+    /// The search keeps within this distance (m) of the guide.
+    tube: f64,
 }
 
 impl Guide {
-    fn new(route: &[Point3<f64>], centre: Vector3<f64>) -> Self {
+    fn new(route: &[Point3<f64>], centre: Vector3<f64>, tube: f64) -> Self {
         let last = route.len() - 1;
         let points: Vec<Point3<f64>> = route
             .iter()
@@ -354,7 +342,7 @@ impl Guide {
         for k in (0..last).rev() {
             rest[k] = rest[k + 1] + (points[k + 1] - points[k]).norm();
         }
-        Self { points, rest }
+        Self { points, rest, tube }
     }
 
     fn goal(&self) -> Point3<f64> {
@@ -362,7 +350,7 @@ impl Guide {
     }
 
     /// Estimated way left from `p`: to the nearest point of the guide, then along the
-    /// guide to its end; `None` beyond [`TUBE`] from the guide.
+    /// guide to its end; `None` beyond its tube from the guide.
     fn estimate(&self, p: &Point3<f64>) -> Option<f64> {
         // (distance to the guide, way left from there)
         let mut best = ((self.goal() - p).norm(), 0.0);
@@ -379,7 +367,7 @@ impl Guide {
                 best = (near, self.rest[k + 1] + (1.0 - t) * len2.sqrt());
             }
         }
-        (best.0 <= TUBE).then_some(best.0 + best.1)
+        (best.0 <= self.tube).then_some(best.0 + best.1)
     }
 }
 
@@ -426,12 +414,13 @@ fn search(
     x: &Shape,
     h: f64,
     budget: usize,
+    greed: f64,
 ) -> (Found, usize) {
     let origin = guide.points[0];
     let goal = guide.goal();
     let at = |k: [i32; 3]| origin + Vector3::new(k[0] as f64, k[1] as f64, k[2] as f64) * h;
     // Costs in micrometres, so that the heap orders integers.
-    let scale = 1e6;
+    let scale = PER_MICROMETRE;
     let mut points: HashMap<u64, Point, BuildHasherDefault<KeyHasher>> = HashMap::default();
     let mut open = BinaryHeap::new();
     let start = Point {
@@ -471,7 +460,7 @@ fn search(
             }
         }
         pt.done = true;
-        if (goal - p).norm() <= 1.5 * h && checker.translation(p, goal, x) {
+        if (goal - p).norm() <= GOAL_REACH * h && checker.translation(p, goal, x) {
             let mut path = vec![goal, p];
             let mut c = k;
             while c != [0; 3] {
@@ -488,7 +477,7 @@ fn search(
                 let estimate = guide.estimate(&at(n));
                 Point {
                     g: u64::MAX,
-                    estimate: estimate.map_or(0, |e| (GREED * e * scale) as u64),
+                    estimate: estimate.map_or(0, |e| (greed * e * scale) as u64),
                     from: k,
                     // Beyond the tube round the guide: left alone, as if blocked.
                     clear: estimate.is_none().then_some(false),

@@ -8,6 +8,11 @@ use crate::collision::CollisionContext;
 use crate::map::grid::{Cell, Grid};
 use crate::map::DistanceField;
 
+/// The default tuning.
+fn d() -> CarrySettings {
+    CarrySettings::default()
+}
+
 /// A free box 6 m x 4 m x 3 m at 0.1 m, with a 0.2 m wall across x at x = 3 and a
 /// 0.6 m square window in it centred at y = 2, z = 1.5 (no wall when `wall` is false).
 fn room(wall: bool) -> CollisionContext {
@@ -58,8 +63,8 @@ fn a_restless_plan_in_open_space_is_flown_in_its_start_shape() {
     let lsc = library(ctx.params()).entries;
     let mut checker = Checker::new(ctx.clone(), None);
     let steps = restless_plan();
-    assert!(Quality::of(&steps).shape_changes >= MIN_CHANGES);
-    let (out, carried) = carried(&mut checker, &lsc, &steps).expect("the line flies it all");
+    assert!(Quality::of(&steps).shape_changes >= d().min_changes);
+    let (out, carried) = carried(&mut checker, &lsc, &steps, &d()).expect("the line flies it all");
     assert_eq!(carried.kind, LscKind::Li);
     // No change at all: the line is the start shape, and the goal needs none.
     assert_eq!(Quality::of(&out).shape_changes, 0);
@@ -76,7 +81,7 @@ fn a_carried_plan_passes_the_checks_through_a_window() {
     let lsc = library(ctx.params()).entries;
     let mut checker = Checker::new(ctx.clone(), None);
     let steps = restless_plan();
-    let (out, _) = carried(&mut checker, &lsc, &steps).expect("a line passes the window");
+    let (out, _) = carried(&mut checker, &lsc, &steps, &d()).expect("a line passes the window");
     assert_carried_plan_holds(&ctx, &steps, &out);
 }
 
@@ -106,7 +111,7 @@ fn assert_carried_plan_holds(ctx: &CollisionContext, steps: &[Step], out: &[Step
         assert!(edge_passes(ctx, w), "{w:?}");
     }
     let motion = |s: &[Step]| Quality::of(s).shape_motion_rad;
-    assert!(motion(out) + SAVING < motion(steps));
+    assert!(motion(out) + d().saving < motion(steps));
 }
 
 /// A plan along `y` through the window room: from x = 2 it bends at each of `before`
@@ -159,7 +164,7 @@ proptest::proptest! {
         proptest::prop_assume!(valid);
         let lsc = library(ctx.params()).entries;
         let mut checker = Checker::new(ctx.clone(), None);
-        if let Some((out, carried)) = carried(&mut checker, &lsc, &steps) {
+        if let Some((out, carried)) = carried(&mut checker, &lsc, &steps, &d()) {
             assert_carried_plan_holds(&ctx, &steps, &out);
             proptest::prop_assert!(carried.head_path_m > 0.0);
         }
@@ -179,7 +184,7 @@ fn plans_with_few_changes_are_left_alone() {
         step(3.0, line, true),
         step(4.0, line, false),
     ];
-    assert!(carried(&mut checker, &lsc, &steps).is_none());
+    assert!(carried(&mut checker, &lsc, &steps, &d()).is_none());
 }
 
 #[test]
@@ -188,9 +193,14 @@ fn a_shape_across_the_window_does_not_fit_and_one_along_it_does() {
     let mut checker = Checker::new(ctx, None);
     let route = [Point3::new(2.0, 2.0, 1.5), Point3::new(4.5, 2.0, 1.5)];
     // Trailing along -x passes end first; trailing along -y lies across the window.
-    assert!(fits_along(&mut checker, &route, &Shape::line(4, 0.0)));
+    assert!(fits_along(
+        &mut checker,
+        &route,
+        &Shape::line(4, 0.0),
+        d().fit_spacing
+    ));
     let across = Shape::line(4, std::f32::consts::FRAC_PI_2);
-    assert!(!fits_along(&mut checker, &route, &across));
+    assert!(!fits_along(&mut checker, &route, &across, d().fit_spacing));
 }
 
 #[test]
@@ -202,7 +212,7 @@ fn the_guide_estimates_the_way_left_within_its_tube() {
         Point3::new(4.0, 2.0, 0.0),
     ];
     // The middle of a shape 0.5 m behind its head along -x.
-    let guide = Guide::new(&route, Vector3::new(-0.5, 0.0, 0.0));
+    let guide = Guide::new(&route, Vector3::new(-0.5, 0.0, 0.0), d().tube);
     // The start and the goal stay; the points between follow the shape's middle.
     assert_eq!(guide.points[0], route[0]);
     assert_eq!(guide.points[3], route[3]);
@@ -235,7 +245,7 @@ fn library_shapes_come_once_each_least_motion_first() {
     let params = ChainParams::new(4);
     let lsc = library(&params).entries;
     let start = Shape::line(4, 0.3);
-    let shapes = shapes(&lsc, &start);
+    let shapes = shapes(&lsc, &start, d().headings);
     let motion: Vec<f64> = shapes.iter().map(|s| shape_motion(&start, &s.0)).collect();
     assert!(motion.windows(2).all(|w| w[0] <= w[1]));
     assert!(shapes.iter().all(|s| s.0.head_yaw() == start.head_yaw()));
@@ -264,10 +274,24 @@ fn a_slot_between_coarse_lattice_points_is_closed_there_and_found_on_the_fine_on
     let mut checker = Checker::new(ctx.clone(), None);
     let line = Shape::line(2, 0.0);
     let route = [Point3::new(2.0, 1.9, 1.5), Point3::new(4.5, 2.05, 1.5)];
-    let guide = Guide::new(&route, Vector3::zeros());
-    let (coarse, _) = search(&mut checker, &guide, &line, 0.1, SEARCH_POINTS);
+    let guide = Guide::new(&route, Vector3::zeros(), d().tube);
+    let (coarse, _) = search(
+        &mut checker,
+        &guide,
+        &line,
+        0.1,
+        d().search_points,
+        d().greed,
+    );
     assert!(matches!(coarse, Found::Closed));
-    let (fine, _) = search(&mut checker, &guide, &line, 0.05, SEARCH_POINTS);
+    let (fine, _) = search(
+        &mut checker,
+        &guide,
+        &line,
+        0.05,
+        d().search_points,
+        d().greed,
+    );
     let Found::Path(path) = fine else {
         panic!("the fine lattice passes the slot");
     };

@@ -9,6 +9,7 @@ use nalgebra::Point3;
 
 use super::candidates::{self, Candidate, Source};
 use super::construction::{Construction, Leg};
+use super::numeric::{DISTINCT_SHAPE, PER_MILLIMETRE, TINY, TINY_F32};
 use super::roadmap::VertexId;
 use super::{follow, srs_connect, Mode, Preference};
 use crate::collision::CollisionContext;
@@ -26,11 +27,12 @@ impl Construction<'_> {
         if !(c_min < c_pref && self.roadmap.is_query(v) && self.roadmap.is_query(u)) {
             return None;
         }
-        // Give way step by step: first to 90 % of the head's own margin along the
+        // Give way step by step: first to `give_way_share` of the head's own margin along the
         // edge (what the passage leaves on its narrowest side), then to the floor.
         let (a, b) = (self.roadmap.point(v), self.roadmap.point(u));
         let head = head_margin(&p.ctx, a, b);
-        let mid = ((0.9 * head * 1000.0).floor() / 1000.0).clamp(c_min, c_pref);
+        let share = p.settings.give_way_share;
+        let mid = ((share * head * PER_MILLIMETRE).floor() / PER_MILLIMETRE).clamp(c_min, c_pref);
         let mut levels = vec![(mid, None)];
         if mid > c_min {
             levels.push((c_min, Some(p.ctx_min.clone())));
@@ -126,7 +128,7 @@ impl Construction<'_> {
             let q = [0, 1, 2].map(|i| a[i] + t * (b[i] - a[i]));
             let laid = follow::lay_along_newest_last(&params, &track);
             let mut changes = Vec::new();
-            if laid.max_angle_diff(&shape) > 1e-4 {
+            if laid.max_angle_diff(&shape) > DISTINCT_SHAPE {
                 let ok =
                     self.checker.config(p, &laid) && self.checker.shape_change(p, &shape, &laid);
                 if !ok {
@@ -167,7 +169,7 @@ impl Construction<'_> {
             if st.source == Source::Follow && length < need {
                 let last = track.last().expect("track starts at a");
                 let d = (v(st.xi) - last).norm();
-                if d > 1e-6 {
+                if d > TINY_F32 {
                     length += d as f64;
                     track.push(v(st.xi));
                 }
@@ -243,7 +245,7 @@ impl Construction<'_> {
 /// A lower bound on the head unit's margin (distance to the map minus `r_u`) along
 /// the segment `a b`, sampled every quarter voxel (m, at least 0).
 fn head_margin(ctx: &CollisionContext, a: [f64; 3], b: [f64; 3]) -> f64 {
-    let step = ctx.field().grid().resolution() / 4.0;
+    let step = ctx.field().grid().resolution() / crate::collision::SAMPLES_PER_VOXEL;
     let n = (super::dist(a, b) / step).ceil().max(1.0) as usize;
     let r_u = ctx.params().unit_radius as f64;
     (0..=n)
@@ -258,7 +260,7 @@ fn head_margin(ctx: &CollisionContext, a: [f64; 3], b: [f64; 3]) -> f64 {
 
 /// The yaw of the edge `a -> b`; for a vertical edge, the shape's own heading.
 fn edge_yaw(a: [f64; 3], b: [f64; 3], shape: &Shape) -> f32 {
-    if (b[0] - a[0]).hypot(b[1] - a[1]) > 1e-6 {
+    if (b[0] - a[0]).hypot(b[1] - a[1]) > TINY {
         (b[1] - a[1]).atan2(b[0] - a[0]) as f32
     } else {
         shape.head_yaw()

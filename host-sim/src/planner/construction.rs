@@ -19,9 +19,6 @@ use super::candidates::{Candidate, Source};
 use super::roadmap::{Roadmap, RouteError, VertexId};
 use super::{Checker, PlanError, Query, Step, Termination};
 
-/// Edges that may fail from one vertex before the chain backs up from it.
-const FAILS_BEFORE_BACKING_UP: usize = 4;
-
 /// One leg of a head edge: shape changes where the head is, then a translation.
 pub(super) struct Leg {
     /// Shape changes where the head is.
@@ -173,7 +170,7 @@ impl<'p> Construction<'p> {
                     });
                 }
                 let here = trail.last().map(|t| t.0).unwrap_or(self.start);
-                let stuck = fails[here] >= FAILS_BEFORE_BACKING_UP && trail.len() > 1;
+                let stuck = fails[here] >= self.planner.settings.backtrack_after && trail.len() > 1;
                 let route = if stuck {
                     Err(PlanError::Unreachable { tol: 0.0 })
                 } else {

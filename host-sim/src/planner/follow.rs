@@ -12,9 +12,25 @@ use aerial_chain_core::kinematics::link_direction;
 use aerial_chain_core::{ChainParams, Shape};
 use nalgebra::Vector3;
 
+use super::numeric::DIV_GUARD_F32;
+
 /// How far inside the pitch limit a clamped link stays (rad): a controller tracking a
 /// shape right at the limit would overshoot it.
+///
+/// Tuning left a constant: the shapes laid here are made by free functions that the
+/// search, threading and connecting share, and a margin is a property of the shapes
+/// (like the model's limit it keeps), not of a query.
 const PITCH_MARGIN: f32 = 0.02;
+
+/// A sharp corner of a track is cut at this share of its two segments.
+///
+/// Tuning left a constant, as [`PITCH_MARGIN`]: a quarter keeps three quarters of
+/// each segment, so the cut line loses little length and stays near the track.
+const CORNER_CUT: f32 = 0.25;
+
+/// Slack (share of a link, over the segment's length) by which a unit may lie past a
+/// segment's end: rounding of `f32` positions, not tuning.
+const ROUNDING_SLACK: f32 = 1e-4;
 
 /// The shape whose units lie on `track` (head at `track[0]`, then back along the
 /// polyline), each `l` from the one before; past the track's end the chain goes on
@@ -132,10 +148,10 @@ pub fn cut_sharp_corners(line: &[Vector3<f32>], max_turn: f32) -> Vec<Vector3<f3
     for w in line.windows(3) {
         let (a, b, c) = (w[0], w[1], w[2]);
         let (u, v) = (b - a, c - b);
-        let cos = u.dot(&v) / (u.norm() * v.norm()).max(1e-12);
+        let cos = u.dot(&v) / (u.norm() * v.norm()).max(DIV_GUARD_F32);
         if cos < max_turn.cos() {
-            out.push(b + 0.25 * (a - b));
-            out.push(b + 0.25 * (c - b));
+            out.push(b + CORNER_CUT * (a - b));
+            out.push(b + CORNER_CUT * (c - b));
         } else {
             out.push(b);
         }
@@ -170,7 +186,7 @@ fn next_unit(track: Track, along: &mut Along, prev: &Place, l: f32) -> Option<Pl
         let (a, b) = (track.at(i), track.at(i + 1));
         let d = b - a;
         let dd = d.norm_squared();
-        if dd < 1e-12 {
+        if dd < DIV_GUARD_F32 {
             continue;
         }
         // |a + t d - c|^2 = l^2, both roots.
@@ -183,7 +199,7 @@ fn next_unit(track: Track, along: &mut Along, prev: &Place, l: f32) -> Option<Pl
         let lo = if i == prev.seg { prev.t } else { 0.0 };
         // A body laid along the track before has its units exactly on the track's
         // vertices: rounding must not push them past the segment's end.
-        let slack = 1e-4 * l / dd.sqrt();
+        let slack = ROUNDING_SLACK * l / dd.sqrt();
         for t in [(-bh - disc.sqrt()) / dd, (-bh + disc.sqrt()) / dd] {
             if t < lo || t > 1.0 + slack {
                 continue;

@@ -30,7 +30,9 @@ mod goal_pose;
 pub(crate) mod graph;
 pub(crate) mod lattice;
 pub(crate) mod motion;
+mod numeric;
 pub(crate) mod refine;
+mod refine_settings;
 pub(crate) mod roadmap;
 mod settings;
 mod shorten;
@@ -50,7 +52,10 @@ pub(crate) use checker::Checker;
 pub use error::PlanError;
 pub use motion::{annotate_quality, source_label, to_plan};
 pub use refine::{Quality, Refinement};
-pub use settings::{Mode, Preference, Settings};
+pub use refine_settings::{
+    CarrySettings, RefineSettings, ShortenSettings, ThreadSettings, WidenSettings,
+};
+pub use settings::{LatticeSettings, Mode, Preference, SettingError, Settings};
 pub use widen::{Widening, CAP as WIDEN_CAP};
 
 use crate::collision::CollisionContext;

@@ -34,44 +34,8 @@ use super::widen::Widening;
 use super::{ArcPlanner, Checker, Solution, Stats, Step};
 use crate::collision::CollisionContext;
 
-/// Collision checks refinement may spend on one plan. At a few microseconds each
-/// this bounds the pass to tens of milliseconds; what is left unrefined when it
-/// runs out stays as the search made it.
-pub const CHECK_BUDGET: u64 = 20_000;
-
-/// How much of the widened plan's clearance post-processing may give back (m): the
-/// checks are conservative, so a margin exactly at the plan's clearance could refuse
-/// the plan's own edges.
-const KEEP_SLACK: f64 = 0.005;
-
-/// A margin less than this (m) above the search's is not worth keeping: it would
-/// refuse shortcuts for next to no clearance.
-const KEEP_GAIN: f64 = 0.025;
-
-/// Post-processing that keeps a widened passage's margin is taken unless it asks for
-/// more than this share of the shape motion of post-processing that does not.
-const KEEP_MOTION: f64 = 1.02;
-
-/// A threaded plan is taken when its worst pinch keeps at least this much larger a
-/// share of the pinch middle's clearance than the other plan,
-const THREAD_GAIN: f64 = 0.01;
-
-/// and at least this share: where threading cannot pass every pinch nearly as well
-/// as its middle (`maze` and `corridor`, whose pinches are the route's turns, reach
-/// 0.4-0.7), it is not worth its shape motion. (The passages issue asks for 0.9 of
-/// the nominal opening; a voxelized opening is often wider, and threaded plans
-/// through the hard-case family's openings keep 0.85-0.9 of the voxels' middle
-/// where they meet it.)
-const THREAD_SHARE: f64 = 0.8;
-
-/// and it moves the angles by no more than this (rad) per link beyond the other plan:
-/// an eighth of a turn, the price of lining the chain up with an opening it would
-/// otherwise cross at an angle. (On `maze` and `corridor` threading follows every
-/// turn of the route, for little or no gain in clearance.)
-const THREAD_MOTION: f64 = std::f64::consts::FRAC_PI_4;
-
-/// Angles closer than this (rad) are the same shape: no shape change is needed.
-const SAME_SHAPE: f32 = 1e-6;
+use super::numeric::{SAME_SHAPE, TIE, TINY};
+use super::RefineSettings;
 
 /// What a plan asks of the chain: the measures the flight time depends on.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -147,7 +111,8 @@ pub(super) fn differs(a: &Shape, b: &Shape) -> bool {
 
 impl ArcPlanner {
     /// Refines a solved query's plan (see the module docs), then shortens its shape
-    /// motion (`super::shorten`), both within `CHECK_BUDGET` checks, then flies a
+    /// motion (`super::shorten`), both within `RefineSettings::check_budget` checks,
+    /// then flies a
     /// stretch of it in one library shape where that moves the angles less
     /// (`super::carry`), then widens its narrow passages (`super::widen`), and takes
     /// the search's route threaded instead where that passes them nearer their middle
@@ -167,6 +132,7 @@ impl ArcPlanner {
             ctx_min: &self.ctx_min,
             lsc: &self.tables.lsc,
             follow_step: self.settings.follow_step,
+            s: &self.refine,
         };
         // Threading depends on the search's plan alone until it is compared with the
         // other stages' result, so it is made beside them (rayon: on another core
@@ -206,12 +172,14 @@ impl ArcPlanner {
 }
 
 /// What post-processing reads of the planner (which itself is not shared between
-/// threads): the contexts it checks in, the library shapes, the follow step.
+/// threads): the contexts it checks in, the library shapes, the follow step, the
+/// tuning.
 struct Post<'a> {
     ctx: &'a CollisionContext,
     ctx_min: &'a CollisionContext,
     lsc: &'a [LscEntry],
     follow_step: f64,
+    s: &'a RefineSettings,
 }
 
 impl Post<'_> {
@@ -227,10 +195,11 @@ impl Post<'_> {
             checker: Checker::new(ctx.clone(), deadline),
             poses,
             checks: 0,
+            s: self.s,
         };
         let steps = pass.run();
         let steps = pass.shrink_changes(steps);
-        let steps = super::shorten::shorten(&mut pass, steps);
+        let steps = super::shorten::shorten(&mut pass, steps, self.s);
         (steps, pass.checks)
     }
 
@@ -245,8 +214,13 @@ impl Post<'_> {
         // free (or run after it).
         let ((widened, first, kept), (plain, mut checks)) = rayon::join(
             || {
-                let (widened, first) =
-                    super::widen::widen(self.ctx, self.ctx_min, raw.to_vec(), deadline);
+                let (widened, first) = super::widen::widen(
+                    self.ctx,
+                    self.ctx_min,
+                    raw.to_vec(),
+                    deadline,
+                    &self.s.widen,
+                );
                 let kept = self.keep_margin(first.in_passages).map(|ctx| {
                     let (steps, spent) = self.shortcut(&ctx, &widened, deadline);
                     (steps, spent, ctx)
@@ -259,16 +233,17 @@ impl Post<'_> {
         if let Some((kept, spent, ctx)) = kept {
             checks += spent;
             let motion = |s: &[Step]| Quality::of(s).shape_motion_rad;
-            if motion(&kept) <= motion(&chosen.0) * KEEP_MOTION + 1e-9 {
+            if motion(&kept) <= motion(&chosen.0) * self.s.keep_motion + TIE {
                 chosen = (kept, ctx, Some(first.moves));
             }
         }
         let mut carrier = Checker::new(chosen.1.clone(), deadline);
-        let carried =
-            super::carry::carried(&mut carrier, self.lsc, &chosen.0).map(|(steps, carried)| {
+        let carried = super::carry::carried(&mut carrier, self.lsc, &chosen.0, &self.s.carry).map(
+            |(steps, carried)| {
                 chosen.0 = steps;
                 carried
-            });
+            },
+        );
         let (steps, ctx, first_moves) = chosen;
         Chosen {
             steps,
@@ -294,7 +269,7 @@ impl Post<'_> {
         if chosen.first_moves.is_none() && steps == raw {
             (std::mem::take(&mut chosen.widened), chosen.first)
         } else {
-            super::widen::widen(&chosen.ctx, self.ctx_min, steps, deadline)
+            super::widen::widen(&chosen.ctx, self.ctx_min, steps, deadline, &self.s.widen)
         }
     }
 
@@ -302,7 +277,7 @@ impl Post<'_> {
     /// passes the route's pinches; `None` where the route has no pinch or the chain
     /// cannot follow it.
     fn threading(&self, raw: &[Step], deadline: Option<Instant>) -> Option<Threaded> {
-        let threading = super::thread::Threading::of(self.ctx, raw)?;
+        let threading = super::thread::Threading::of(self.ctx, raw, &self.s.thread)?;
         let (steps, _) = threading.follow(self.ctx, &raw[0], self.follow_step, deadline)?;
         let passing = threading.measure(self.ctx, &steps, true);
         Some(Threaded {
@@ -314,8 +289,8 @@ impl Post<'_> {
 
     /// The threaded plan, where `steps` passes some pinch of the route off its middle
     /// (below the share widening aims for) and the threaded plan passes every pinch
-    /// nearer its middle ([`THREAD_GAIN`], [`THREAD_SHARE`]) for little more shape
-    /// motion ([`THREAD_MOTION`]); else `steps`. Whether the threaded plan was taken
+    /// nearer its middle (`ThreadSettings::gain`, `share`) for little more shape
+    /// motion (`motion`); else `steps`. Whether the threaded plan was taken
     /// is the last of the three.
     fn threaded_if_better(
         &self,
@@ -332,13 +307,14 @@ impl Post<'_> {
             return (steps, widening, false);
         };
         let share = threading.measure(self.ctx, &steps, false).share;
-        if share >= super::widen::CENTRED {
+        if share >= self.s.widen.centred {
             return (steps, widening, false);
         }
         let links = self.ctx.params().links() as f64;
         let motion = |s: &[Step]| Quality::of(s).shape_motion_rad;
-        let affordable = motion(&t) <= motion(&steps) + links * THREAD_MOTION;
-        if passing.share >= THREAD_SHARE && passing.share > share + THREAD_GAIN && affordable {
+        let th = &self.s.thread;
+        let affordable = motion(&t) <= motion(&steps) + links * th.motion;
+        if passing.share >= th.share && passing.share > share + th.gain && affordable {
             // Widening the threaded plan gained one instance of 200 in `arc bench
             // robust` for a third more time: its units already pass in the middle.
             let tw = Widening {
@@ -355,12 +331,12 @@ impl Post<'_> {
 
     /// The context post-processing checks in after the search's plan was widened to
     /// keep `narrowest` (m) through every passage (`None`: it passes none): where
-    /// that is more than the preferred clearance (by [`KEEP_GAIN`]), a context at that
-    /// margin less [`KEEP_SLACK`], so that a shortcut never passes an opening closer
+    /// that is more than the preferred clearance (by `RefineSettings::keep_gain`), a
+    /// context at that margin less `keep_slack`, so that a shortcut never passes an opening closer
     /// than the plan already does; else `None`, the search's own.
     fn keep_margin(&self, narrowest: Option<f64>) -> Option<CollisionContext> {
-        let keep = narrowest? - KEEP_SLACK;
-        if keep < self.ctx.clearance_margin() + KEEP_GAIN {
+        let keep = narrowest? - self.s.keep_slack;
+        if keep < self.ctx.clearance_margin() + self.s.keep_gain {
             return None;
         }
         let mut c =
@@ -399,6 +375,7 @@ struct Pass<'a> {
     checker: Checker,
     poses: &'a [Step],
     checks: u64,
+    s: &'a RefineSettings,
 }
 
 impl Pass<'_> {
@@ -422,7 +399,7 @@ impl Pass<'_> {
     }
 
     fn exhausted(&self) -> bool {
-        self.checks >= CHECK_BUDGET || super::expired(self.checker.deadline)
+        self.checks >= self.s.check_budget || super::expired(self.checker.deadline)
     }
 
     /// The farthest pose (beyond the next) reachable from pose `i` directly, with
@@ -511,9 +488,9 @@ impl Pass<'_> {
 
     /// Makes each shape change as small as the run of translations after it allows:
     /// a change `a -> b` followed by translations with `b` (and then, maybe, a change
-    /// `b -> c`) becomes `a -> b'` with `b'` a quarter, half or three quarters of the
-    /// way from `a` to `b` (the first that flies the whole run), when that moves the
-    /// chain's angles less in total.
+    /// `b -> c`) becomes `a -> b'` with `b'` a share of the way from `a` to `b`
+    /// (`RefineSettings::partial_shares`, the first that flies the whole run), when
+    /// that moves the chain's angles less in total.
     fn shrink_changes(&mut self, mut steps: Vec<Step>) -> Vec<Step> {
         let mut k = 1;
         while k < steps.len() && !self.exhausted() {
@@ -538,9 +515,9 @@ impl Pass<'_> {
         let next = steps.get(end + 1).map(|s| s.shape);
         let motion = |x: &Shape| shape_motion(&a, x) + next.map_or(0.0, |c| shape_motion(x, &c));
         let whole = motion(&b);
-        for t in [0.25f32, 0.5, 0.75] {
+        for t in self.s.partial_shares {
             let c = a.lerp(&b, t);
-            if motion(&c) + 1e-6 >= whole || !self.flies_run(steps, k, end, &c) {
+            if motion(&c) + TINY >= whole || !self.flies_run(steps, k, end, &c) {
                 continue;
             }
             return Some(c);

@@ -139,7 +139,10 @@ impl Roadmap {
     /// Applies the clearance factor to the edges of vertices `from..`. The factor
     /// depends only on the edge's two ends, so both directions get the same weight.
     fn weigh_edges(&mut self, from: VertexId) {
-        let (w, r) = (self.clearance_weight, self.clearance_ref.max(1e-9));
+        let (w, r) = (
+            self.clearance_weight,
+            self.clearance_ref.max(super::numeric::TIE),
+        );
         for v in from..self.points.len() {
             let (points, clearance) = (&self.points, &self.clearance);
             for e in self.graph.edges_mut(v) {
@@ -233,7 +236,10 @@ impl Roadmap {
         inner: &[[f64; 3]],
         to: VertexId,
     ) -> Vec<VertexId> {
-        let (w, r) = (self.clearance_weight, self.clearance_ref.max(1e-9));
+        let (w, r) = (
+            self.clearance_weight,
+            self.clearance_ref.max(super::numeric::TIE),
+        );
         let mut ids = vec![from];
         for &p in inner {
             let c = ctx.clearance(p);

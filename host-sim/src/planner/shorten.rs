@@ -36,15 +36,8 @@ use super::candidates::Source;
 use super::refine::shape_motion;
 use super::Step;
 
-/// Motion (rad) a replacement must save to be taken: below it, a change is rounding.
-const SAVING: f64 = 1e-4;
-
-/// Angles closer than this (rad) are the same shape, as in refinement.
-const SAME_SHAPE: f32 = 1e-6;
-
-/// At most this many passes over the runs (each pass after the first only acts where
-/// a neighbour changed, so the passes converge in a few).
-const MAX_PASSES: usize = 4;
+use super::numeric::SAME_SHAPE;
+use super::RefineSettings;
 
 /// The checks shortening asks for, and whether it may still ask (a budget or a
 /// deadline).
@@ -70,12 +63,13 @@ struct Run {
 
 /// The plan's steps with less shape motion (see the module docs); the start and the
 /// goal stay, and the result passes the same checks as the input.
-pub(super) fn shorten(checks: &mut impl Checks, steps: Vec<Step>) -> Vec<Step> {
+/// Tuned by `s.shorten` and the shares `s.partial_shares` (tried largest first).
+pub(super) fn shorten(checks: &mut impl Checks, steps: Vec<Step>, s: &RefineSettings) -> Vec<Step> {
     if steps.len() < 2 {
         return steps;
     }
     let mut runs = hold_head_yaw(to_runs(&steps));
-    for pass in 1..=MAX_PASSES {
+    for pass in 1..=s.shorten.max_passes {
         let mut improved = false;
         let mut i = 1;
         while i < runs.len() && !checks.exhausted() {
@@ -86,7 +80,7 @@ pub(super) fn shorten(checks: &mut impl Checks, steps: Vec<Step>) -> Vec<Step> {
                 i += 1;
                 continue;
             }
-            if let Some(x) = replacement(checks, &runs, i) {
+            if let Some(x) = replacement(checks, &runs, i, s) {
                 improved = true;
                 // A drop or a merge joins two runs: look at the new run i again.
                 if apply(&mut runs, i, x, pass) {
@@ -189,7 +183,13 @@ enum Replacement {
 
 /// The first admissible replacement of run `i`'s shape, cheapest in motion first, if
 /// any saves motion.
-fn replacement(checks: &mut impl Checks, runs: &[Run], i: usize) -> Option<Replacement> {
+fn replacement(
+    checks: &mut impl Checks,
+    runs: &[Run],
+    i: usize,
+    s: &RefineSettings,
+) -> Option<Replacement> {
+    let saving = s.shorten.saving;
     let prev = runs[i - 1].shape;
     let cur = runs[i].shape;
     let next = runs.get(i + 1).map(|r| r.shape);
@@ -205,7 +205,7 @@ fn replacement(checks: &mut impl Checks, runs: &[Run], i: usize) -> Option<Repla
         options.push((motion(&n), Replacement::Merge));
         shapes.extend([target, prev.lerp(&n, 0.5)]);
     }
-    shapes.extend([0.75f32, 0.5, 0.25].map(|t| cur.lerp(&target, t)));
+    shapes.extend(s.partial_shares.iter().rev().map(|&t| cur.lerp(&target, t)));
     for mut x in shapes {
         // The head's yaw is held (see `hold_head_yaw`).
         x.set_head_yaw(prev.head_yaw());
@@ -213,9 +213,9 @@ fn replacement(checks: &mut impl Checks, runs: &[Run], i: usize) -> Option<Repla
     }
     // Stable, and motion equal within rounding counts as equal: ties keep the order
     // above (fewer changes first, then the shape nearest the current one).
-    options.sort_by_key(|o| (o.0 / SAVING).round() as i64);
+    options.sort_by_key(|o| (o.0 / saving).round() as i64);
     for (m, r) in options {
-        if m + SAVING > now || checks.exhausted() {
+        if m + saving > now || checks.exhausted() {
             break;
         }
         let x = match r {

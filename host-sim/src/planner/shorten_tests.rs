@@ -97,7 +97,7 @@ fn a_change_the_rest_of_the_plan_does_not_need_is_dropped() {
     let b = bent(0.8, -0.8);
     let steps = plan(&[a, b], true);
     let mut checks = rule(|_, _| true, |_, _| true);
-    let out = shorten(&mut checks, steps.clone());
+    let out = shorten(&mut checks, steps.clone(), &RefineSettings::default());
     well_formed(&steps, &out);
     assert!(motion(&steps) > 1.5);
     assert_eq!(motion(&out), 0.0);
@@ -110,7 +110,7 @@ fn changes_at_one_point_merge_into_one_direct_change() {
     let steps = plan(&[a, b, c], false);
     // Only `c` flies the translation, and any change is admissible.
     let mut checks = rule(move |_, s| s.max_angle_diff(&c) < 1e-6, |_, _| true);
-    let out = shorten(&mut checks, steps.clone());
+    let out = shorten(&mut checks, steps.clone(), &RefineSettings::default());
     well_formed(&steps, &out);
     assert_eq!(out.iter().filter(|s| s.shape_change).count(), 1);
     assert!((motion(&out) - shape_motion(&a, &c)).abs() < 1e-6);
@@ -131,7 +131,7 @@ fn a_back_and_forth_is_clamped_between_its_neighbours() {
         },
         |_, _| true,
     );
-    let out = shorten(&mut checks, steps.clone());
+    let out = shorten(&mut checks, steps.clone(), &RefineSettings::default());
     well_formed(&steps, &out);
     let mid = out[1].shape;
     assert!((mid.yaw(0) - 0.3).abs() < 1e-6 && (mid.yaw(1) - 0.2).abs() < 1e-6);
@@ -145,7 +145,7 @@ fn the_last_shape_relaxes_back_as_far_as_the_passage_allows() {
     let steps = plan(&[a, b], true);
     // The translation needs link 0 turned by at least 0.4 rad.
     let mut checks = rule(|_, s| s.yaw(0) >= 0.4, |_, _| true);
-    let out = shorten(&mut checks, steps.clone());
+    let out = shorten(&mut checks, steps.clone(), &RefineSettings::default());
     well_formed(&steps, &out);
     assert!(
         (out[1].shape.yaw(0) - 0.5).abs() < 1e-6,
@@ -165,7 +165,7 @@ fn the_head_yaw_is_held_and_a_turn_of_it_alone_disappears() {
     let steps = plan(&[a, b, c], true);
     // Every change rejected: only the hold, which needs no check, can act.
     let mut checks = rule(|_, s| s.yaw(0) > 0.25, |_, _| false);
-    let out = shorten(&mut checks, steps.clone());
+    let out = shorten(&mut checks, steps.clone(), &RefineSettings::default());
     well_formed(&steps, &out);
     assert!(out.iter().all(|s| s.shape.head_yaw() == 0.0));
     assert_eq!(out.iter().filter(|s| s.shape_change).count(), 1);
@@ -177,7 +177,7 @@ fn nothing_changes_where_no_check_passes() {
     let (a, b) = (bent(0.0, 0.0), bent(1.0, 0.0));
     let steps = plan(&[a, b], true);
     let mut checks = rule(|_, _| false, |_, _| false);
-    let out = shorten(&mut checks, steps.clone());
+    let out = shorten(&mut checks, steps.clone(), &RefineSettings::default());
     let key = |s: &Step| (s.xi, s.shape, s.shape_change);
     assert_eq!(
         out.iter().map(key).collect::<Vec<_>>(),

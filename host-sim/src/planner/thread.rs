@@ -14,7 +14,7 @@
 //! translates a short way. A translation of `ds` carries a unit whose own track turns
 //! by `theta` from the head's heading `ds sin(theta)` off its track, so steps are
 //! shortened while a unit is inside a pinch and the head heads elsewhere (at most
-//! [`OFF_TRACK`] of the map's resolution off). Every step passes the search's checks;
+//! `ThreadSettings::off_track` of the map's resolution off). Every step passes the search's checks;
 //! where one does not, threading gives up and the plan keeps the other stages'
 //! result.
 
@@ -25,46 +25,19 @@ use aerial_chain_core::Shape;
 use nalgebra::{Point3, Vector3};
 
 use super::candidates::Source;
+use super::numeric::{SAME_SHAPE, TIE, TINY, TINY_F32};
 use super::widen::{distance, gradient, zeta};
-use super::{follow, Checker, Step};
+use super::{follow, Checker, Step, ThreadSettings};
 use crate::collision::exact::{exact_clearance, positions_f64};
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
 use crate::collision::CollisionContext;
 
 /// The head is in a pinch where its distance to the map is less than its radius plus
-/// this (m): the passages widening works on (`super::widen::CAP`).
+/// this (m): derived, the passages widening works on (`super::widen::CAP`).
 const PINCH: f64 = super::widen::CAP;
 
-/// For the step length, a unit is inside a pinch where its distance to the map is
-/// under its radius plus this share of [`PINCH`].
-const IN_PINCH: f64 = 0.5;
-
-/// How far (share of the resolution) a translation may carry a unit in a pinch off
-/// its track: the passages issue asks for 90 % of the middle's clearance, a tenth of
-/// a 0.5 m opening's 0.1 m.
-const OFF_TRACK: f64 = 0.1;
-
-/// Shortest step (share of the resolution): a unit that cannot stay on its track
-/// within this is left to the checks.
-const MIN_STEP: f64 = 0.04;
-
-/// A ray that runs this far (m) from a pinch's middle has left it.
-const ESCAPE: f64 = 1.0;
-
-/// A start whose front link points within this (rad, 30 degrees) of the route is
-/// slid along it as it lies.
-const ALIGNED: f32 = 0.52;
-
-/// A pinch at least this long (m) is a tunnel: its axis runs through the middles
-/// of its ends (`Router::through_tunnel`).
-const TUNNEL: f64 = 0.4;
-
-/// Steps a threaded plan may have (it gives up beyond).
-const MAX_STEPS: usize = 4000;
-
-/// How far back (and on) along the route, in route samples, a pinch's axis may be
-/// joined to the route.
-const JOIN_REACH: usize = 200;
+/// Radians per degree, for the direction grid given in degrees.
+const DEGREE: f64 = std::f64::consts::PI / 180.0;
 
 /// A pinch of a head route: its axis, from `a` to `b` through its middle, and the
 /// clearance a unit keeps in its middle.
@@ -79,29 +52,38 @@ pub(super) struct Pinch {
 pub(super) struct Threading {
     route: Vec<Point3<f64>>,
     pinches: Vec<Pinch>,
+    s: ThreadSettings,
 }
 
 impl Threading {
     /// The head route of `raw` straightened through its pinches; `None` when it has
     /// no pinch.
-    pub(super) fn of(ctx: &CollisionContext, raw: &[Step]) -> Option<Self> {
+    pub(super) fn of(ctx: &CollisionContext, raw: &[Step], s: &ThreadSettings) -> Option<Self> {
         let mut route: Vec<Point3<f64>> = Vec::with_capacity(raw.len());
         for s in raw {
             if route.last() != Some(&s.xi) {
                 route.push(s.xi);
             }
         }
-        Self::along(ctx, &route)
+        Self::along(ctx, &route, s)
     }
 
     /// The head route `route` (start first) straightened through its pinches; `None`
     /// when it has none.
-    pub(super) fn along(ctx: &CollisionContext, route: &[Point3<f64>]) -> Option<Self> {
+    pub(super) fn along(
+        ctx: &CollisionContext,
+        route: &[Point3<f64>],
+        s: &ThreadSettings,
+    ) -> Option<Self> {
         if route.len() < 2 {
             return None;
         }
-        let (route, pinches) = Router { ctx }.straightened(route);
-        (!pinches.is_empty()).then_some(Self { route, pinches })
+        let (route, pinches) = Router { ctx, s }.straightened(route);
+        (!pinches.is_empty()).then_some(Self {
+            route,
+            pinches,
+            s: *s,
+        })
     }
 
     /// The least clearance a unit keeps in the middle of any of the route's pinches
@@ -123,7 +105,7 @@ impl Threading {
         if step <= 0.0 {
             return None;
         }
-        Follower::new(ctx, start, step, deadline).along(&self.route)
+        Follower::new(ctx, start, step, deadline, &self.s).along(&self.route)
     }
 
     /// How `steps` passes the pinches, over the samples of every edge at twice the
@@ -141,7 +123,7 @@ impl Threading {
         let (l, r_u) = (params.link_length as f64, params.unit_radius as f64);
         let field = ctx.field();
         let r_v = field.grid().resolution();
-        let cap = r_u + super::widen::CAP.max(PINCH) + 0.01;
+        let cap = r_u + super::widen::CAP.max(PINCH) + self.s.measure_slack;
         let mut out = Passing {
             share: f64::INFINITY,
             narrowest: super::widen::CAP,
@@ -153,7 +135,8 @@ impl Threading {
             for j in (0..=n).step_by(2).chain([n]) {
                 let z = edge_sample(kind, &za, &zb, j as f64 / n as f64);
                 for p in positions_f64(l, [z[0], z[1], z[2]], &z[3..]) {
-                    let alongside = || self.pinches.iter().filter(|k| k.alongside(p));
+                    let near = self.s.alongside;
+                    let alongside = || self.pinches.iter().filter(move |k| k.alongside(p, near));
                     if (!every_unit && alongside().next().is_none())
                         || field.clearance_above(p, cap) >= cap
                     {
@@ -162,7 +145,7 @@ impl Threading {
                     let d = exact_clearance(field, p, 0.0, cap).min(cap) - r_u;
                     out.narrowest = out.narrowest.min(d);
                     for k in alongside() {
-                        out.share = out.share.min(d / k.middle.max(1e-9));
+                        out.share = out.share.min(d / k.middle.max(TIE));
                     }
                 }
             }
@@ -181,21 +164,22 @@ pub(super) struct Passing {
 }
 
 impl Pinch {
-    /// Whether a unit at `p` is alongside the axis: between its ends, within a
-    /// metre of it.
-    fn alongside(&self, p: Point3<f64>) -> bool {
-        let Some(u) = (self.b - self.a).try_normalize(1e-9) else {
+    /// Whether a unit at `p` is alongside the axis: between its ends, within `near`
+    /// (m) of it.
+    fn alongside(&self, p: Point3<f64>, near: f64) -> bool {
+        let Some(u) = (self.b - self.a).try_normalize(TIE) else {
             return false;
         };
         let w = p - self.a;
         let along = w.dot(&u);
-        (0.0..=(self.b - self.a).norm()).contains(&along) && (w - along * u).norm() <= 1.0
+        (0.0..=(self.b - self.a).norm()).contains(&along) && (w - along * u).norm() <= near
     }
 }
 
 /// Pinches of a head route and their axes.
 struct Router<'a> {
     ctx: &'a CollisionContext,
+    s: &'a ThreadSettings,
 }
 
 impl Router<'_> {
@@ -298,7 +282,7 @@ impl Router<'_> {
         out
     }
 
-    /// Of the route samples `ks` (within [`JOIN_REACH`], on the far side of `end` from
+    /// Of the route samples `ks` (within `join_reach`, on the far side of `end` from
     /// the axis `u`), the one the head can fly to `end` from with the least turning,
     /// at the sample and at `end` together.
     fn join(
@@ -309,13 +293,12 @@ impl Router<'_> {
         u: Vector3<f64>,
     ) -> Option<usize> {
         let angle =
-            |x: Vector3<f64>, y: Vector3<f64>| match (x.try_normalize(1e-9), y.try_normalize(1e-9))
-            {
+            |x: Vector3<f64>, y: Vector3<f64>| match (x.try_normalize(TIE), y.try_normalize(TIE)) {
                 (Some(x), Some(y)) => x.dot(&y).clamp(-1.0, 1.0).acos(),
                 _ => 0.0,
             };
         let mut best: Option<(f64, usize)> = None;
-        for k in ks.take(JOIN_REACH) {
+        for k in ks.take(self.s.join_reach) {
             let to_end = end - dense[k];
             if to_end.dot(&u) <= 0.0 || !self.head_flies(dense[k], end) {
                 continue;
@@ -328,7 +311,7 @@ impl Router<'_> {
             };
             let before = from.map_or(to_end, |j| dense[k] - dense[j]);
             let turn = angle(before, to_end) + angle(to_end, u);
-            if best.is_none_or(|(t, _)| turn < t - 1e-9) {
+            if best.is_none_or(|(t, _)| turn < t - TIE) {
                 best = Some((turn, k));
             }
         }
@@ -339,12 +322,12 @@ impl Router<'_> {
     /// from the stretch's narrowest sample, out to where the pinch ends on either side.
     /// `None` when the head cannot fly it.
     fn axis(&self, stretch: &[Point3<f64>]) -> Option<Pinch> {
-        let heading = (stretch[stretch.len() - 1] - stretch[0]).try_normalize(1e-9)?;
+        let heading = (stretch[stretch.len() - 1] - stretch[0]).try_normalize(TIE)?;
         let mut c = *stretch
             .iter()
             .min_by(|a, b| self.ctx.clearance(**a).total_cmp(&self.ctx.clearance(**b)))?;
         let mut u = heading;
-        for _ in 0..3 {
+        for _ in 0..self.s.axis_rounds {
             c = self.centre(c, u);
             c = self.narrowest_along(c, u);
             u = self.direction(c, u);
@@ -361,27 +344,29 @@ impl Router<'_> {
         (middle > 0.0 && self.head_flies(a, b)).then_some(Pinch { a, b, middle })
     }
 
-    /// The way through the pinch at `c`: the mean of the directions (within 80
-    /// degrees of `guess`) of the lines through `c` that run free for [`ESCAPE`] both
-    /// ways. From inside an opening they form a cone about its axis.
+    /// The way through the pinch at `c`: the mean of the directions (within `cone_deg`
+    /// of `guess`, on a grid of `grid_step_deg`) of the lines through `c` that run
+    /// free for `escape` both ways. From inside an opening they form a cone about its
+    /// axis.
     fn direction(&self, c: Point3<f64>, guess: Vector3<f64>) -> Vector3<f64> {
         let yaw0 = guess.y.atan2(guess.x);
         let pitch0 = guess.z.clamp(-1.0, 1.0).asin();
-        let deg = std::f64::consts::PI / 180.0;
+        let s = self.s;
+        let (n, deg) = (s.grid_steps, DEGREE);
         let mut sum = Vector3::zeros();
-        for j in -16i32..=16 {
-            let pitch = pitch0 + 5.0 * deg * j as f64;
-            if pitch.abs() > 85.0 * deg {
+        for j in -n..=n {
+            let pitch = pitch0 + s.grid_step_deg * deg * j as f64;
+            if pitch.abs() > s.max_pitch_deg * deg {
                 continue;
             }
-            for i in -16i32..=16 {
-                let yaw = yaw0 + 5.0 * deg * i as f64;
+            for i in -n..=n {
+                let yaw = yaw0 + s.grid_step_deg * deg * i as f64;
                 let u = Vector3::new(
                     yaw.cos() * pitch.cos(),
                     yaw.sin() * pitch.cos(),
                     pitch.sin(),
                 );
-                if u.dot(&guess) > (80.0 * deg).cos()
+                if u.dot(&guess) > (s.cone_deg * deg).cos()
                     && self.runs_free(c, u)
                     && self.runs_free(c, -u)
                 {
@@ -390,17 +375,19 @@ impl Router<'_> {
                 }
             }
         }
-        sum.try_normalize(1e-9).unwrap_or(guess)
+        sum.try_normalize(TIE).unwrap_or(guess)
     }
 
     /// Distances out along a pinch's axis from its middle, every half voxel up to
-    /// 4 m: where a pinch's ends are looked for.
+    /// `axis_reach`: where a pinch's ends are looked for.
     fn out_along(&self) -> impl Iterator<Item = f64> {
-        let h = self.res() / 2.0;
-        (1..).map(move |k| k as f64 * h).take_while(|t| *t < 4.0)
+        let (h, reach) = (self.res() / 2.0, self.s.axis_reach);
+        (1..)
+            .map(move |k| k as f64 * h)
+            .take_while(move |t| *t < reach)
     }
 
-    /// In a tunnel (a pinch at least [`TUNNEL`] long) the cone of free lines is
+    /// In a tunnel (a pinch at least `tunnel` long) the cone of free lines is
     /// narrow and the direction grid biases its mean by a degree or two, which a
     /// metre of tunnel turns into centimetres: there the axis is the line through the
     /// middles of its cross-sections near either end.
@@ -415,35 +402,38 @@ impl Router<'_> {
                 .unwrap_or(0.0)
         };
         let (back, on) = (extent(-1.0), extent(1.0));
-        if back + on < TUNNEL {
+        if back + on < self.s.tunnel {
             return (c, u);
         }
-        let e0 = self.centre(c - 0.8 * back * u, u);
-        let e1 = self.centre(c + 0.8 * on * u, u);
-        match (e1 - e0).try_normalize(1e-9) {
-            Some(axis) if axis.dot(&u) > 0.9 => {
+        let ends = self.s.tunnel_ends;
+        let e0 = self.centre(c - ends * back * u, u);
+        let e1 = self.centre(c + ends * on * u, u);
+        match (e1 - e0).try_normalize(TIE) {
+            Some(axis) if axis.dot(&u) > self.s.tunnel_aligned => {
                 (self.centre(nalgebra::center(&e0, &e1), axis), axis)
             }
             _ => (c, u),
         }
     }
 
-    /// The point of the line through `c` along `u`, within 20 half voxels, where the
+    /// The point of the line through `c` along `u`, within `narrowest_reach` half
+    /// voxels, where the
     /// distance field's bound is least: inside the pinch rather than at its mouth.
     fn narrowest_along(&self, c: Point3<f64>, u: Vector3<f64>) -> Point3<f64> {
         let h = self.res() / 2.0;
-        (-20..=20)
+        let n = self.s.narrowest_reach;
+        (-n..=n)
             .map(|k| c + u * (k as f64 * h))
             .min_by(|a, b| self.ctx.clearance(*a).total_cmp(&self.ctx.clearance(*b)))
             .unwrap_or(c)
     }
 
-    /// A ray from `c` along `u` runs [`ESCAPE`] without coming within half a voxel of
+    /// A ray from `c` along `u` runs `escape` without coming within half a voxel of
     /// the map (the distance field's bound, sphere tracing).
     fn runs_free(&self, c: Point3<f64>, u: Vector3<f64>) -> bool {
         let stop = self.res() / 2.0;
         let mut t = 0.0;
-        while t < ESCAPE {
+        while t < self.s.escape {
             let d = self.ctx.clearance(c + u * t);
             if d < stop {
                 return false;
@@ -457,15 +447,15 @@ impl Router<'_> {
     /// map is largest: gradient ascent with shrinking steps.
     fn centre(&self, mut c: Point3<f64>, u: Vector3<f64>) -> Point3<f64> {
         let mut d = distance(self.ctx, c);
-        for step in [0.4, 0.2, 0.1, 0.05, 0.025] {
-            for _ in 0..12 {
+        for step in self.s.centre_steps {
+            for _ in 0..self.s.centre_rounds {
                 let g = gradient(self.ctx, c);
-                let Some(g) = (g - g.dot(&u) * u).try_normalize(1e-6) else {
+                let Some(g) = (g - g.dot(&u) * u).try_normalize(TINY) else {
                     break;
                 };
                 let next = c + step * self.res() * g;
                 let dn = distance(self.ctx, next);
-                if dn <= d + 1e-9 {
+                if dn <= d + TIE {
                     break;
                 }
                 (c, d) = (next, dn);
@@ -521,10 +511,17 @@ struct Follower<'a> {
     steps: Vec<Step>,
     step: f64,
     head_yaw: f32,
+    s: ThreadSettings,
 }
 
 impl<'a> Follower<'a> {
-    fn new(ctx: &'a CollisionContext, start: &Step, step: f64, deadline: Option<Instant>) -> Self {
+    fn new(
+        ctx: &'a CollisionContext,
+        start: &Step,
+        step: f64,
+        deadline: Option<Instant>,
+        s: &ThreadSettings,
+    ) -> Self {
         Self {
             ctx,
             checker: Checker::new(ctx.clone(), deadline),
@@ -532,25 +529,27 @@ impl<'a> Follower<'a> {
             steps: vec![*start],
             step,
             head_yaw: start.shape.head_yaw(),
+            s: *s,
         }
     }
 
     /// Turns the chain about its head towards `dir` (the route's first heading) when
-    /// its front link points more than [`ALIGNED`] away from it: a body trailing
-    /// across the route cannot be slid along it. The whole turn, or three quarters
-    /// or half of it, whichever passes the checks first; none when none does.
+    /// its front link points more than `aligned` away from it: a body trailing across
+    /// the route cannot be slid along it. The shares `align_shares` of the turn (the
+    /// whole, three quarters, half), whichever passes the checks first; none when none
+    /// does.
     fn align(&mut self, dir: Vector3<f64>) {
         let start = self.steps[0];
         let front = link_direction(start.shape.pitch(0), start.shape.yaw(0));
-        if dir.xy().norm() < 1e-6 || front.xy().norm() < 1e-6 {
+        if dir.xy().norm() < TINY || front.xy().norm() < TINY_F32 {
             return;
         }
         let turn =
             aerial_chain_core::angle::diff(front.y.atan2(front.x), dir.y.atan2(dir.x) as f32);
-        if turn.abs() <= ALIGNED {
+        if turn.abs() <= self.s.aligned {
             return;
         }
-        for share in [1.0, 0.75, 0.5] {
+        for share in self.s.align_shares {
             let mut s = start.shape.rotated(turn * share);
             s.set_head_yaw(self.head_yaw);
             if self.checker.config(start.xi, &s)
@@ -575,7 +574,7 @@ impl<'a> Follower<'a> {
         self.align(route[1] - route[0]);
         for w in route.windows(2) {
             let mut p = self.head();
-            while (w[1] - p).norm() > 1e-9 {
+            while (w[1] - p).norm() > TIE {
                 let shape = self.lay(p)?;
                 let dir = (w[1] - p) / (w[1] - p).norm();
                 let ds = self.step_length(p, &shape, dir).min((w[1] - p).norm());
@@ -594,7 +593,7 @@ impl<'a> Follower<'a> {
                     shape_change: false,
                 });
                 self.track.push(v32(q));
-                if self.steps.len() > MAX_STEPS {
+                if self.steps.len() > self.s.max_steps {
                     return None;
                 }
                 p = q;
@@ -618,7 +617,7 @@ impl<'a> Follower<'a> {
         // The head's yaw turns the units only: the start's is kept (`super::shorten`).
         laid.set_head_yaw(self.head_yaw);
         let shape = self.shape();
-        if laid.max_angle_diff(&shape) <= 1e-6 {
+        if laid.max_angle_diff(&shape) <= SAME_SHAPE {
             return Some(shape);
         }
         if !(self.checker.config(p, &laid) && self.checker.shape_change(p, &shape, &laid)) {
@@ -639,7 +638,7 @@ impl<'a> Follower<'a> {
         let params = self.ctx.params();
         let res = self.ctx.field().grid().resolution();
         // A unit may enter a pinch during the step: it moves at most `self.step`.
-        let near = params.unit_radius as f64 + IN_PINCH * PINCH + self.step;
+        let near = params.unit_radius as f64 + self.s.in_pinch * PINCH + self.step;
         let o = offsets(params, shape);
         let mut ds = self.step;
         for (k, offset) in o.iter().enumerate().take(params.n()).skip(1) {
@@ -649,11 +648,11 @@ impl<'a> Follower<'a> {
             // The unit's track runs along the link in front of it.
             let along = link_direction(shape.pitch(k - 1), shape.yaw(k - 1)).cast::<f64>();
             let sin = along.cross(&dir).norm();
-            if sin > 1e-6 {
-                ds = ds.min(OFF_TRACK * res / sin);
+            if sin > TINY {
+                ds = ds.min(self.s.off_track * res / sin);
             }
         }
-        ds.max(MIN_STEP * res)
+        ds.max(self.s.min_step * res)
     }
 }
 

@@ -36,7 +36,7 @@ fn an_oblique_crossing_is_threaded_through_the_middle() {
             shape_change: false,
         })
         .collect();
-    let threading = Threading::of(&ctx, &raw).expect("a pinch");
+    let threading = Threading::of(&ctx, &raw, &ThreadSettings::default()).expect("a pinch");
     let (out, _) = threading
         .follow(&ctx, &raw[0], 0.1, None)
         .expect("the window can be threaded");
@@ -68,10 +68,13 @@ fn a_unit_about_to_enter_a_pinch_shortens_the_step() {
         source: Source::Start,
         shape_change: false,
     };
-    let f = Follower::new(&ctx, &start, 0.1, None);
+    let f = Follower::new(&ctx, &start, 0.1, None, &ThreadSettings::default());
     let dir = Vector3::new(30f64.to_radians().cos(), 30f64.to_radians().sin(), 0.0);
     let ds = f.step_length(start.xi, &start.shape, dir);
-    assert!(ds <= OFF_TRACK * 0.05 / 0.5 + 1e-9, "step {ds}");
+    assert!(
+        ds <= ThreadSettings::default().off_track * 0.05 / 0.5 + 1e-9,
+        "step {ds}"
+    );
     // Heading along the chain, nobody leaves their track: the whole step.
     let ds = f.step_length(start.xi, &start.shape, Vector3::x());
     assert_eq!(ds, 0.1);
@@ -91,7 +94,11 @@ fn a_tunnel_axis_runs_through_the_middles_of_its_ends() {
         Point3::new(2.5, 1.05, 1.04),
         Point3::new(4.4, 1.9, 1.0),
     ];
-    let (_, pinches) = Router { ctx: &ctx }.straightened(&route);
+    let (_, pinches) = Router {
+        ctx: &ctx,
+        s: &ThreadSettings::default(),
+    }
+    .straightened(&route);
     assert_eq!(pinches.len(), 1);
     let p = pinches[0];
     // Both ends on the tunnel's axis, outside its mouths: a degree off over the
@@ -112,7 +119,11 @@ fn a_pinch_becomes_its_axis_through_the_middle() {
         Point3::new(2.07, 1.04, 1.02),
         Point3::new(3.6, 1.8, 1.0),
     ];
-    let (out, pinches) = Router { ctx: &ctx }.straightened(&route);
+    let (out, pinches) = Router {
+        ctx: &ctx,
+        s: &ThreadSettings::default(),
+    }
+    .straightened(&route);
     assert_eq!(pinches.len(), 1);
     assert!((pinches[0].middle - 0.1).abs() < 0.01, "{pinches:?}");
     assert_eq!((out[0], out[out.len() - 1]), (route[0], route[2]));

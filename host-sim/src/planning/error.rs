@@ -42,6 +42,9 @@ pub enum PlanningError {
     /// the field.
     #[error("{0}")]
     Mission(String),
+    /// A tuning setting outside its range (the field and its value).
+    #[error("setting {0}")]
+    Setting(#[from] crate::planner::SettingError),
     /// The goal's yaw and shape give no valid configuration at the goal (bad input).
     #[error("the goal configuration ({pose}) is not valid at ({x:.3}, {y:.3}, {z:.3}): {why}", x = at[0], y = at[1], z = at[2])]
     GoalPose {

@@ -16,6 +16,7 @@ mod arrival;
 mod error;
 mod mission;
 mod options;
+mod settings_file;
 
 use std::sync::atomic::AtomicUsize;
 use std::sync::Arc;
@@ -27,6 +28,7 @@ pub use arrival::Arrival;
 pub use error::{NoPlan, PlanningError};
 pub use mission::{plan_mission, LegError, MissionPlanned};
 pub use options::{PlanOptions, DEFAULT_TIME_LIMIT_S, MAX_TIME_LIMIT_S};
+pub use settings_file::{SettingsFile, SettingsFileError};
 
 use crate::collision::CollisionContext;
 use crate::goal::GoalPose;
@@ -136,6 +138,7 @@ pub fn plan(
     options: &PlanOptions,
 ) -> Result<Planned, PlanningError> {
     let stop = options.termination()?;
+    options.validate_tuning()?;
     arrival::check_pose(request, options.planner.n_psi)?;
     let setup = Instant::now();
     let mut planner = planner(request, tables, options)?;
@@ -205,7 +208,9 @@ fn planner(
             )?
         }
     };
-    ArcPlanner::new(ctx, tables, options.planner.clone()).map_err(PlanningError::Refused)
+    ArcPlanner::new(ctx, tables, options.planner.clone())
+        .map(|p| p.with_refine(options.refine.clone()))
+        .map_err(PlanningError::Refused)
 }
 
 /// Why the query that began at `began` gave no plan: a query that cannot be asked is

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::PlanningError;
 use crate::collision::DEFAULT_CLEARANCE;
-use crate::planner::{Settings, Termination};
+use crate::planner::{RefineSettings, Settings, Termination};
 use crate::tables::TableSettings;
 
 /// The time limit of `arc plan` and of [`super::plan`] unless one is given (s):
@@ -23,8 +23,11 @@ pub const MAX_TIME_LIMIT_S: f64 = 1e6;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct PlanOptions {
-    /// The planner's parameters (roadmap, shape sources, follow step, ...).
+    /// The planner's parameters (roadmap, shape sources, follow step, ...): the
+    /// search's tuning.
     pub planner: Settings,
+    /// Post-processing's tuning (and threading's, which the search uses too).
+    pub refine: RefineSettings,
     /// Clearance margin added to every body's radius (m): plans keep this far from
     /// walls (`--clearance`).
     pub clearance: f64,
@@ -47,6 +50,7 @@ impl Default for PlanOptions {
         let tables = TableSettings::default();
         Self {
             planner: Settings::default(),
+            refine: RefineSettings::default(),
             clearance: DEFAULT_CLEARANCE,
             no_smooth: false,
             time_limit_s: Some(DEFAULT_TIME_LIMIT_S),
@@ -70,6 +74,15 @@ impl PlanOptions {
         Ok(Termination {
             time_limit: Some(Duration::from_secs_f64(t)),
         })
+    }
+
+    /// Checks the tuning settings (those without a flag of `arc plan`: the planner's
+    /// lattice and construction tuning, post-processing's, and the trajectory's when
+    /// one is asked for); the error names the field and its value.
+    pub fn validate_tuning(&self) -> Result<(), PlanningError> {
+        self.planner.validate_tuning()?;
+        self.refine.validate()?;
+        Ok(())
     }
 
     /// The settings of shape tables built for these options.

@@ -101,3 +101,41 @@ fn bad_input_and_no_plan_are_told_apart() {
     assert!(s.starts_with("no plan: time limit reached"), "{s}");
     assert!(s.contains("time limit stopped it after trying"), "{s}");
 }
+
+#[test]
+fn tuning_settings_reach_the_search_post_processing_and_the_trajectory() {
+    let (request, mut options) = window();
+    options.trajectory = Some(crate::trajectory::Settings::default());
+    let base = plan(&request, None, &options).unwrap();
+    let widen = |p: &Planned| p.refinement.expect("refined").widening;
+    // Widening with one measurement moves nothing: what widening trades is its budget.
+    let mut tight = options.clone();
+    tight.refine.widen.budget = 1;
+    let t = plan(&request, None, &tight).unwrap();
+    assert!(widen(&base).moves > 0, "{:?}", widen(&base));
+    assert_eq!(widen(&t).moves, 0, "{:?}", widen(&t));
+    assert!(widen(&t).after < widen(&base).after);
+    // A lattice search that may not jump through open space expands more points.
+    let mut short = options.clone();
+    short.planner.lattice.max_jump = 1.0;
+    let e = plan(&request, None, &short).unwrap();
+    let expanded = (base.stats.lattice_expanded, e.stats.lattice_expanded);
+    assert!(expanded.1 > expanded.0, "{expanded:?}");
+    // A trajectory whose runs join one edge merges no corner.
+    let mut single = options.clone();
+    single.trajectory = Some(crate::trajectory::Settings {
+        max_run: 1,
+        ..crate::trajectory::Settings::default()
+    });
+    let s = plan(&request, None, &single).unwrap();
+    let merged = |p: &Planned| p.trajectory.as_ref().unwrap().as_ref().unwrap().merged();
+    assert!(merged(&s) <= merged(&base));
+    // Out of range: refused as bad input, naming the field.
+    let mut bad = options.clone();
+    bad.refine.widen.centred = 2.0;
+    let err = plan(&request, None, &bad).unwrap_err();
+    assert!(
+        err.is_input() && err.to_string().contains("refine.widen.centred"),
+        "{err}"
+    );
+}

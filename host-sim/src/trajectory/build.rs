@@ -40,11 +40,13 @@ use crate::map::Grid;
 use crate::sim::reference::{Reference, Scaling, Segment};
 
 /// Peak of the smoothstep's derivative: a ramp of length `R` that changes a rate by
-/// `dv` accelerates by at most `1.5 dv / R`.
+/// `dv` accelerates by at most `1.5 dv / R`. Derived (the smoothstep `3t^2 - 2t^3` has
+/// the largest slope 1.5, at its middle), not tuning.
 const RAMP_PEAK: f64 = 1.5;
 
-/// Rounds of lowering cruise rates until every edge's ramps fit.
-const FIT_ROUNDS: usize = 200;
+/// Each round of fitting lowers an edge's rate this much below what fits it exactly, so
+/// that rounding cannot keep the fit from ending. A numerical guard, not tuning.
+const FIT_UNDERSHOOT: f64 = 1.001;
 
 /// A timed trajectory: its samples, and the analytic motion they were taken from.
 #[derive(Clone, Debug)]
@@ -145,7 +147,7 @@ fn build_leg(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
     }
     let head_path = edges.iter().map(|s| merge::head_length(&s.delta)).sum();
     let mut demands = group::Demands::new();
-    let mut grouping = group::Grouping::new(&edges, l, settings.blend);
+    let mut grouping = group::Grouping::new(&edges, l, settings.blend, settings);
     // The places where a motion starts whose blend with the one before was undone.
     let mut unblended: HashSet<u64> = HashSet::new();
     // What the last round checked: its segments, and the first sample it found wrong.
@@ -272,7 +274,7 @@ fn merged_near(segments: &[Segment], merged: &[bool], v: &Violation, dt: f64) ->
 /// Blends are timed by the limits, not by the plan's stop-and-go length, so the
 /// budget is checked here again, before the samples are made.
 pub(super) fn sample(r: &Reference, dt: f64) -> Result<(Vec<f64>, Vec<Vec<f64>>), TrajectoryError> {
-    let last = ((r.duration() / dt) - 1e-9).ceil().max(0.0);
+    let last = ((r.duration() / dt) - super::TICK_GUARD).ceil().max(0.0);
     // `max` has made a NaN duration 0; `as` saturates an infinite one.
     if last >= MAX_SAMPLES as f64 {
         return Err(TrajectoryError::TooLong(last as usize));
@@ -342,13 +344,13 @@ impl Timing<'_> {
         let mut rates = self.max_rates.clone();
         let (up, down) = loop {
             let mut fitted = false;
-            for _ in 0..FIT_ROUNDS {
+            for _ in 0..self.settings.fit_rounds {
                 let (up, down) = self.ramps(&rates, blend);
                 let mut all = true;
                 for k in 0..m {
                     let excess = rates[k] * (up[k] + down[k]) / 2.0;
                     if excess > 1.0 {
-                        rates[k] /= excess.sqrt() * 1.001;
+                        rates[k] /= excess.sqrt() * FIT_UNDERSHOOT;
                         all = false;
                     }
                 }
@@ -377,7 +379,7 @@ impl Timing<'_> {
             let scaling = Scaling::with_ramps(rates[k], up[k], down[k]);
             let t0 = match blend[k] {
                 true => end - up[k],
-                false => ((end / dt) - 1e-9).ceil().max(0.0) * dt,
+                false => ((end / dt) - super::TICK_GUARD).ceil().max(0.0) * dt,
             };
             end = t0 + scaling.duration;
             out.push(Segment {

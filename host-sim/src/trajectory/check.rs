@@ -462,7 +462,9 @@ impl Checker<'_> {
             .map(|k| (d[4 + 2 * k].powi(2) + d[5 + 2 * k].powi(2)).sqrt())
             .sum::<f64>();
         let travel = head + self.params.link_length as f64 * links;
-        let pieces = ((travel / (self.grid.resolution() / 4.0)).ceil() as usize).max(1);
+        let pieces = ((travel / (self.grid.resolution() / crate::collision::SAMPLES_PER_VOXEL))
+            .ceil() as usize)
+            .max(1);
         if pieces > MAX_INTERVALS {
             return Err((0.0, Problem::TooFar(pieces)));
         }

@@ -16,15 +16,10 @@
 //! steps, then flies alone. Every step leaves the merged motions shorter or fewer, so
 //! the search ends.
 
-use super::merge::{head_length, straight, Demand, MAX_RUN};
+use super::merge::{head_length, straight, Demand};
+use super::Settings;
 use crate::sim::reference::{Segment, SegmentKind};
 use crate::sim::ReferenceLimits;
-
-/// Shortest part of a translation (m) a pair is made with, or shrunk to.
-const MIN_PIECE: f64 = 0.1;
-
-/// How often a failed pair flies half as much of its translation before it gives up.
-const SHRINKS: u8 = 2;
 
 /// Which side of its shape change a pair's translation lies on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -84,6 +79,8 @@ impl Motion {
 #[derive(Clone, Debug)]
 pub(super) struct Grouping {
     motions: Vec<Motion>,
+    /// The tuning of runs and pairs.
+    s: Settings,
 }
 
 /// The demands of motions already measured, by their places: the generator assembles
@@ -103,8 +100,8 @@ impl Grouping {
     /// of one edge is none; a shape change and one translation make a pair instead),
     /// else a translation and the shape change after it, or a shape change and the
     /// translation after it, as a pair; each edge in at most one motion. `on == false`:
-    /// every edge alone.
-    pub(super) fn new(edges: &[Segment], l: f64, on: bool) -> Self {
+    /// every edge alone. Tuned by `s` (runs, pieces, shrinks).
+    pub(super) fn new(edges: &[Segment], l: f64, on: bool, s: &Settings) -> Self {
         let own = |k: usize| Motion {
             start: k as f64,
             end: (k + 1) as f64,
@@ -112,6 +109,7 @@ impl Grouping {
         };
         let mut g = Self {
             motions: Vec::with_capacity(edges.len()),
+            s: *s,
         };
         let mut k = 0;
         while k < edges.len() {
@@ -125,7 +123,7 @@ impl Grouping {
             let mut end = k;
             while let Some(next) = [end + 2, end + 1]
                 .into_iter()
-                .find(|&e| e < edges.len() && e - k < MAX_RUN && straight(&edges[k..=e], l))
+                .find(|&e| e < edges.len() && e - k < s.max_run && straight(&edges[k..=e], l, s))
             {
                 end = next;
             }
@@ -161,7 +159,7 @@ impl Grouping {
     /// Pairs the shape change flown alone as motion `m` with the translation on `side`
     /// of it, where motion `m`'s neighbour there flies that translation (or what other
     /// pairs left of it) as the plan has it: with all of that part, unless it is a
-    /// sliver of under [`MIN_PIECE`]. Whether it made the pair.
+    /// sliver of under `Settings::min_piece`. Whether it made the pair.
     fn pair(&mut self, m: usize, side: Side, edges: &[Segment]) -> bool {
         let shape = self.motions[m].start as usize;
         let (t, neighbour) = match side {
@@ -177,7 +175,7 @@ impl Grouping {
         }
         // A whole translation however short, else no sliver.
         let share = next.end - next.start;
-        if share * head_length(&edges[t].delta) < MIN_PIECE && share < 1.0 {
+        if share * head_length(&edges[t].delta) < self.s.min_piece && share < 1.0 {
             return false;
         }
         let kind = Kind::Pair {
@@ -285,7 +283,9 @@ impl Grouping {
                     Side::After => (shape + 1, motion.end - (shape + 1) as f64),
                 };
                 let half = piece / 2.0;
-                if shrunk < SHRINKS && half * head_length(&edges[t].delta) >= MIN_PIECE {
+                if shrunk < self.s.shrinks
+                    && half * head_length(&edges[t].delta) >= self.s.min_piece
+                {
                     let place = match side {
                         Side::Before => motion.start + half,
                         Side::After => motion.end - half,
@@ -459,9 +459,9 @@ mod tests {
             ([0.3, 0.0, 1.0], 0.0),
             ([0.3, 0.1, 1.0], 0.0),
         ]);
-        let g = Grouping::new(&e, 0.5, true);
+        let g = Grouping::new(&e, 0.5, true, &Settings::default());
         assert_eq!(places(&g), [(0.0, 3.0, true), (3.0, 4.0, false)]);
-        let off = Grouping::new(&e, 0.5, false);
+        let off = Grouping::new(&e, 0.5, false, &Settings::default());
         assert_eq!(off.merged_corners(), 0);
         assert_eq!(g.merged_corners(), 2);
         // Halved: the first edge alone, then the other two; then those apart.
@@ -485,7 +485,7 @@ mod tests {
             ([0.1, 0.0, 1.0], 0.1),
             ([0.2, 0.0, 1.0], 0.1),
         ]);
-        let g = Grouping::new(&e, 0.5, true);
+        let g = Grouping::new(&e, 0.5, true, &Settings::default());
         assert_eq!(places(&g), [(0.0, 2.0, true), (2.0, 3.0, false)]);
     }
 
@@ -498,7 +498,7 @@ mod tests {
             ([2.0, 0.0, 1.0], 0.4),
             ([4.0, 0.0, 1.0], 0.4),
         ]);
-        let mut g = Grouping::new(&e, 0.5, true);
+        let mut g = Grouping::new(&e, 0.5, true, &Settings::default());
         covers(&g, 3);
         assert_eq!(places(&g), [(0.0, 2.0, true), (2.0, 3.0, false)]);
         assert_eq!(g.merged_corners(), 1);
@@ -547,7 +547,7 @@ mod tests {
             ([0.3, 0.0, 1.0], 0.0),
             ([0.3, 0.0, 1.0], 0.4),
         ]);
-        let mut g = Grouping::new(&e, 0.5, true);
+        let mut g = Grouping::new(&e, 0.5, true, &Settings::default());
         assert_eq!(places(&g), [(0.0, 2.0, true)]);
         assert!(g.undo(0, &e));
         assert_eq!(places(&g), [(0.0, 0.5, false), (0.5, 2.0, true)]);
@@ -565,7 +565,7 @@ mod tests {
             ([0.4, 0.0, 1.0], 0.4),
             ([0.4, 0.0, 1.0], 0.0),
         ]);
-        let g = Grouping::new(&e, 0.5, true);
+        let g = Grouping::new(&e, 0.5, true, &Settings::default());
         covers(&g, 4);
         assert_eq!(places(&g), [(0.0, 2.0, true), (2.0, 4.0, true)]);
         assert_eq!(g.merged_corners(), 2);
@@ -591,7 +591,7 @@ mod tests {
                 points.push((h, yaw));
             }
             let e = edges(&points);
-            let mut g = Grouping::new(&e, 0.5, true);
+            let mut g = Grouping::new(&e, 0.5, true, &Settings::default());
             covers(&g, e.len());
             let corners = e.len() - 1;
             let mut undone = 0;
@@ -612,7 +612,7 @@ mod tests {
                     let part = m.end.min((k + 1) as f64) - m.start;
                     let piece = part * head_length(&e[k].delta);
                     let whole = part == 1.0 || m.start.fract() == 0.0 && m.end.fract() == 0.0;
-                    proptest::prop_assert!(whole || piece >= MIN_PIECE - 1e-9,
+                    proptest::prop_assert!(whole || piece >= Settings::default().min_piece - 1e-9,
                         "a sliver of {piece} m: {:?}", g.motions);
                 }
             }

@@ -97,7 +97,7 @@ pub(super) fn join(
             segments.push(hold(end, leg.hold_s, tr.reference.end(), leg.to));
         }
         // The next leg starts from rest on a sample time, as an unblended edge does.
-        offset = ((end + leg.hold_s) / dt - 1e-9).ceil() * dt;
+        offset = ((end + leg.hold_s) / dt - super::TICK_GUARD).ceil() * dt;
         stop_go += tr.stop_go + leg.hold_s;
         head_path += tr.head_path;
         corners += tr.corners;

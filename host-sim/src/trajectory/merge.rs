@@ -9,7 +9,7 @@
 //! of velocity between measurements.
 //!
 //! Two kinds of merge are tried: a *run*, many short edges whose waypoints lie within
-//! [`RUN_TOLERANCE`] of the straight move through them (follow-the-leader steps, a
+//! `Settings::run_tolerance` of the straight move through them (follow-the-leader steps, a
 //! chain bending around its head's track a little at a time: flown edge by edge, every
 //! step would start and end a link's turn, and the ramps between such short edges
 //! bring the chain almost to rest); and a *pair*, a translation with the shape change
@@ -21,27 +21,12 @@ use crate::sim::reference::{Segment, SegmentKind};
 use crate::sim::ReferenceLimits;
 
 /// Measurements along a shape change for its fastest unit.
+///
+/// Tuning left a constant: the bound adds the most a velocity can change between two
+/// measurements, so it holds at any count; more measurements make it tighter (faster
+/// merged shape changes) for time. `motion_speed` is shared with the demands' cache,
+/// which holds no settings.
 const SPEED_SAMPLES: usize = 128;
-
-/// How far (m) a run's straight move may carry any unit from where the plan has it at
-/// the run's inner waypoints: a fraction of the planner's clearance margin (0.05 m),
-/// which the trajectory check then asks of the whole move.
-pub(super) const RUN_TOLERANCE: f64 = 0.02;
-
-/// The same for a run of short steps only (translations, none longer than
-/// [`SHORT_STEP`], and shape changes): a follow-the-leader path's steps cut one
-/// continuous motion into pieces, and their corners are where the cutting fell, not
-/// places the plan chose. Runs of them may cut those corners by more (a chain threaded
-/// through a bend then turns its links together, not one after another at the angular
-/// rate limit); the check still asks the whole move for the margin. Measured on `corridor` N = 6 (seed 2, threaded): 55 s
-/// of flight where 0.02 m gave 94 s.
-const STEP_RUN_TOLERANCE: f64 = 0.06;
-
-/// Longest translation (m) of a run of short steps (threading's steps are 2-4 cm).
-const SHORT_STEP: f64 = 0.2;
-
-/// Most edges one run joins.
-pub(super) const MAX_RUN: usize = 64;
 
 /// What the rate of a motion depends on.
 #[derive(Clone, Copy, Debug, Default)]
@@ -119,13 +104,13 @@ pub(super) fn head_length(d: &[f64]) -> f64 {
 }
 
 /// Whether the straight move from the start of `run` to its end passes every inner
-/// waypoint within [`RUN_TOLERANCE`] ([`STEP_RUN_TOLERANCE`] for short steps): each
+/// waypoint within `s.run_tolerance` (`s.step_run_tolerance` for short steps): each
 /// unit's distance from where the plan has it, where the move has the head as far
 /// along as the plan has it there. Where the head
 /// moves, only the waypoints that end a translation are compared: a follow-the-leader
 /// step changes shape, then translates, and its straight version moves both at once,
 /// so the waypoint between the two is off any straight line by the step itself.
-pub(super) fn straight(run: &[Segment], l: f64) -> bool {
+pub(super) fn straight(run: &[Segment], l: f64, s: &super::Settings) -> bool {
     let dim = run[0].delta.len();
     let angles = |d: &[f64]| d[3..].iter().map(|a| a.abs()).sum::<f64>();
     let head_total: f64 = run.iter().map(|e| head_length(&e.delta)).sum();
@@ -140,9 +125,9 @@ pub(super) fn straight(run: &[Segment], l: f64) -> bool {
         .iter()
         .map(|e| head_length(&e.delta))
         .fold(0.0f64, f64::max);
-    let tol = match longest > 0.0 && longest <= SHORT_STEP {
-        true => STEP_RUN_TOLERANCE,
-        false => RUN_TOLERANCE,
+    let tol = match longest > 0.0 && longest <= s.short_step {
+        true => s.step_run_tolerance,
+        false => s.run_tolerance,
     };
     for e in &run[..run.len() - 1] {
         at.iter_mut().zip(&e.delta).for_each(|(a, d)| *a += d);

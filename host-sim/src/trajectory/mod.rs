@@ -42,6 +42,24 @@ use serde::{Deserialize, Serialize};
 /// Sample spacing of a trajectory by default (s): 50 Hz.
 pub const DEFAULT_DT: f64 = 0.02;
 
+/// Largest sample spacing (s): the settings' contract (docs/model.md, "Trajectories").
+pub const MAX_DT: f64 = 0.1;
+
+/// Floating-point guard of sample times (a share of a sample): a time that is a whole
+/// number of samples up to rounding counts as whole. Not tuning.
+pub(crate) const TICK_GUARD: f64 = 1e-9;
+
+/// The defaults of the blending tuning, one per field of [`Settings`].
+mod defaults {
+    pub const RUN_TOLERANCE: f64 = 0.02;
+    pub const STEP_RUN_TOLERANCE: f64 = 0.06;
+    pub const SHORT_STEP: f64 = 0.2;
+    pub const MAX_RUN: usize = 64;
+    pub const MIN_PIECE: f64 = 0.1;
+    pub const SHRINKS: u8 = 2;
+    pub const FIT_ROUNDS: usize = 200;
+}
+
 /// The limits a trajectory keeps at every sample (docs/model.md, "Trajectories").
 /// The defaults are `arc sim`'s.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -96,20 +114,52 @@ impl Limits {
     }
 }
 
-/// How a trajectory is made. In a file (serde), a field left out takes its default.
+/// How a trajectory is made: the limits and sampling (`arc`'s flags), and the tuning of
+/// blends and merges (docs/settings.md), which trades flight time against work and
+/// how far a merged move may leave the plan's path (the exact check still holds every
+/// sample to the clearance). In a file (serde), a field left out takes its default.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Settings {
     /// The limits.
+    /// Higher limits: faster flights, harder to track.
     pub limits: Limits,
     /// Sample spacing (s), in `(0, 0.1]`.
+    /// Smaller: finer samples, more of them to check and store.
     pub dt: f64,
     /// Blend consecutive edges where admissible (false: stop at every waypoint).
+    /// Off: every waypoint a stop, the slowest flight, nothing to check beyond the
+    /// plan.
     pub blend: bool,
     /// Clearance (m) every body keeps from the map wherever the motion is not the
     /// plan's own (a blend, a merge), so that a controller's tracking error cannot turn
     /// a shortcut into a contact; the planner's default margin.
+    /// Larger: fewer blends and merges pass, longer flights.
     pub clearance: f64,
+    /// How far (m) a run's straight move may carry any unit from where the plan has it
+    /// at the run's inner waypoints: a fraction of the planner's clearance margin
+    /// (0.05 m), which the check then asks of the whole move. Larger: more corners
+    /// merged, shorter flights, farther from the plan's path.
+    pub run_tolerance: f64,
+    /// The same for a run of short steps only (translations none longer than
+    /// `short_step`, and shape changes): a follow-the-leader path's corners are where
+    /// its steps cut one motion, not places the plan chose. Measured on `corridor` N = 6
+    /// (seed 2, threaded): 55 s of flight where `run_tolerance` gave 94 s.
+    pub step_run_tolerance: f64,
+    /// Longest translation (m) of a run of short steps (threading's steps are 2-4 cm).
+    /// Longer: more runs take the larger tolerance.
+    pub short_step: f64,
+    /// Most edges one run joins. More: longer merged moves, more work per run.
+    pub max_run: usize,
+    /// Shortest part of a translation (m) a pair is made with, or shrunk to.
+    /// Smaller: pairs made with shorter pieces, more of them tried.
+    pub min_piece: f64,
+    /// How often a failed pair flies half as much of its translation before it gives
+    /// up. More: more pairs kept, more checks.
+    pub shrinks: u8,
+    /// Rounds of lowering cruise rates until every edge's ramps fit; a plan whose ramps
+    /// still do not fit is timed without blends there.
+    pub fit_rounds: usize,
 }
 
 impl Default for Settings {
@@ -119,9 +169,20 @@ impl Default for Settings {
             dt: DEFAULT_DT,
             blend: true,
             clearance: crate::collision::DEFAULT_CLEARANCE,
+            run_tolerance: defaults::RUN_TOLERANCE,
+            step_run_tolerance: defaults::STEP_RUN_TOLERANCE,
+            short_step: defaults::SHORT_STEP,
+            max_run: defaults::MAX_RUN,
+            min_piece: defaults::MIN_PIECE,
+            shrinks: defaults::SHRINKS,
+            fit_rounds: defaults::FIT_ROUNDS,
         }
     }
 }
+
+/// Largest value of a blending setting (m, or a count): beyond any map, and it bounds
+/// the work of a run. The settings' contract, not tuning.
+const MAX_TUNING: f64 = 1e4;
 
 /// Most samples one trajectory may have (a 5.5-hour flight at 50 Hz).
 pub const MAX_SAMPLES: usize = 1_000_000;
@@ -132,7 +193,8 @@ pub enum TrajectoryError {
     /// The plan breaks the plan format.
     #[error("plan: {0}")]
     Plan(#[from] FormatError),
-    /// A limit that is not a positive number.
+    /// A limit (or a blending setting) that is not a positive number (at most 1e4 for a
+    /// blending setting).
     #[error("limit {name} = {value} must be a positive number")]
     Limit {
         /// The limit's name.
@@ -159,7 +221,7 @@ impl Settings {
     /// Checks the limits and the sample spacing.
     pub fn validate(&self) -> Result<(), TrajectoryError> {
         self.limits.validate()?;
-        if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= 0.1) {
+        if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= MAX_DT) {
             return Err(TrajectoryError::Dt(self.dt));
         }
         if !(self.clearance.is_finite() && self.clearance >= 0.0) {
@@ -167,6 +229,19 @@ impl Settings {
                 name: "clearance",
                 value: self.clearance,
             });
+        }
+        for (name, value) in [
+            ("run_tolerance", self.run_tolerance),
+            ("step_run_tolerance", self.step_run_tolerance),
+            ("short_step", self.short_step),
+            ("max_run", self.max_run as f64),
+            ("min_piece", self.min_piece),
+            ("shrinks", self.shrinks as f64),
+            ("fit_rounds", self.fit_rounds as f64),
+        ] {
+            if !(value.is_finite() && value > 0.0 && value <= MAX_TUNING) {
+                return Err(TrajectoryError::Limit { name, value });
+            }
         }
         Ok(())
     }

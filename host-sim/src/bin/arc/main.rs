@@ -149,7 +149,7 @@ where
 {
     let cli = command()
         .try_get_matches_from(args)
-        .and_then(|m| Cli::from_arg_matches(&m))
+        .and_then(|m| Cli::from_arg_matches(&m).map(|c| (c, m)))
         .map_err(|e| {
             // --help and --version are not errors.
             if matches!(
@@ -173,7 +173,7 @@ where
                 .collect();
             CliError::input(first.join(" ").trim_start_matches("error: ").to_string())
         });
-    let cli = match cli {
+    let (cli, matches) = match cli {
         Ok(c) => c,
         Err(e) if e.code == exit::DONE => return Ok(()),
         Err(e) => return Err(e),
@@ -181,7 +181,7 @@ where
     match cli.command {
         Command::Tables(c) => tables::run(c),
         Command::Shapes(a) => tables::run_shapes(a),
-        Command::Plan(a) => plan::run(*a),
+        Command::Plan(a) => plan::run(*a, &given(&matches, "plan")),
         Command::Verify(a) => verify::run(a),
         Command::Trajectory(a) => trajectory::run(a),
         Command::Map(c) => map::run(c),
@@ -191,6 +191,19 @@ where
         Command::Export(a) => export::run(*a),
         Command::Explore(a) => explore::run(*a),
     }
+}
+
+/// The ids of the arguments of subcommand `name` given on the command line, not left
+/// at their defaults: where a settings file and a flag both set a value, the flag
+/// wins (`arc plan --settings`).
+fn given(m: &clap::ArgMatches, name: &str) -> plan::Given {
+    let Some(sub) = m.subcommand_matches(name) else {
+        return plan::Given::new();
+    };
+    sub.ids()
+        .filter(|id| sub.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
+        .map(|id| id.to_string())
+        .collect()
 }
 
 /// Restores the default action of SIGPIPE, which Rust's runtime ignores: with it

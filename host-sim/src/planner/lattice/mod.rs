@@ -69,22 +69,6 @@ use search::{Limit, Search};
 const AXIS_BITS: u32 = 21;
 const AXIS_MASK: u64 = (1 << AXIS_BITS) - 1;
 
-/// Surcharge (per metre) for stepping where the clearance is below the preferred one.
-const NARROW_SURCHARGE: f64 = 4.0;
-/// Clearance above the preferred radius at which the step penalty vanishes (m).
-const CLEARANCE_REF: f64 = 0.5;
-/// Inflation of the A* heuristic (weighted A*): routes within this factor of the
-/// cheapest, found with far fewer expansions.
-const HEURISTIC_WEIGHT: f64 = 2.5;
-/// Longest step (lattice spacings) in open space.
-const MAX_JUMP: f64 = 16.0;
-/// Lattice points the first, straight-line-guided search may touch before the
-/// coarse guide is built.
-const QUICK_BUDGET: usize = 10_000;
-/// A string-pulled segment keeps the clearance of the points it replaces up to this
-/// much above the preferred radius (m).
-const KEEP_CAP: f64 = 0.3;
-
 /// How the lattice search ended.
 #[derive(Clone, Debug, PartialEq)]
 pub enum LatticeOutcome {
@@ -144,6 +128,8 @@ pub struct HeadLattice {
     weight: f64,
     /// Most lattice points a query may visit.
     pub budget: usize,
+    /// The search's tuning (`planner::LatticeSettings`).
+    pub(super) tuning: super::LatticeSettings,
     /// Expansions of the last strided search.
     searched: std::cell::Cell<Option<usize>>,
     /// The map's free regions for the sphere of radius `r_min`, labelled on first use.
@@ -152,8 +138,24 @@ pub struct HeadLattice {
 
 impl HeadLattice {
     /// The lattice of `ctx`'s map for the head's sphere: it must be free at clearance
-    /// `clearance_min`, and prefers `ctx`'s clearance.
+    /// `clearance_min`, and prefers `ctx`'s clearance; tuned by the defaults.
+    #[cfg(test)]
     pub fn new(ctx: &CollisionContext, clearance_min: f64, weight: f64) -> Self {
+        Self::tuned(
+            ctx,
+            clearance_min,
+            weight,
+            super::LatticeSettings::default(),
+        )
+    }
+
+    /// [`HeadLattice::new`] with the search's tuning `tuning`.
+    pub fn tuned(
+        ctx: &CollisionContext,
+        clearance_min: f64,
+        weight: f64,
+        tuning: super::LatticeSettings,
+    ) -> Self {
         let g = ctx.field().grid();
         let (lo, hi) = g.bounds();
         let h = g.resolution() / 2.0;
@@ -169,7 +171,8 @@ impl HeadLattice {
             r_min: unit_r + clearance_min.min(pref) + FK_TOLERANCE,
             r_pref: unit_r + pref + FK_TOLERANCE,
             weight,
-            budget: 60_000_000,
+            budget: tuning.budget,
+            tuning,
             searched: std::cell::Cell::new(None),
             regions: std::sync::OnceLock::new(),
         }
@@ -179,7 +182,7 @@ impl HeadLattice {
     /// first call (part of the planner's setup: its cost follows the map's size).
     pub fn regions(&self, field: &DistanceField) -> &Regions {
         self.regions
-            .get_or_init(|| Regions::label(field, self.r_min))
+            .get_or_init(|| Regions::label(field, self.r_min, self.tuning.min_block))
     }
 
     /// Forgets the labelled regions (the next query that needs them labels them
@@ -261,12 +264,13 @@ impl HeadLattice {
 
     /// Step cost factor for entering a point of clearance `c`.
     pub(super) fn factor(&self, c: f64) -> f64 {
-        let mut f = 1.0 + self.weight * (1.0 - (c - self.unit_r) / CLEARANCE_REF).max(0.0);
+        let mut f =
+            1.0 + self.weight * (1.0 - (c - self.unit_r) / self.tuning.clearance_ref).max(0.0);
         if c <= self.r_pref {
             // Below the preferred clearance: the more so the narrower, so routes
             // through tight openings keep to their middle.
-            let span = (self.r_pref - self.r_min).max(1e-6);
-            f += NARROW_SURCHARGE * (0.5 + (self.r_pref - c) / span);
+            let span = (self.r_pref - self.r_min).max(crate::planner::numeric::TINY);
+            f += self.tuning.narrow_surcharge * (0.5 + (self.r_pref - c) / span);
         }
         f
     }
@@ -304,7 +308,7 @@ impl HeadLattice {
     ) -> Option<HeadRoute> {
         let mut nodes = Nodes::new(self, ctx_min.field());
         let quick = Limit {
-            budget: QUICK_BUDGET.min(self.budget),
+            budget: self.tuning.quick_budget.min(self.budget),
             deadline,
         };
         let straight = guide::Guide::straight(self, goal);

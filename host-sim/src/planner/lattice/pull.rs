@@ -2,8 +2,9 @@
 //! then the path pulled taut where the head's sphere can fly the segments.
 
 use super::nodes::Nodes;
-use super::{dist, exact_clearance, norm, search::offsets26, sub, HeadLattice, KEEP_CAP};
+use super::{dist, exact_clearance, norm, search::offsets26, sub, HeadLattice};
 use crate::collision::CollisionContext;
+use crate::planner::numeric::{DIV_GUARD, MILLIMETRE, TIE};
 
 impl HeadLattice {
     /// Moves the path's points where it is narrower than the preferred radius across
@@ -12,7 +13,7 @@ impl HeadLattice {
     /// first route it finds.
     pub(super) fn centre(&self, nodes: &mut Nodes, pts: &mut [[f64; 3]], clear: &mut [f64]) {
         let field = nodes.field;
-        let cap = self.r_pref + 4.0 * self.h;
+        let cap = self.r_pref + self.tuning.centre_reach * self.h;
         let exact = |p: [f64; 3]| exact_clearance(field, p, 0.0, cap);
         let offs = offsets26();
         for j in 1..pts.len().saturating_sub(1) {
@@ -20,7 +21,7 @@ impl HeadLattice {
                 continue;
             }
             let d = sub(pts[j + 1], pts[j - 1]);
-            let dn = norm(d).max(1e-12);
+            let dn = norm(d).max(DIV_GUARD);
             let base = [0, 1, 2].map(|a| ((pts[j][a] - self.lo[a]) / self.h).round() as i64);
             let Some(mut cur) = self.pack(base) else {
                 continue;
@@ -33,7 +34,7 @@ impl HeadLattice {
                     let on = norm([o[0] as f64, o[1] as f64, o[2] as f64]);
                     let along =
                         (o[0] as f64 * d[0] + o[1] as f64 * d[1] + o[2] as f64 * d[2]) / (on * dn);
-                    if along.abs() > 0.35 {
+                    if along.abs() > self.tuning.across {
                         continue;
                     }
                     let Some(n) = self.pack([i[0] + o[0], i[1] + o[1], i[2] + o[2]]) else {
@@ -43,7 +44,7 @@ impl HeadLattice {
                         continue;
                     }
                     let e = exact(self.point(n));
-                    if e > best + 1e-9 && next.is_none_or(|(_, b)| e > b) {
+                    if e > best + TIE && next.is_none_or(|(_, b)| e > b) {
                         next = Some((n, e));
                     }
                 }
@@ -60,7 +61,7 @@ impl HeadLattice {
     /// Pulls a lattice path taut: from each kept point, the farthest later point that
     /// one segment reaches, where the head's sphere can fly the segment (conservative,
     /// at the smallest clearance) and the segment keeps at least the smallest clearance
-    /// of the points it replaces (capped at the preferred radius plus `KEEP_CAP`).
+    /// of the points it replaces (capped at the preferred radius plus `LatticeSettings::keep_cap`).
     pub fn simplify(
         &self,
         ctx_min: &CollisionContext,
@@ -76,7 +77,7 @@ impl HeadLattice {
                 .iter()
                 .copied()
                 .fold(f64::INFINITY, f64::min)
-                .min(self.r_pref + KEEP_CAP);
+                .min(self.r_pref + self.tuning.keep_cap);
             if !ctx_min.is_head_segment_free(pts[i], pts[j]) {
                 return false;
             }
@@ -85,7 +86,7 @@ impl HeadLattice {
             (0..=n).all(|s| {
                 let t = s as f64 / n as f64;
                 let p = [0, 1, 2].map(|a| pts[i][a] + t * (pts[j][a] - pts[i][a]));
-                field.clearance(p) + 1e-3 >= need
+                field.clearance(p) + MILLIMETRE >= need
             })
         };
         let mut out = vec![pts[0]];

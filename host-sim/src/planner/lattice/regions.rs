@@ -50,9 +50,11 @@ use crate::map::distance::DistanceField;
 /// Allowance for rounding in the relaxed test (m): relaxing further is always safe.
 const ROUND_EPS: f64 = 1e-6;
 
-/// Smallest block edge of the coarse graph (m).
-const MIN_BLOCK: f64 = 0.4;
 /// Most blocks over the map's box (the block edge grows to stay below).
+///
+/// Tuning left a constant: it bounds the coarse graph's memory and labelling time on
+/// the largest maps (docs/promises.md), which a settings file should not lift; the
+/// smallest block is the setting `planner::LatticeSettings::min_block`.
 const MAX_BLOCKS: f64 = 100_000.0;
 
 /// One slab's union-find ([`Regions::join_rows`]).
@@ -102,14 +104,15 @@ pub struct CoarseGraph {
 }
 
 impl Regions {
-    /// Labels the regions of `field`'s grid for a sphere of radius `radius` (m).
-    pub fn label(field: &DistanceField, radius: f64) -> Self {
+    /// Labels the regions of `field`'s grid for a sphere of radius `radius` (m), in
+    /// blocks of at least `min_block` (m, `planner::LatticeSettings::min_block`).
+    pub fn label(field: &DistanceField, radius: f64, min_block: f64) -> Self {
         let g = field.grid();
         let dims = g.dims();
         let r = g.resolution();
         let threshold = radius - r * 3f64.sqrt() / 2.0 - ROUND_EPS;
         let volume: f64 = dims.iter().map(|&d| d as f64 * r).product();
-        let block_m = MIN_BLOCK.max((volume / MAX_BLOCKS).cbrt());
+        let block_m = min_block.max((volume / MAX_BLOCKS).cbrt());
         let block = ((block_m / r).round() as u32).max(1);
         // Segments of every row, rows in parallel by z-slab.
         let slabs: Vec<Vec<Vec<[u32; 2]>>> = (0..dims[2])
@@ -485,7 +488,11 @@ mod tests {
     /// nodes, and voxels of one block that touch share a node.
     fn coarse_and_brute_force(g: Grid, radius: f64) -> (Edges, Edges) {
         let field = DistanceField::new(g);
-        let regions = Regions::label(&field, radius);
+        let regions = Regions::label(
+            &field,
+            radius,
+            crate::planner::LatticeSettings::default().min_block,
+        );
         let c = regions.coarse();
         let graph = (0..c.centre.len())
             .flat_map(|a| {

@@ -7,7 +7,11 @@ use std::collections::BinaryHeap;
 use super::flood::Flood;
 use super::guide::Guide;
 use super::nodes::{KeySet, Nodes};
-use super::{dist, HeadLattice, HEURISTIC_WEIGHT, MAX_JUMP};
+use super::{dist, HeadLattice};
+
+/// Rounding allowance of a reach in lattice spacings (a ten-thousandth): a point at
+/// exactly two strides is kept whatever the rounding of its coordinates. Not tuning.
+const REACH_ROUNDING: f64 = 1.0001;
 
 /// How one strided search ended.
 pub(super) enum Search {
@@ -106,7 +110,7 @@ impl HeadLattice {
             let q = (p[a] - self.lo[a]) / self.h;
             ((q - off as f64) / stride as f64).round() as i64 * stride + off
         });
-        let reach = 2.0 * stride as f64 * self.h * 1.0001;
+        let reach = 2.0 * stride as f64 * self.h * REACH_ROUNDING;
         let mut found: Vec<(f64, u64)> = Vec::new();
         for dz in -2..=2 {
             for dy in -2..=2 {
@@ -162,7 +166,7 @@ impl HeadLattice {
             if c < n.g {
                 n.g = c;
                 open.push(Open {
-                    f: c + HEURISTIC_WEIGHT * guide.estimate(s, self.point(s)),
+                    f: c + self.tuning.heuristic_weight * guide.estimate(s, self.point(s)),
                     k: s,
                 });
             }
@@ -197,7 +201,7 @@ impl HeadLattice {
             let room = ((ck - self.r_min) / (stride as f64 * self.h * 3f64.sqrt())).floor();
             let step = stride
                 * if room >= 2.0 {
-                    room.min(MAX_JUMP) as i64
+                    room.min(self.tuning.max_jump) as i64
                 } else {
                     1
                 };
@@ -226,7 +230,7 @@ impl HeadLattice {
                     nn.g = ng;
                     nn.parent = k;
                     open.push(Open {
-                        f: ng + HEURISTIC_WEIGHT * guide.estimate(n, pn),
+                        f: ng + self.tuning.heuristic_weight * guide.estimate(n, pn),
                         k: n,
                     });
                 }

@@ -9,13 +9,23 @@ use super::CAP;
 use crate::collision::exact::{exact_clearance, positions_f64};
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
 use crate::collision::CollisionContext;
+use crate::planner::numeric::{TIE, TINY};
 use crate::planner::Step;
 
 /// Samples of an edge are measured at the verifier's spacing times this: no unit
 /// moves more than `SAMPLE_SPACING r_v / 4` between two, so a narrowest missed in
 /// between is at most that much narrower (the clearance changes no faster than the
 /// unit moves); `arc verify` reports the exact figure.
+///
+/// Tuning left a constant: every measuring function of widening and threading
+/// samples edges at this spacing, and their callers (tests included) hold no
+/// settings; 2 halves the measurements for at most `r_v / 2` of missed narrowing.
 const SAMPLE_SPACING: f64 = 2.0;
+
+/// The gradient of [`distance`] is taken by central differences this many steps per
+/// voxel: derived from the resolution, an eighth of a voxel, well inside the voxel
+/// whose cube is nearest, so that both differences see the same obstacle.
+const GRADIENT_STEPS_PER_VOXEL: f64 = 8.0;
 
 /// The narrowest sample of an edge: its clearance and where (unit centre, and which
 /// unit at which sample).
@@ -84,7 +94,7 @@ pub(super) fn narrowest_of(
     for &(lb, p, spot) in &samples.bounds {
         // A bound within a micrometre of the best is as good as equal: the samples
         // along a flat face all share it.
-        if lb - r_u + 1e-6 >= best.clearance || lb > samples.within {
+        if lb - r_u + TINY >= best.clearance || lb > samples.within {
             break;
         }
         // Near the cap the bound is close enough: the exact measure there costs
@@ -142,7 +152,7 @@ fn at_or_below(ctx: &CollisionContext, lb: f64, p: Point3<f64>, floor: f64) -> b
     let field = ctx.field();
     let reach = floor + r_u;
     lb - r_u >= CAP - field.grid().resolution()
-        || exact_clearance(field, p, reach, reach + 1e-9) <= reach
+        || exact_clearance(field, p, reach, reach + TIE) <= reach
 }
 
 /// Whether edge `e` of `steps` surely fails [`keeps_above`] at `floor`, by a look at
@@ -254,7 +264,7 @@ pub(super) fn distance_below(ctx: &CollisionContext, p: Point3<f64>, cap: f64) -
 
 /// The gradient of [`distance`] at `p` (central differences, an eighth of a voxel).
 pub(in crate::planner) fn gradient(ctx: &CollisionContext, p: Point3<f64>) -> Vector3<f64> {
-    let h = ctx.field().grid().resolution() / 8.0;
+    let h = ctx.field().grid().resolution() / GRADIENT_STEPS_PER_VOXEL;
     Vector3::from_fn(|i, _| {
         let mut e = Vector3::zeros();
         e[i] = h;

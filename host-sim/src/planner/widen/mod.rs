@@ -8,7 +8,7 @@
 //! 0.5 m window the chain's units could keep 0.1 m, and a plan that passes 1 cm from
 //! the preferred margin's edge is valid but needlessly close. Widening looks at the
 //! edges whose units come within [`CAP`] of the map, narrowest first, and, where the
-//! unit keeps less than [`CENTRED`] of what the middle of its passage would, moves a
+//! unit keeps less than `WidenSettings::centred` of what the middle of its passage would, moves a
 //! station next to it (or both ends of a translation together) a small step at a
 //! time, in the direction that most increases that unit's clearance, while the
 //! narrowest clearance of every edge the move touches grows. A translation whose ends
@@ -19,21 +19,22 @@
 //! edges it touches stay above their floors, which measures far less than finding
 //! their narrowest (most moves fail, and a look at the unit that was narrowest
 //! settles most of those); an edge no move widens is given up with the
-//! edges stuck at the same pinch ([`SAME_PINCH`]).
+//! edges stuck at the same pinch (`WidenSettings::same_pinch`).
 //!
 //! An edge is judged by its narrowest sample, which lies in one passage; a second
 //! pass ([`Widener::other_passages`]) widens translations that cross another passage
 //! off its middle, by moves that narrow no edge.
 //!
 //! The start and the goal stay where they are. Work is counted in edge measurements
-//! ([`BUDGET`]), not time, so the result is deterministic.
+//! (`WidenSettings::budget`), not time, so the result is deterministic.
 
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 use std::time::Instant;
 
-use super::{expired, Step};
+use super::numeric::{DIV_GUARD, TIE};
+use super::{expired, Step, WidenSettings};
 use crate::collision::exact::positions_f64;
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
 use crate::collision::CollisionContext;
@@ -48,49 +49,12 @@ mod tests;
 pub(super) use measure::{distance, gradient, zeta};
 
 /// Clearances at or above this (m) are wide enough: widening leaves them alone.
+///
+/// Tuning left a constant: it is the cap of every clearance post-processing measures
+/// (widening's samples, threading's pinches, `planner::Widening` and `arc plan`'s
+/// report), which the measuring functions share without a settings value; a setting
+/// would have to reach each of them and the reports.
 pub const CAP: f64 = 0.25;
-
-/// Edge measurements widening may spend on one plan.
-pub const BUDGET: usize = 150;
-
-/// Step lengths tried, as fractions of the map's resolution, largest first.
-const STEPS: [f64; 3] = [0.4, 0.15, 0.05];
-
-/// Directions tried per step: the clearance's gradient, then the nearest lattice
-/// directions (axes and face diagonals) that also widen.
-const DIRECTIONS: usize = 3;
-
-/// Translations widening may split into three (per plan).
-const MAX_SPLITS: usize = 2;
-
-/// An edge whose narrowest unit keeps this share of what the middle of its passage
-/// would keep is wide enough. The passages issue asks for 0.9; above 0.93 widening
-/// spent its budget on millimetres (0.97 kept the same openings at the target on the
-/// 200 instances of `arc bench robust`, in 10 % more time).
-pub(super) const CENTRED: f64 = 0.93;
-
-/// Narrowest samples nearer than this (m) are at the same pinch: where the moves of
-/// one edge's stations could not widen it, the edges whose narrowest unit is this
-/// near and keeps at most [`PLATEAU`] more are given up too. Their moves push the same
-/// units against the same walls: on the 20 robust instances of `arc bench flight`
-/// such edges were tried a dozen times each, for about a fifth of widening's
-/// measurements, and almost never widened.
-const SAME_PINCH: f64 = 0.15;
-
-/// See [`SAME_PINCH`] (m).
-const PLATEAU: f64 = 0.003;
-
-/// Smallest gain (m) that counts as widening.
-const GAIN: f64 = 1e-4;
-
-/// Samples farther apart than this (m) may lie in two passages: an edge crossing
-/// both is judged by its narrowest sample, in one of them, and
-/// [`Widener::other_passages`] looks for the other.
-const SEPARATE: f64 = 0.8;
-
-/// Samples of another passage looked at per edge, narrowest first, each at least
-/// [`SEPARATE`] from the ones before (a long tunnel holds several).
-const OTHER_CANDIDATES: usize = 3;
 
 /// A run of steps at one head position: the translation into it, its shape changes,
 /// and the translation out of it move with it.
@@ -126,6 +90,7 @@ pub(super) fn widen(
     ctx_min: &CollisionContext,
     steps: Vec<Step>,
     deadline: Option<Instant>,
+    s: &WidenSettings,
 ) -> (Vec<Step>, Widening) {
     let edges = steps.len().saturating_sub(1);
     let narrow: Vec<Narrowest> = (0..edges).map(|e| measure_whole(ctx, e, &steps)).collect();
@@ -138,6 +103,7 @@ pub(super) fn widen(
         spent: edges,
         splits: 0,
         deadline,
+        s,
     };
     let before = w.narrowest();
     let mut moves = 0;
@@ -176,13 +142,14 @@ struct Widener<'a> {
     splits: usize,
     /// When to stop trying moves (the query's time limit).
     deadline: Option<Instant>,
+    s: &'a WidenSettings,
 }
 
 impl Widener<'_> {
     /// Whether another measurement may be spent: budget left, and the deadline not
     /// passed.
     fn may_spend(&self) -> bool {
-        self.spent < BUDGET && !expired(self.deadline)
+        self.spent < self.s.budget && !expired(self.deadline)
     }
 
     fn narrowest(&self) -> f64 {
@@ -193,7 +160,7 @@ impl Widener<'_> {
     fn narrowest_in_passages(&self) -> Option<f64> {
         (0..self.narrow.len())
             .filter(|&e| self.narrow[e].clearance < CAP)
-            .filter(|&e| in_passage(self.ctx, self.narrow[e].at, self.along(e)))
+            .filter(|&e| in_passage(self.ctx, self.s, self.narrow[e].at, self.along(e)))
             .map(|e| self.narrow[e].clearance)
             .min_by(f64::total_cmp)
     }
@@ -201,7 +168,7 @@ impl Widener<'_> {
     /// The direction of edge `e` when it is a translation.
     fn along(&self, e: usize) -> Option<Vector3<f64>> {
         let (xa, xb) = (self.steps[e].xi, self.steps[e + 1].xi);
-        Vector3::new(xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]).try_normalize(1e-9)
+        Vector3::new(xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]).try_normalize(TIE)
     }
 
     /// The narrowest edge below [`CAP`] that may still widen.
@@ -216,12 +183,12 @@ impl Widener<'_> {
     }
 
     /// Gives up edge `e`, which no move widens, and the edges stuck at its pinch
-    /// ([`SAME_PINCH`]).
+    /// (`WidenSettings::same_pinch`).
     fn stuck_at_pinch(&mut self, e: usize) {
         let pinch = self.narrow[e];
         for (k, n) in self.narrow.iter().enumerate() {
-            let near = (n.at - pinch.at).norm() <= SAME_PINCH;
-            if k == e || (near && n.clearance <= pinch.clearance + PLATEAU) {
+            let near = (n.at - pinch.at).norm() <= self.s.same_pinch;
+            if k == e || (near && n.clearance <= pinch.clearance + self.s.plateau) {
                 self.stuck[k] = true;
             }
         }
@@ -264,14 +231,14 @@ impl Widener<'_> {
         let along = self.along(e);
         let narrow = self.narrow[e];
         let grad = gradient(self.ctx, narrow.at);
-        if !below_aim(self.ctx, narrow.at, grad, along, narrow.clearance) {
+        if !below_aim(self.ctx, self.s, narrow.at, grad, along, narrow.clearance) {
             // Open on one side, or as wide as the passage allows.
             return false;
         }
         if !groups.is_empty() && self.try_groups(e, &groups, grad, along) {
             return true;
         }
-        self.splits < MAX_SPLITS && self.split(e)
+        self.splits < self.s.max_splits && self.split(e)
     }
 
     /// Tries the moves of `groups` along `grad` (then other directions); whether one
@@ -287,11 +254,13 @@ impl Widener<'_> {
         let r_v = self.ctx.field().grid().resolution();
         // Along the gradient at every step length; the other directions only at the
         // smallest, where the gradient's own step has failed.
-        let mut tries: Vec<(f64, &Vector3<f64>)> = STEPS
+        let mut tries: Vec<(f64, &Vector3<f64>)> = self
+            .s
+            .steps
             .iter()
             .flat_map(|&f| dirs.first().map(|d| (f, d)))
             .collect();
-        let last = STEPS[STEPS.len() - 1];
+        let last = self.s.steps[self.s.steps.len() - 1];
         tries.extend(dirs.iter().skip(1).map(|d| (last, d)));
         for (f, d) in tries {
             for g in groups {
@@ -334,7 +303,7 @@ impl Widener<'_> {
             return false;
         };
         let len = (0..3).map(|i| (b[i] - a[i]).powi(2)).sum::<f64>().sqrt();
-        let margin = (2.0 * r_v / len).min(0.25);
+        let margin = (2.0 * r_v / len).min(self.s.split_margin);
         let (lo, hi) = ((lo - margin).max(margin), (hi + margin).min(1.0 - margin));
         if hi - lo < margin {
             return false;
@@ -358,7 +327,7 @@ impl Widener<'_> {
     }
 
     /// Candidate directions at `p`: the exact clearance's gradient there, then the
-    /// axis and face-diagonal directions that increase it most ([`DIRECTIONS`] in all).
+    /// axis and face-diagonal directions that increase it most (`WidenSettings::directions` in all).
     fn directions(&self, grad: Vector3<f64>, along: Option<Vector3<f64>>) -> Vec<Vector3<f64>> {
         let flat = |v| across(v, along);
         let mut dirs: Vec<(f64, Vector3<f64>)> = Vec::new();
@@ -370,7 +339,7 @@ impl Widener<'_> {
                         continue;
                     }
                     let Some(d) =
-                        flat(Vector3::new(x as f64, y as f64, z as f64)).try_normalize(1e-9)
+                        flat(Vector3::new(x as f64, y as f64, z as f64)).try_normalize(TIE)
                     else {
                         continue;
                     };
@@ -383,10 +352,10 @@ impl Widener<'_> {
         }
         dirs.sort_by(|a, b| b.0.total_cmp(&a.0));
         flat(grad)
-            .try_normalize(1e-12)
+            .try_normalize(DIV_GUARD)
             .into_iter()
             .chain(dirs.into_iter().map(|(_, d)| d))
-            .take(DIRECTIONS)
+            .take(self.s.directions)
             .collect()
     }
 
@@ -400,7 +369,7 @@ impl Widener<'_> {
             .map(|e| self.narrow[e].clearance)
             .fold(f64::INFINITY, f64::min);
         // The edge being widened first: most moves that fail, fail there.
-        let mut order: Vec<(usize, f64)> = touched.map(|k| (k, old + GAIN)).collect();
+        let mut order: Vec<(usize, f64)> = touched.map(|k| (k, old + self.s.gain)).collect();
         order.sort_by_key(|&(k, _)| k != first);
         self.take_if_above(moved, &order)
     }
@@ -465,7 +434,7 @@ impl Widener<'_> {
     /// share may cross another passage off its middle (a tunnel, then a door a chain
     /// length further: widening judged the edge by the tunnel). For each such
     /// translation, the narrowest samples away from its narrowest
-    /// ([`OTHER_CANDIDATES`], [`SEPARATE`] apart) are measured against their own
+    /// (`WidenSettings::other_candidates`, `WidenSettings::separate` apart) are measured against their own
     /// passage's middle, and the first off it is widened by moves of the edge's
     /// stations that widen it there and narrow no edge they touch. Returns the moves.
     fn other_passages(&mut self) -> usize {
@@ -485,7 +454,7 @@ impl Widener<'_> {
                     break;
                 };
                 let r_v = self.ctx.field().grid().resolution();
-                let taken = STEPS.iter().any(|&f| {
+                let taken = self.s.steps.iter().any(|&f| {
                     groups.iter().any(|g| {
                         self.may_spend() && self.try_move_at(g, d * (f * r_v), e, target, &away)
                     })
@@ -509,15 +478,15 @@ impl Widener<'_> {
         along: Vector3<f64>,
     ) -> Option<(Narrowest, Vector3<f64>, Vec<Point3<f64>>)> {
         let mut away = vec![self.narrow[e].at];
-        for _ in 0..OTHER_CANDIDATES {
-            let far = |p: &Point3<f64>| away.iter().all(|q| (p - q).norm() > SEPARATE);
+        for _ in 0..self.s.other_candidates {
+            let far = |p: &Point3<f64>| away.iter().all(|q| (p - q).norm() > self.s.separate);
             self.spent += 1;
             let n = measure(self.ctx, e, &self.steps, f64::NEG_INFINITY, far)?;
             if n.clearance >= CAP {
                 return None;
             }
             let grad = gradient(self.ctx, n.at);
-            if below_aim(self.ctx, n.at, grad, Some(along), n.clearance) {
+            if below_aim(self.ctx, self.s, n.at, grad, Some(along), n.clearance) {
                 return Some((n, grad, away));
             }
             away.push(n.at);
@@ -526,7 +495,7 @@ impl Widener<'_> {
     }
 
     /// [`Self::try_move`] for a sample of another passage: the move is taken when
-    /// edge `e` keeps more than `target` in that passage (within [`SEPARATE`] of it,
+    /// edge `e` keeps more than `target` in that passage (within `WidenSettings::separate` of it,
     /// and nearer it than the samples of the passages `away`), no edge the move
     /// touches gets narrower, and the moved edges pass the checks.
     fn try_move_at(
@@ -540,14 +509,14 @@ impl Widener<'_> {
         let (moved, touched) = self.moved(group, delta);
         let near = |p: &Point3<f64>| {
             let d = (p - target.at).norm();
-            d <= SEPARATE && away.iter().all(|q| (p - q).norm() > d)
+            d <= self.s.separate && away.iter().all(|q| (p - q).norm() > d)
         };
         self.spent += 1;
-        if measure(self.ctx, e, &moved, target.clearance + GAIN, near).is_none() {
+        if measure(self.ctx, e, &moved, target.clearance + self.s.gain, near).is_none() {
             return false;
         }
         let floors: Vec<(usize, f64)> = touched
-            .map(|k| (k, self.narrow[k].clearance - 1e-9))
+            .map(|k| (k, self.narrow[k].clearance - TIE))
             .collect();
         self.take_if_above(moved, &floors)
     }

@@ -1,12 +1,12 @@
 //! Widening's tests: on a window and on an opening with a door behind it.
 
 use super::measure::{distance, fails_near, keeps_above, measure, measure_whole, samples, Spot};
-use super::passage::TARGET_SHARE;
 use super::*;
 use crate::collision::exact::positions_f64;
 use crate::map::grid::{Cell, Grid};
 use crate::map::DistanceField;
 use crate::planner::Source;
+use crate::planner::WidenSettings;
 use aerial_chain_core::{ChainParams, Shape};
 use std::sync::Arc;
 
@@ -35,7 +35,7 @@ fn step(xi: [f64; 3], shape: &Shape) -> Step {
 fn widened_in_the_window(steps: &[Step]) -> Vec<Step> {
     let ctx = window();
     assert!(steps.windows(2).all(|w| edge_passes(&ctx, &w[0], &w[1])));
-    let (out, report) = widen(&ctx, &ctx, steps.to_vec(), None);
+    let (out, report) = widen(&ctx, &ctx, steps.to_vec(), None, &WidenSettings::default());
     let (first, last) = (&steps[0], &steps[steps.len() - 1]);
     assert_eq!((out[0].xi, out[out.len() - 1].xi), (first.xi, last.xi));
     assert!(out.iter().all(|s| s.shape == first.shape));
@@ -64,13 +64,13 @@ fn past_its_deadline_widening_moves_nothing_and_keeps_the_plan() {
     let ctx = window();
     let past = Some(std::time::Instant::now());
     std::thread::sleep(std::time::Duration::from_millis(2));
-    let (out, report) = widen(&ctx, &ctx, off_centre(), past);
+    let (out, report) = widen(&ctx, &ctx, off_centre(), past, &WidenSettings::default());
     assert_eq!(out, off_centre());
     assert_eq!(report.moves, 0);
     assert_eq!(report.before, report.after);
     // Without a deadline the same plan is widened (the test above): the deadline is
     // what stopped it.
-    let (_, free) = widen(&ctx, &ctx, off_centre(), None);
+    let (_, free) = widen(&ctx, &ctx, off_centre(), None, &WidenSettings::default());
     assert!(free.moves > 0);
 }
 
@@ -91,8 +91,8 @@ fn a_passage_between_start_and_goal_is_split_and_centred() {
 #[test]
 fn the_same_plan_widens_the_same_way() {
     let ctx = window();
-    let (a, ra) = widen(&ctx, &ctx, off_centre(), None);
-    let (b, rb) = widen(&ctx, &ctx, off_centre(), None);
+    let (a, ra) = widen(&ctx, &ctx, off_centre(), None, &WidenSettings::default());
+    let (b, rb) = widen(&ctx, &ctx, off_centre(), None, &WidenSettings::default());
     assert!(ra.moves > 0);
     assert_eq!((a, ra), (b, rb));
 }
@@ -149,13 +149,13 @@ fn a_second_passage_on_the_same_translation_is_widened_too() {
     assert!(steps.windows(2).all(|w| edge_passes(&ctx, &w[0], &w[1])));
     let door_before = clearance_at_wall(&ctx, &steps, 3.05);
     assert!(door_before < 0.16, "{door_before}");
-    let (out, report) = widen(&ctx, &ctx, steps, None);
+    let (out, report) = widen(&ctx, &ctx, steps, None, &WidenSettings::default());
     assert!(out.windows(2).all(|w| edge_passes(&ctx, &w[0], &w[1])));
     let opening = clearance_at_wall(&ctx, &out, 2.05);
     let door = clearance_at_wall(&ctx, &out, 3.05);
     assert!(opening > 0.099, "opening {opening}");
     assert!(
-        door >= TARGET_SHARE * 0.2,
+        door >= WidenSettings::default().target_share * 0.2,
         "door {door}, before {door_before}"
     );
     assert!(report.moves > 0);
@@ -244,14 +244,15 @@ fn an_edge_stuck_at_a_pinch_gives_up_its_neighbours_there() {
         narrow: vec![
             at(2.0, 0.1),
             at(2.05, 0.102),
-            at(2.0, 0.1 + PLATEAU + 1e-4),
-            at(2.0 + SAME_PINCH + 0.01, 0.1),
+            at(2.0, 0.1 + WidenSettings::default().plateau + 1e-4),
+            at(2.0 + WidenSettings::default().same_pinch + 0.01, 0.1),
             at(1.9, 0.09),
         ],
         stuck: vec![false; 5],
         deadline: None,
         spent: 0,
         splits: 0,
+        s: &WidenSettings::default(),
     };
     w.stuck_at_pinch(0);
     assert_eq!(w.stuck, [true, true, false, false, true]);
@@ -266,7 +267,7 @@ fn wide_plans_are_left_alone() {
         step([1.0, 1.0, 1.0], &straight),
         step([1.4, 1.0, 1.0], &straight),
     ];
-    let (out, report) = widen(&ctx, &ctx, steps.clone(), None);
+    let (out, report) = widen(&ctx, &ctx, steps.clone(), None, &WidenSettings::default());
     assert_eq!(out, steps);
     assert_eq!(report.moves, 0);
     assert_eq!(report.before, CAP);

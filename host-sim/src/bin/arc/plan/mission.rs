@@ -15,7 +15,12 @@ use aerial_chain::planner::Query;
 use aerial_chain::planning::{plan_mission, PlanOptions, Request};
 
 /// Runs `arc plan --mission path`.
-pub fn run(a: &PlanArgs, path: &Path, options: &PlanOptions) -> CliResult {
+pub fn run(
+    a: &PlanArgs,
+    path: &Path,
+    options: &PlanOptions,
+    timing: &aerial_chain::trajectory::Settings,
+) -> CliResult {
     let mission = Mission::read(path).map_err(|e| CliError::input(e.to_string()))?;
     if a.problem.query.goal.is_some() {
         return Err(CliError::input(
@@ -90,7 +95,7 @@ pub fn run(a: &PlanArgs, path: &Path, options: &PlanOptions) -> CliResult {
             .goals
             .last()
             .map(|g| (g.position.into(), g.tolerance));
-        draw(a, pic, grid, plan, timed, last)?;
+        draw(a, pic, grid, plan, timed, last, timing)?;
         report.line(format_args!("  picture: {}", pic.display()));
     }
     Ok(())

@@ -1,5 +1,6 @@
 //! `arc plan`: the ARCplanner on a map file or a built-in scenario.
 
+use std::collections::BTreeSet;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicUsize;
 use std::sync::Arc;
@@ -18,7 +19,9 @@ use aerial_chain::collision::DEFAULT_CLEARANCE;
 use aerial_chain::map::DistanceField;
 use aerial_chain::plan_file::MapSection;
 use aerial_chain::planner::{Mode, Preference, Quality, Refinement, Settings};
-use aerial_chain::planning::{self, PlanOptions, PlanningError, Request, DEFAULT_TIME_LIMIT_S};
+use aerial_chain::planning::{
+    self, PlanOptions, PlanningError, Request, SettingsFile, DEFAULT_TIME_LIMIT_S,
+};
 use aerial_chain::tables::{ShapeTables, TableSettings};
 
 /// `arc plan`
@@ -30,26 +33,26 @@ pub struct PlanArgs {
     #[command(flatten)]
     problem: ProblemArgs,
     /// Shape sources: both (the ARCplanner), lsc or srs (the paper's ablation).
-    #[arg(long, value_enum, default_value_t = Mode::Both)]
+    #[arg(long, value_enum, default_value_t = defaults().mode)]
     mode: Mode,
     /// Shape preference: least (change only when needed) or coverage (PN where it fits).
-    #[arg(long, value_enum, default_value_t = Preference::Least)]
+    #[arg(long, value_enum, default_value_t = defaults().prefer)]
     prefer: Preference,
     /// Seed of the uniform head roadmap (a query that flies the lattice's head route
     /// alone builds none, and the seed does not change its plan).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = defaults().seed)]
     seed: u64,
     /// Head roadmap vertices M_VT.
-    #[arg(long, default_value_t = 1500)]
+    #[arg(long, default_value_t = defaults().vertices)]
     vertices: usize,
     /// Head roadmap radius r_T (m).
-    #[arg(long, default_value_t = 1.5)]
+    #[arg(long, default_value_t = defaults().r_t)]
     r_t: f64,
     /// Most neighbours per head roadmap vertex (the nearest within r_T).
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = defaults().max_neighbours)]
     max_neighbours: usize,
     /// Headings tried per shape (n_psi).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = defaults().n_psi)]
     n_psi: usize,
     /// G_Val connection radius d_c (C_T metric) [default: r_S for N and N_SRS].
     #[arg(long)]
@@ -68,24 +71,24 @@ pub struct PlanArgs {
     clearance: f64,
     /// Smallest clearance margin (m) the planner may give way to, only along a passage
     /// narrower than --clearance allows (0: the exact contract of docs/model.md).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = defaults().clearance_min)]
     clearance_min: f64,
     /// Head route search over the map's half-cell lattice (off: the paper's uniform
     /// head roadmap only).
-    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    #[arg(long, default_value_t = defaults().head_lattice, action = clap::ArgAction::Set)]
     head_lattice: bool,
     /// Step (m) of follow-the-leader motion, where the body is laid back along the
     /// head's track (long chains through windows and doors); 0 turns it off (the paper).
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = defaults().follow_step)]
     follow_step: f64,
     /// Head edges the planner may drop without progress before it grows the roadmap.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = defaults().max_replans)]
     max_replans: usize,
     /// How strongly head paths keep away from obstacles (0: shortest, as in the paper).
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = defaults().clearance_weight)]
     clearance_weight: f64,
     /// Times a failing query may double the head roadmap and try again.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = defaults().max_growth)]
     max_growth: usize,
     /// Keep the plan as the search made it: no shortcuts, no merged translations or
     /// dropped shape changes (see `planner::refine`).
@@ -118,60 +121,31 @@ pub struct PlanArgs {
     trajectory: Option<PathBuf>,
     #[command(flatten)]
     timing: TimingArgs,
+    /// Tuning from a settings file (JSON, one object with the sections planner,
+    /// refine and trajectory; docs/settings.md lists every setting). A flag given on
+    /// the command line wins over the file; a flag left at its default does not.
+    #[arg(long)]
+    settings: Option<PathBuf>,
+}
+
+/// The ids of the flags given on the command line (not left at their defaults): where
+/// a settings file and a flag both set a value, the flag wins.
+pub type Given = BTreeSet<String>;
+
+/// The planner's defaults, the flags' (a settings file's fields left out take the same).
+fn defaults() -> Settings {
+    Settings::default()
 }
 
 /// Smallest follow-the-leader step (m) other than 0 (off).
 const MIN_FOLLOW_STEP: f64 = 1e-3;
 
 /// Checks every option before any work: numbers within their limits, sizes within
-/// their budgets (docs/promises.md), the picture's format.
+/// their budgets (docs/promises.md), the picture's format. (The planner's settings are
+/// checked once merged with a settings file: [`check_planner`].)
 fn check(a: &PlanArgs) -> Result<(), CliError> {
-    checks::count("--max-growth", a.max_growth, 0, 8, "256 times the vertices")?;
-    checks::non_negative("--clearance-weight", a.clearance_weight)?;
-    checks::count(
-        "--max-neighbours",
-        a.max_neighbours,
-        1,
-        checks::MAX_NEIGHBOURS,
-        "edges per vertex",
-    )?;
-    let most = checks::MAX_HEAD_VERTICES >> a.max_growth;
-    checks::count(
-        "--vertices",
-        a.vertices,
-        1,
-        most,
-        &format!(
-            "--max-growth {} lets the roadmap grow to {} times this, and the budget is {} \
-             vertices",
-            a.max_growth,
-            1usize << a.max_growth,
-            checks::MAX_HEAD_VERTICES
-        ),
-    )?;
-    checks::length("--r-t", a.r_t, true)?;
-    checks::count("--n-psi", a.n_psi, 1, 360, "headings per shape")?;
-    if let Some(d) = a.d_c {
-        checks::positive("--d-c", d as f64)?;
-    }
-    // A floor on the step bounds the steps of an edge (and the memory they take).
-    if !(a.follow_step == 0.0 || (MIN_FOLLOW_STEP..=1.0).contains(&a.follow_step)) {
-        return Err(checks::bad(
-            "--follow-step",
-            a.follow_step,
-            &format!("0 (off) or between {MIN_FOLLOW_STEP} and 1 m"),
-        ));
-    }
     checks::length("--goal-tol", a.problem.goal_tol, false)?;
     checks::length("--clearance", a.clearance, false)?;
-    checks::count(
-        "--max-replans",
-        a.max_replans,
-        0,
-        checks::MAX_REPLANS,
-        "dropped edges per query",
-    )?;
-    checks::length("--clearance-min", a.clearance_min, false)?;
     checks::time_limit(Some(a.time_limit))?;
     checks::srs(a.srs)?;
     a.timing.settings()?;
@@ -182,6 +156,116 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
         ));
     }
     super::picture::check(a.picture.as_ref(), a.frame_step)
+}
+
+/// Checks the planner's settings that have a flag, each named `name(flag, field)`: the
+/// flag where it gave the value, else the settings file's field.
+fn check_planner(s: &Settings, name: &dyn Fn(&str, &str) -> String) -> Result<(), CliError> {
+    let n = |flag: &str, field: &str| name(flag, field);
+    let growth = n("--max-growth", "max_growth");
+    checks::count(&growth, s.max_growth, 0, 8, "256 times the vertices")?;
+    checks::non_negative(
+        &n("--clearance-weight", "clearance_weight"),
+        s.clearance_weight,
+    )?;
+    checks::count(
+        &n("--max-neighbours", "max_neighbours"),
+        s.max_neighbours,
+        1,
+        checks::MAX_NEIGHBOURS,
+        "edges per vertex",
+    )?;
+    let most = checks::MAX_HEAD_VERTICES >> s.max_growth;
+    checks::count(
+        &n("--vertices", "vertices"),
+        s.vertices,
+        1,
+        most,
+        &format!(
+            "{growth} {} lets the roadmap grow to {} times this, and the budget is {} \
+             vertices",
+            s.max_growth,
+            1usize << s.max_growth,
+            checks::MAX_HEAD_VERTICES
+        ),
+    )?;
+    checks::length(&n("--r-t", "r_t"), s.r_t, true)?;
+    checks::count(
+        &n("--n-psi", "n_psi"),
+        s.n_psi,
+        1,
+        360,
+        "headings per shape",
+    )?;
+    if let Some(d) = s.d_c {
+        checks::positive(&n("--d-c", "d_c"), d as f64)?;
+    }
+    // A floor on the step bounds the steps of an edge (and the memory they take).
+    if !(s.follow_step == 0.0 || (MIN_FOLLOW_STEP..=1.0).contains(&s.follow_step)) {
+        return Err(checks::bad(
+            &n("--follow-step", "follow_step"),
+            s.follow_step,
+            &format!("0 (off) or between {MIN_FOLLOW_STEP} and 1 m"),
+        ));
+    }
+    checks::count(
+        &n("--max-replans", "max_replans"),
+        s.max_replans,
+        0,
+        checks::MAX_REPLANS,
+        "dropped edges per query",
+    )?;
+    checks::length(
+        &n("--clearance-min", "clearance_min"),
+        s.clearance_min,
+        false,
+    )?;
+    Ok(())
+}
+
+/// A settings file as read: its settings, its name, and the keys it sets (dotted
+/// paths, such as `planner.vertices`).
+struct Loaded {
+    file: SettingsFile,
+    name: String,
+    keys: BTreeSet<String>,
+}
+
+impl Loaded {
+    /// Whether the file sets `key`.
+    fn sets(&self, key: &str) -> bool {
+        self.keys.contains(key)
+    }
+}
+
+/// The settings file of `--settings`, read and checked (its tuning settings; those
+/// with a flag are checked with the flags, [`check_planner`]).
+fn read_settings(a: &PlanArgs) -> Result<Option<Loaded>, CliError> {
+    let Some(path) = &a.settings else {
+        return Ok(None);
+    };
+    let name = crate::fsutil::input_name(path);
+    let text =
+        crate::fsutil::read_input(path).map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    let file = SettingsFile::parse(&text, &name).map_err(|e| CliError::input(e.to_string()))?;
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+    let mut keys = BTreeSet::new();
+    key_paths(&value, "", &mut keys);
+    Ok(Some(Loaded { file, name, keys }))
+}
+
+/// Every key of the JSON object `v` and of the objects within, as dotted paths.
+fn key_paths(v: &serde_json::Value, path: &str, out: &mut BTreeSet<String>) {
+    if let serde_json::Value::Object(m) = v {
+        for (k, inner) in m {
+            let here = match path {
+                "" => k.clone(),
+                p => format!("{p}.{k}"),
+            };
+            key_paths(inner, &here, out);
+            out.insert(here);
+        }
+    }
 }
 
 /// The tables: read from `--tables` (and checked against the chain) or generated.
@@ -218,43 +302,100 @@ pub fn load_tables(
     }
 }
 
-/// The facade's options from the command line (checked before).
-fn options(a: &PlanArgs) -> Result<PlanOptions, CliError> {
+/// The facade's options from the command line and the settings file `file`: a value is
+/// the flag's where the flag is given on the command line (`given`), else the file's
+/// where the file sets it, else the flag's default (the settings' default).
+fn options(a: &PlanArgs, file: Option<&Loaded>, given: &Given) -> Result<PlanOptions, CliError> {
+    let base = file.map(|f| f.file.clone()).unwrap_or_default();
+    let flag =
+        |id: &str| given.contains(id) || !file.is_some_and(|f| f.sets(&format!("planner.{id}")));
+    let mut p = base.planner;
+    macro_rules! take {
+        ($($field:ident),*) => {
+            $(if flag(stringify!($field)) {
+                p.$field = a.$field;
+            })*
+        };
+    }
+    take!(
+        vertices,
+        r_t,
+        max_neighbours,
+        n_psi,
+        d_c,
+        mode,
+        prefer,
+        seed,
+        max_replans,
+        max_growth,
+        clearance_weight,
+        follow_step,
+        clearance_min,
+        head_lattice
+    );
+    let name = |flag_name: &str, field: &str| match file {
+        Some(f) if !flag(field) => format!("{}: planner.{field}", f.name),
+        _ => flag_name.to_string(),
+    };
+    check_planner(&p, &name)?;
     Ok(PlanOptions {
-        planner: Settings {
-            vertices: a.vertices,
-            r_t: a.r_t,
-            max_neighbours: a.max_neighbours,
-            n_psi: a.n_psi,
-            d_c: a.d_c,
-            mode: a.mode,
-            prefer: a.prefer,
-            seed: a.seed,
-            max_replans: a.max_replans,
-            max_growth: a.max_growth,
-            clearance_weight: a.clearance_weight,
-            follow_step: a.follow_step,
-            clearance_min: a.clearance_min,
-            head_lattice: a.head_lattice,
-        },
+        planner: p,
+        refine: base.refine,
         clearance: a.clearance,
         no_smooth: a.no_smooth,
         time_limit_s: Some(a.time_limit),
         srs: a.srs,
         srs_seed: a.srs_seed,
         trajectory: match a.trajectory {
-            Some(_) => Some(a.timing.settings()?),
+            Some(_) => Some(timing(a, file, given)?),
             None => None,
         },
     })
 }
 
+/// How the plan is timed, by the rule of [`options`]: the timing flags where given,
+/// else the file's trajectory section where it sets a value, else the flags' defaults
+/// (the blending tuning, which has no flag: the file's or the default).
+fn timing(
+    a: &PlanArgs,
+    file: Option<&Loaded>,
+    given: &Given,
+) -> Result<aerial_chain::trajectory::Settings, CliError> {
+    let flags = a.timing.settings()?;
+    let Some(f) = file else {
+        return Ok(flags);
+    };
+    let mut t = f.file.trajectory;
+    let flag = |id: &str, key: &str| given.contains(id) || !f.sets(&format!("trajectory.{key}"));
+    if flag("speed", "limits.speed") {
+        t.limits.speed = flags.limits.speed;
+    }
+    if flag("accel", "limits.accel") {
+        t.limits.accel = flags.limits.accel;
+    }
+    if flag("angular_rate_deg", "limits.angular_rate") {
+        t.limits.angular_rate = flags.limits.angular_rate;
+    }
+    if flag("angular_accel_deg", "limits.angular_accel") {
+        t.limits.angular_accel = flags.limits.angular_accel;
+    }
+    if flag("dt", "dt") {
+        t.dt = flags.dt;
+    }
+    if flag("no_blend", "blend") {
+        t.blend = flags.blend;
+    }
+    Ok(t)
+}
+
 /// Runs `arc plan`.
-pub fn run(a: PlanArgs) -> CliResult {
+pub fn run(a: PlanArgs, given: &Given) -> CliResult {
     check(&a)?;
-    let options = options(&a)?;
+    let file = read_settings(&a)?;
+    let options = options(&a, file.as_ref(), given)?;
+    let timing = timing(&a, file.as_ref(), given)?;
     if let Some(path) = &a.mission {
-        return mission::run(&a, path, &options);
+        return mission::run(&a, path, &options, &timing);
     }
     // Setup (map, distance field, shape tables) is timed apart: the time limit
     // covers what follows it (docs/promises.md).
@@ -326,7 +467,7 @@ pub fn run(a: PlanArgs) -> CliResult {
     }
     if let Some(pic) = &a.picture {
         let goal = Some((query.goal, query.goal_tol));
-        match draw(&a, pic, grid, plan, timed, goal)? {
+        match draw(&a, pic, grid, plan, timed, goal, &timing)? {
             Some((frames, step)) => report.line(format_args!(
                 "  animation: {} ({frames} frames, one per {step} s of the trajectory)",
                 pic.display()
@@ -347,13 +488,14 @@ fn draw(
     plan: &aerial_chain::plan_file::Plan,
     timed: Option<aerial_chain::trajectory::Trajectory>,
     goal: Option<(nalgebra::Point3<f64>, f64)>,
+    timing: &aerial_chain::trajectory::Settings,
 ) -> Result<Option<(usize, f64)>, CliError> {
     use aerial_chain::plan_picture::{self as pp, AnimationOptions, Motion, PictureOptions};
     let title = format!("ARCplanner on {}", a.problem.map.name());
     if super::picture::is_animation(pic) {
         let tr = match timed {
             Some(t) => t,
-            None => super::trajectory::make(plan, "the plan", grid, &a.timing.settings()?)?,
+            None => super::trajectory::make(plan, "the plan", grid, timing)?,
         };
         let opts = AnimationOptions {
             title,
@@ -365,12 +507,7 @@ fn draw(
         return Ok(Some(made));
     }
     // Without an admissible trajectory the picture still comes, its ramp in waypoint order.
-    let tr = timed.or_else(|| {
-        a.timing
-            .settings()
-            .ok()
-            .and_then(|s| aerial_chain::trajectory::build(plan, grid, &s).ok())
-    });
+    let tr = timed.or_else(|| aerial_chain::trajectory::build(plan, grid, timing).ok());
     let opts = PictureOptions {
         title,
         goal,
