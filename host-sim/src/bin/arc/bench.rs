@@ -173,6 +173,9 @@ pub struct OnlineArgs {
     /// ones, each with its own N); 0: none.
     #[arg(long, default_value_t = 20)]
     robust: usize,
+    /// Simulated seconds an exploration may take.
+    #[arg(long, default_value_t = 600.0)]
+    time_limit: f64,
     /// Where CSV, markdown and the plot go.
     #[arg(long, default_value = "bench-out")]
     out_dir: PathBuf,
@@ -583,6 +586,13 @@ fn run_online(a: OnlineArgs) -> CliResult {
         aerial_chain::problem::scenarios::build(s).map_err(|e| CliError::input(e.to_string()))?;
     }
     checks::count("--robust", a.robust, 0, 200, "instances")?;
+    if !(a.time_limit > 0.0 && a.time_limit <= 86_400.0) {
+        return Err(checks::bad(
+            "--time-limit",
+            a.time_limit,
+            "a positive number of simulated seconds, at most 86400",
+        ));
+    }
     let t = Instant::now();
     let mut jobs: Vec<(String, u8)> = Vec::new();
     for sc in &a.scenarios {
@@ -595,7 +605,7 @@ fn run_online(a: OnlineArgs) -> CliResult {
     );
     let mut runs = Vec::new();
     for (sc, n) in jobs {
-        let r = study::online::run_one(&sc, n);
+        let r = study::online::run_one(&sc, n, a.time_limit);
         eprintln!(
             "{sc} N = {n}: {} in {:.1} s (finished map {:.1} s), {} replans, p95 {:.1} ms, max {:.1} ms",
             r.end,

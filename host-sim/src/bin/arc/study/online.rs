@@ -16,9 +16,6 @@ use aerial_chain_core::ChainParams;
 
 use super::report::csv_field;
 
-/// Simulated seconds an exploration may take in the benchmark.
-const TIME_LIMIT_S: f64 = 600.0;
-
 /// One run: an exploration and the finished-map flight of the same query.
 #[derive(Clone, Debug, Default)]
 pub struct OnlineRun {
@@ -70,13 +67,13 @@ impl OnlineRun {
 
 /// Explores `scenario` with `units` from an empty map, and flies the finished-map
 /// plan of the same query.
-pub fn run_one(scenario: &str, units: u8) -> OnlineRun {
+pub fn run_one(scenario: &str, units: u8, time_limit_s: f64) -> OnlineRun {
     let mut run = OnlineRun {
         scenario: scenario.into(),
         units,
         ..OnlineRun::default()
     };
-    if let Err(e) = explore_one(&mut run) {
+    if let Err(e) = explore_one(&mut run, time_limit_s) {
         run.end = e;
     }
     let finished = super::flight::run_one(scenario, units, 1);
@@ -84,7 +81,7 @@ pub fn run_one(scenario: &str, units: u8) -> OnlineRun {
     run
 }
 
-fn explore_one(run: &mut OnlineRun) -> Result<(), String> {
+fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
     let sc = scenarios::build(&run.scenario).map_err(|e| e.to_string())?;
     let params = ChainParams::new(run.units)
         .validate()
@@ -104,7 +101,7 @@ fn explore_one(run: &mut OnlineRun) -> Result<(), String> {
     let mut start = vec![sc.start.x, sc.start.y, sc.start.z];
     start.extend(shape.as_slice().iter().map(|&v| v as f64));
     let settings = ExploreSettings {
-        time_limit_s: TIME_LIMIT_S,
+        time_limit_s,
         audit: true,
         ..ExploreSettings::default()
     };
