@@ -159,6 +159,7 @@ pub struct OnlinePlanner {
     seen_at_last: usize,
     route_at: f64,
     reached: bool,
+    failures: u32,
     keep_maps: bool,
     records: Vec<ReplanRecord>,
 }
@@ -213,6 +214,7 @@ impl OnlinePlanner {
             seen_at_last: usize::MAX,
             route_at: f64::NEG_INFINITY,
             reached: false,
+            failures: 0,
             keep_maps: false,
             records: Vec::new(),
         })
@@ -266,7 +268,7 @@ impl OnlinePlanner {
         let commit = matches!(trigger, Trigger::Start | Trigger::CommitShort);
         let (outcome, committed_m) = if self.reached {
             (Outcome::Reached, 0.0)
-        } else if !fresh && self.route.is_some() {
+        } else if !fresh && self.route.is_some() && !(commit && self.retry_due()) {
             self.route_at = now;
             (Outcome::NothingNew, 0.0)
         } else {
@@ -277,7 +279,8 @@ impl OnlinePlanner {
                 .route
                 .as_ref()
                 .is_some_and(|r| r.holds(self.belief.route_field()));
-            let searched = match commit && holds {
+            let stale = now - self.route_at >= self.settings.route_period_s;
+            let searched = match commit && holds && !stale {
                 true => Ok(()),
                 false => {
                     self.route_at = now;
@@ -290,6 +293,11 @@ impl OnlinePlanner {
                 Ok(()) => self.commit(began),
             }
         };
+        match outcome {
+            Outcome::NoRoom => self.failures += 1,
+            Outcome::Committed | Outcome::Looked => self.failures = 0,
+            _ => {}
+        }
         let record = ReplanRecord {
             t: now,
             trigger,
@@ -301,6 +309,22 @@ impl OnlinePlanner {
         };
         self.records.push(record.clone());
         record
+    }
+
+    /// Most times a commit that found no piece is tried again, each with twice the
+    /// deadline before, while nothing new is seen: a piece that needs more search than
+    /// one deadline gives is found while the chain waits (up to 8 deadlines).
+    const RETRIES: u32 = 3;
+
+    /// Whether a commit that found no piece is to be tried again with a longer deadline.
+    fn retry_due(&self) -> bool {
+        (1..=Self::RETRIES).contains(&self.failures)
+    }
+
+    /// The wall time this commit may take: the deadline, doubled for every failed try
+    /// since the last piece ([`Self::RETRIES`] at most).
+    fn deadline(&self) -> f64 {
+        self.settings.deadline_s * f64::from(1u32 << self.failures.min(Self::RETRIES))
     }
 
     /// Searches the route from the committed motion's end; `Err` with the reason when
@@ -341,15 +365,12 @@ impl OnlinePlanner {
         let route = self.route.clone().expect("searched");
         let known = self.known_prefix(&route);
         let last = route.points.len() - 1;
-        let candidates: Vec<usize> = if known == last {
-            vec![last]
-        } else {
-            [1.0, 2.0 / 3.0, 1.0 / 3.0]
-                .iter()
-                .map(|f| ((known as f64) * f).round() as usize)
-                .filter(|&k| k > 0)
-                .collect()
-        };
+        let mut candidates: Vec<usize> = [1.0, 2.0 / 3.0, 1.0 / 3.0]
+            .iter()
+            .map(|f| ((known as f64) * f).round() as usize)
+            .filter(|&k| k > 0)
+            .collect();
+        candidates.dedup();
         let r_v = self.belief.route_field().grid().resolution();
         let count = candidates.len();
         for (tried, k) in candidates.into_iter().enumerate() {
@@ -363,7 +384,7 @@ impl OnlinePlanner {
             }
             // The time left, shared by the candidates left: a far piece that cannot be
             // found quickly leaves time for a nearer one.
-            let left = self.settings.deadline_s - began.elapsed().as_secs_f64();
+            let left = self.deadline() - began.elapsed().as_secs_f64();
             let deadline = left / (count - tried) as f64;
             if deadline <= 0.0 {
                 break;
