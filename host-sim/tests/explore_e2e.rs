@@ -189,8 +189,8 @@ fn bad_sensor_settings_are_refused_naming_them() {
     let cases: [(&[&str], &str); 5] = [
         (&["--sensor", "wide.json"], "fov_h_deg"),
         (&["--sensor", "typo.json"], "fov_h"),
-        (&["--sensor-rate", "0"], "rate_hz"),
-        (&["--sensor-range", "0.1"], "max_range"),
+        (&["--sensor-rate", "0"], "--sensor-rate"),
+        (&["--sensor-range", "0.1"], "--sensor-range"),
         (&["--deadline", "-1"], "--deadline"),
     ];
     for (flags, named) in cases {

@@ -222,6 +222,9 @@ pub enum ExploreError {
         /// Why.
         why: String,
     },
+    /// The flight could record more than the memory budget.
+    #[error("--time-limit: {0}")]
+    Budget(String),
     /// A time limit that is not a positive number of seconds.
     #[error("time limit {0} s must be a positive number of simulated seconds, at most 86400")]
     TimeLimit(f64),
@@ -245,6 +248,7 @@ pub fn explore(
     if !(settings.time_limit_s > 0.0 && settings.time_limit_s <= 86_400.0) {
         return Err(ExploreError::TimeLimit(settings.time_limit_s));
     }
+    check_budget(&params, settings)?;
     let mut online = settings.online.clone();
     online.trajectory.limits = settings.fly.timing.limits;
     check_start(truth, &params, start, online.plan.clearance)?;
@@ -281,6 +285,25 @@ pub fn explore(
     };
     let end = lp.fly()?;
     lp.finish(end, start)
+}
+
+/// Refuses a run whose flight could record more than `sim::MAX_RECORDED_BYTES`:
+/// every physics step up to the time limit and the settling after it.
+fn check_budget(params: &ChainParams, settings: &ExploreSettings) -> Result<(), ExploreError> {
+    let cfg = settings.fly.sim_config();
+    let steps = ((settings.time_limit_s + cfg.settle_time) * cfg.rate).ceil() + 1.0;
+    let bytes = steps * crate::sim::flight::sample_bytes(params.n());
+    if bytes > crate::sim::flight::MAX_RECORDED_BYTES {
+        return Err(ExploreError::Budget(format!(
+            "a flight of up to {:.0} simulated s at {} Hz records {steps:.3e} steps of N = {}, \
+             {:.2} GiB, over the budget of 1 GiB: lower the time limit",
+            settings.time_limit_s + cfg.settle_time,
+            cfg.rate,
+            params.n(),
+            bytes / crate::sim::flight::MAX_RECORDED_BYTES
+        )));
+    }
+    Ok(())
 }
 
 /// Refuses a start that is not valid on the truth with the clearance (grown by the

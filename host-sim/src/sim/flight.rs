@@ -138,7 +138,7 @@ pub const CLEARANCE_TOLERANCE: f64 = 1e-4;
 pub const MAX_RECORDED_BYTES: f64 = (1u64 << 30) as f64;
 
 /// Bytes one recorded step of an `n`-unit chain takes, about.
-fn sample_bytes(n: usize) -> f64 {
+pub(crate) fn sample_bytes(n: usize) -> f64 {
     let per_unit = std::mem::size_of::<BodySample>() + 4 + 12;
     let per_link = std::mem::size_of::<BodySample>() + 16;
     (std::mem::size_of::<Sample>() + n * per_unit + n * per_link) as f64

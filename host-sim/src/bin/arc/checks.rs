@@ -86,6 +86,21 @@ pub fn positive(flag: &str, v: f64) -> Result<(), CliError> {
     }
 }
 
+/// `--sensor-rate`: scans per second, positive and at most what a depth camera
+/// delivers (`sensing::survey::MAX_RATE_HZ`).
+pub fn sensor_rate(v: f64) -> Result<(), CliError> {
+    let max = aerial_chain::sensing::survey::MAX_RATE_HZ;
+    if v > 0.0 && v <= max {
+        Ok(())
+    } else {
+        Err(bad(
+            "--sensor-rate",
+            v,
+            &format!("a positive number of scans per second, at most {max}"),
+        ))
+    }
+}
+
 /// `--srs`: the number of random shapes, which the table indexes with 16 bits.
 pub fn srs(v: usize) -> Result<(), CliError> {
     count(

@@ -84,7 +84,11 @@ fn check(a: &ExploreArgs) -> Result<(), CliError> {
         ));
     }
     checks::length("--clearance", a.clearance, false)?;
-    checks::positive("--goal-tol", a.problem.goal_tol)?;
+    checks::length("--goal-tol", a.problem.goal_tol, true)?;
+    checks::sensor_rate(a.sensor_rate)?;
+    if let Some(r) = a.sensor_range {
+        checks::length("--sensor-range", r, true)?;
+    }
     if a.record_every == 0 {
         return Err(checks::bad("--record-every", 0, "at least 1"));
     }
@@ -110,6 +114,13 @@ fn survey(a: &ExploreArgs) -> Result<Survey, CliError> {
         None => DepthSensor::default(),
     };
     if let Some(r) = a.sensor_range {
+        if r <= sensor.min_range {
+            return Err(checks::bad(
+                "--sensor-range",
+                r,
+                &format!("above the sensor's min_range ({} m)", sensor.min_range),
+            ));
+        }
         sensor.max_range = r;
     }
     let survey = Survey {

@@ -139,14 +139,7 @@ fn check(a: &SimArgs) -> Result<(), CliError> {
     if a.record_every == 0 {
         return Err(checks::bad("--record-every", 0, "at least 1"));
     }
-    let max = aerial_chain::sensing::survey::MAX_RATE_HZ;
-    if !(a.sensor_rate > 0.0 && a.sensor_rate <= max) {
-        return Err(checks::bad(
-            "--sensor-rate",
-            a.sensor_rate,
-            &format!("a positive number of scans per second, at most {max}"),
-        ));
-    }
+    checks::sensor_rate(a.sensor_rate)?;
     if let Some(p) = &a.map_out {
         let bt = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bt"));
         if !bt {
