@@ -9,7 +9,7 @@
 //!   clouds in the world frame, replans under a deadline, and commits pieces that lie
 //!   in space known free, pass the trajectory's exact check with unknown space
 //!   occupied, and end at rest;
-//! - [`explore`]: [`explore()`], the simulator as a client: sensors read the true map,
+//! - [`mod@explore`]: [`explore()`], the simulator as a client: sensors read the true map,
 //!   the chain's dynamics fly what is committed (`arc explore`).
 //!
 //! # The rule for what the chain may do
