@@ -155,9 +155,10 @@ pub fn search(
 }
 
 /// A* over the 26-connected voxels whose bound is at least the proof radius (the start
-/// voxel always), Euclidean costs ([`NARROW_COST`] times that below the route radius). Goal voxels: centres within `tol` plus half a voxel
-/// diagonal of `goal`, so that every head position within `tol` has its voxel among
-/// them. `Err` holds the number of voxels reached.
+/// voxel always), Euclidean costs ([`NARROW_COST`] times that below the route radius).
+/// Goal voxels: centres within `tol` plus half a voxel diagonal of `goal`, so that every
+/// head position within `tol` has its voxel among them. `Err` holds the number of
+/// voxels reached.
 fn astar(
     scratch: &mut Scratch,
     field: &DistanceField,

@@ -345,40 +345,14 @@ impl OccupancyMap {
         if !c.iter().all(|v| v.is_finite()) {
             return Err(refuse("centre", c.coords.as_slice(), "must be finite"));
         }
-        if !(radius.is_finite() && radius >= 0.0) {
-            return Err(refuse(
-                "radius",
-                radius,
-                "must be a finite number of metres >= 0",
-            ));
-        }
+        check_radius(radius)?;
         let r = self.resolution;
         let lo = c.map(|v| (v - radius) / r).map(f64::floor);
         let hi = c.map(|v| (v + radius) / r).map(f64::ceil);
-        let span: f64 = (0..3).map(|a| hi[a] - lo[a] + 1.0).product();
-        if span > MAX_SPHERE_VOXELS as f64 || lo.iter().chain(hi.iter()).any(|v| v.abs() > 32768.0)
-        {
-            return Err(refuse(
-                "radius",
-                radius,
-                "covers too many voxels or leaves OctoMap's key range",
-            ));
-        }
-        let mut changes = Vec::new();
         let r2 = radius * radius;
-        for z in lo[2] as i32..=hi[2] as i32 {
-            for y in lo[1] as i32..=hi[1] as i32 {
-                for x in lo[0] as i32..=hi[0] as i32 {
-                    let i = [x, y, z];
-                    if self.farthest_corner_sq(i, &c) <= r2 {
-                        let old = self.voxels.insert(i, self.params.min);
-                        changes.extend(self.change(i, old, self.params.min));
-                    }
-                }
-            }
-        }
-        changes.sort_unstable_by_key(|c| c.voxel);
-        Ok(changes)
+        self.mark_free_in([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z], radius, |m, i| {
+            m.farthest_corner_sq(i, &c) <= r2
+        })
     }
 
     /// Marks as observed free every voxel whose closed cube comes within `radius` of the
@@ -396,16 +370,25 @@ impl OccupancyMap {
         if !a.iter().chain(b.iter()).all(|v| v.is_finite()) {
             return Err(refuse("segment", a.coords.as_slice(), "must be finite"));
         }
-        if !(radius.is_finite() && radius >= 0.0) {
-            return Err(refuse(
-                "radius",
-                radius,
-                "must be a finite number of metres >= 0",
-            ));
-        }
+        check_radius(radius)?;
         let r = self.resolution;
         let lo = [0, 1, 2].map(|k| ((a[k].min(b[k]) - radius) / r).floor());
         let hi = [0, 1, 2].map(|k| ((a[k].max(b[k]) + radius) / r).floor());
+        self.mark_free_in(lo, hi, radius, |m, i| {
+            m.segment_cube_distance(i, &a, &b) <= radius
+        })
+    }
+
+    /// Marks free the voxels of the box of lattice indices `lo..=hi` that `inside`
+    /// keeps (log-odds at the lower clamping bound); refuses, naming `radius`, a box
+    /// of more than [`MAX_SPHERE_VOXELS`] or one that leaves OctoMap's key range.
+    fn mark_free_in(
+        &mut self,
+        lo: [f64; 3],
+        hi: [f64; 3],
+        radius: f64,
+        inside: impl Fn(&Self, [i32; 3]) -> bool,
+    ) -> Result<Vec<VoxelChange>, FusionError> {
         let span: f64 = (0..3).map(|k| hi[k] - lo[k] + 1.0).product();
         if span > MAX_SPHERE_VOXELS as f64 || lo.iter().chain(hi.iter()).any(|v| v.abs() > 32768.0)
         {
@@ -420,7 +403,7 @@ impl OccupancyMap {
             for y in lo[1] as i32..=hi[1] as i32 {
                 for x in lo[0] as i32..=hi[0] as i32 {
                     let i = [x, y, z];
-                    if self.segment_cube_distance(i, &a, &b) <= radius {
+                    if inside(self, i) {
                         let old = self.voxels.insert(i, self.params.min);
                         changes.extend(self.change(i, old, self.params.min));
                     }
@@ -512,6 +495,19 @@ impl OccupancyMap {
     /// Writes the seen map as a `.bt` file OctoMap reads.
     pub fn write_bt(&self, path: &Path) -> Result<(), MapFileError> {
         self.to_octree()?.write_bt(path)
+    }
+}
+
+/// A radius of a marked ball or capsule: finite and `>= 0` metres.
+fn check_radius(radius: f64) -> Result<(), FusionError> {
+    if radius.is_finite() && radius >= 0.0 {
+        Ok(())
+    } else {
+        Err(refuse(
+            "radius",
+            radius,
+            "must be a finite number of metres >= 0",
+        ))
     }
 }
 

@@ -131,9 +131,10 @@ pub struct RobustArgs {
     threads: Option<usize>,
 }
 
-/// `arc bench flight`
+/// The runs of `arc bench flight` and `arc bench online`: scenarios times chain sizes,
+/// and the first instances of the robust family.
 #[derive(Args, Debug)]
-pub struct FlightArgs {
+pub struct Runs {
     /// Scenarios, comma-separated.
     #[arg(
         long,
@@ -144,13 +145,34 @@ pub struct FlightArgs {
     /// Chain sizes, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "4,5,6")]
     units: Vec<u8>,
-    /// Seeds per scenario and size (1, 2, ...).
-    #[arg(long, default_value_t = 2)]
-    seeds: u64,
-    /// Also fly this many instances of `arc bench robust`'s family (its first ones,
+    /// Also run this many instances of `arc bench robust`'s family (its first ones,
     /// each with its own N and planner seed); 0: none.
     #[arg(long, default_value_t = 20)]
     robust: usize,
+}
+
+impl Runs {
+    /// Checks the sizes, the scenarios and the instance count.
+    fn check(&self) -> CliResult {
+        for n in &self.units {
+            checks::count("--units", *n as usize, 2, 16, "units")?;
+        }
+        for s in &self.scenarios {
+            aerial_chain::problem::scenarios::build(s)
+                .map_err(|e| CliError::input(e.to_string()))?;
+        }
+        checks::count("--robust", self.robust, 0, 200, "instances")
+    }
+}
+
+/// `arc bench flight`
+#[derive(Args, Debug)]
+pub struct FlightArgs {
+    #[command(flatten)]
+    runs: Runs,
+    /// Seeds per scenario and size (1, 2, ...).
+    #[arg(long, default_value_t = 2)]
+    seeds: u64,
     /// Where CSV, markdown and the plot go.
     #[arg(long, default_value = "bench-out")]
     out_dir: PathBuf,
@@ -159,20 +181,8 @@ pub struct FlightArgs {
 /// `arc bench online`
 #[derive(Args, Debug)]
 pub struct OnlineArgs {
-    /// Scenarios, comma-separated.
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "window,maze,silos,corridor"
-    )]
-    scenarios: Vec<String>,
-    /// Chain sizes, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "4,5,6")]
-    units: Vec<u8>,
-    /// Also explore this many instances of `arc bench robust`'s family (its first
-    /// ones, each with its own N); 0: none.
-    #[arg(long, default_value_t = 20)]
-    robust: usize,
+    #[command(flatten)]
+    runs: Runs,
     /// Simulated seconds an exploration may take.
     #[arg(long, default_value_t = 600.0)]
     time_limit: f64,
@@ -518,22 +528,16 @@ fn run_robust(a: RobustArgs) -> CliResult {
 
 fn run_flight(a: FlightArgs) -> CliResult {
     checks::count("--seeds", a.seeds as usize, 1, 1000, "seeds")?;
-    for n in &a.units {
-        checks::count("--units", *n as usize, 2, 16, "units")?;
-    }
-    for s in &a.scenarios {
-        aerial_chain::problem::scenarios::build(s).map_err(|e| CliError::input(e.to_string()))?;
-    }
+    a.runs.check()?;
     let speed = aerial_chain::trajectory::Limits::default().speed;
     let t = Instant::now();
-    checks::count("--robust", a.robust, 0, 200, "instances")?;
     let mut jobs = Vec::new();
-    for sc in &a.scenarios {
-        for &n in &a.units {
+    for sc in &a.runs.scenarios {
+        for &n in &a.runs.units {
             jobs.extend((1..=a.seeds).map(|seed| (sc.clone(), n, seed)));
         }
     }
-    jobs.extend(study::flight::robust_sample(a.robust));
+    jobs.extend(study::flight::robust_sample(a.runs.robust));
     let mut runs = Vec::new();
     for (sc, n, seed) in jobs {
         let r = study::flight::run_one(&sc, n, seed);
@@ -554,7 +558,7 @@ fn run_flight(a: FlightArgs) -> CliResult {
         "{}\nMedians over seeds 1..={} (the robust family: over its first {} instances, N = 4..8 as drawn); flight time from the start of the flight (1 s hold included) to arrival; {} build; whole study {:.0} s.\n",
         study::flight::markdown(&runs, speed),
         a.seeds,
-        a.robust,
+        a.runs.robust,
         if cfg!(debug_assertions) { "debug" } else { "release" },
         t.elapsed().as_secs_f64()
     );
@@ -579,13 +583,7 @@ fn run_flight(a: FlightArgs) -> CliResult {
 }
 
 fn run_online(a: OnlineArgs) -> CliResult {
-    for n in &a.units {
-        checks::count("--units", *n as usize, 2, 16, "units")?;
-    }
-    for s in &a.scenarios {
-        aerial_chain::problem::scenarios::build(s).map_err(|e| CliError::input(e.to_string()))?;
-    }
-    checks::count("--robust", a.robust, 0, 200, "instances")?;
+    a.runs.check()?;
     if !(a.time_limit > 0.0 && a.time_limit <= 86_400.0) {
         return Err(checks::bad(
             "--time-limit",
@@ -595,11 +593,11 @@ fn run_online(a: OnlineArgs) -> CliResult {
     }
     let t = Instant::now();
     let mut jobs: Vec<(String, u8)> = Vec::new();
-    for sc in &a.scenarios {
-        jobs.extend(a.units.iter().map(|&n| (sc.clone(), n)));
+    for sc in &a.runs.scenarios {
+        jobs.extend(a.runs.units.iter().map(|&n| (sc.clone(), n)));
     }
     jobs.extend(
-        study::flight::robust_sample(a.robust)
+        study::flight::robust_sample(a.runs.robust)
             .into_iter()
             .map(|(sc, n, _)| (sc, n)),
     );
