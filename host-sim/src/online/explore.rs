@@ -35,8 +35,8 @@ pub struct ExploreSettings {
     pub survey: Survey,
     /// How the online planner plans.
     pub online: OnlineSettings,
-    /// How the chain is flown (physics, control, arrival); its timing limits time the
-    /// pieces too (they replace `online.trajectory.limits`).
+    /// How the chain is flown (physics, control, arrival); its timing settings time the
+    /// pieces too (they replace `online.trajectory`).
     pub fly: FlyOptions,
     /// Simulated seconds before the run gives up.
     pub time_limit_s: f64,
@@ -249,8 +249,9 @@ pub fn explore(
         return Err(ExploreError::TimeLimit(settings.time_limit_s));
     }
     check_budget(&params, settings)?;
+    // Pieces are timed as the flight times motion: one set of timing settings.
     let mut online = settings.online.clone();
-    online.trajectory.limits = settings.fly.timing.limits;
+    online.trajectory = settings.fly.timing;
     check_start(truth, &params, start, online.plan.clearance)?;
     let mut planner = OnlinePlanner::new(
         params,
@@ -260,7 +261,7 @@ pub fn explore(
         goal_tol,
         truth,
         prior,
-        online.clone(),
+        online,
         settings.survey.sensor.fov_h_deg,
     )?;
     planner.keep_maps(settings.audit);
@@ -273,7 +274,6 @@ pub fn explore(
     let mut lp = Loop {
         truth,
         settings,
-        online,
         planner,
         run,
         flown_radius: params.unit_radius as f64 + settings.online.plan.clearance,
@@ -329,7 +329,6 @@ fn check_start(
 struct Loop<'a> {
     truth: &'a Grid,
     settings: &'a ExploreSettings,
-    online: OnlineSettings,
     planner: OnlinePlanner,
     run: FlightRun<'a>,
     flown_radius: f64,
@@ -383,11 +382,11 @@ impl Loop<'_> {
             return None;
         }
         let remaining = self.run.reference().duration() - t;
-        if remaining < self.online.deadline_s + period {
+        if remaining < self.planner.settings().deadline_s + period {
             Some(Trigger::CommitShort)
         } else if self.planner.route_cut() {
             Some(Trigger::RouteCut)
-        } else if t - self.planner.route_searched_at() >= self.online.route_period_s {
+        } else if t - self.planner.route_searched_at() >= self.planner.settings().route_period_s {
             Some(Trigger::Period)
         } else {
             None

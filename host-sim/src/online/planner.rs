@@ -476,9 +476,14 @@ impl OnlinePlanner {
                 });
             }
         }
-        let trajectory =
-            crate::trajectory::build(&plan, request.grid(), &self.settings.trajectory).ok()?;
-        let map = self.keep_maps.then(|| request.grid().clone());
+        self.timed(plan, request.grid())
+    }
+
+    /// `plan` as a piece: timed and checked exactly on `grid` (the map with unknown
+    /// space occupied), which the piece keeps when the planner keeps maps.
+    fn timed(&self, plan: Plan, grid: &Grid) -> Option<Piece> {
+        let trajectory = crate::trajectory::build(&plan, grid, &self.settings.trajectory).ok()?;
+        let map = self.keep_maps.then(|| grid.clone());
         Some(Piece {
             plan,
             trajectory,
@@ -502,21 +507,14 @@ impl OnlinePlanner {
             return false;
         }
         let to = turned(&self.end, look);
-        let field = self.belief.commit_field();
+        let field = self.belief.commit_field().clone();
         let map = MapSection::of(field.grid());
         let mut plan = Plan::from_zetas(&self.params, map, vec![self.end.clone(), to]);
         plan.stats.insert("turn_to_look".into(), true.into());
-        let Ok(trajectory) =
-            crate::trajectory::build(&plan, field.grid(), &self.settings.trajectory)
-        else {
+        let Some(piece) = self.timed(plan, field.grid()) else {
             return false;
         };
-        let map = self.keep_maps.then(|| field.grid().clone());
-        self.push(Piece {
-            plan,
-            trajectory,
-            map,
-        });
+        self.push(piece);
         true
     }
 
@@ -551,6 +549,11 @@ impl OnlinePlanner {
     /// Every replan so far.
     pub fn records(&self) -> &[ReplanRecord] {
         &self.records
+    }
+
+    /// How it plans.
+    pub fn settings(&self) -> &OnlineSettings {
+        &self.settings
     }
 
     /// What the planner believes of the world.

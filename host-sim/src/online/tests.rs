@@ -2,28 +2,30 @@
 //! test on the map it was committed on (unknown space occupied), the joined plan is
 //! valid on the world, and the flight keeps clear of it.
 
+use std::sync::atomic::AtomicUsize;
+
 use super::*;
 use crate::collision::verify_plan;
+use crate::plan_file::Waypoint;
 use crate::planning::PlanOptions;
-use crate::problem::scenarios;
-use crate::tables::{ShapeTables, TableSettings};
+use crate::problem::scenarios::{self, Scenario};
+use crate::tables::ShapeTables;
 use aerial_chain_core::ChainParams;
+
+/// Scenario `window` for `units` units: the chain, `arc plan`'s tables, and the start
+/// configuration.
+fn window(units: u8) -> (Scenario, ChainParams, ShapeTables, Vec<f64>) {
+    let sc = scenarios::build("window").unwrap();
+    let params = ChainParams::new(units).validate().unwrap();
+    let settings = PlanOptions::default().table_settings();
+    let tables = ShapeTables::build(params, &settings, &AtomicUsize::new(0)).unwrap();
+    let start = Waypoint::new(sc.start.into(), &sc.start_shape(units).unwrap()).zeta;
+    (sc, params, tables, start)
+}
 
 #[test]
 fn the_window_from_an_empty_map_commits_only_pieces_valid_on_what_was_seen() {
-    let sc = scenarios::build("window").unwrap();
-    let params = ChainParams::new(4).validate().unwrap();
-    let defaults = PlanOptions::default();
-    let settings = TableSettings {
-        srs: defaults.srs,
-        seed: defaults.srs_seed,
-        ..Default::default()
-    };
-    let tables =
-        ShapeTables::build(params, &settings, &std::sync::atomic::AtomicUsize::new(0)).unwrap();
-    let shape = sc.start_shape(4).unwrap();
-    let mut start = vec![sc.start.x, sc.start.y, sc.start.z];
-    start.extend(shape.as_slice().iter().map(|&v| v as f64));
+    let (sc, params, tables, start) = window(4);
     let settings = ExploreSettings {
         time_limit_s: 300.0,
         audit: true,
@@ -56,58 +58,35 @@ fn the_window_from_an_empty_map_commits_only_pieces_valid_on_what_was_seen() {
 
 #[test]
 fn bad_settings_are_refused_by_name() {
-    let sc = scenarios::build("window").unwrap();
-    let params = ChainParams::new(3).validate().unwrap();
-    let tables = ShapeTables::build(
-        params,
-        &TableSettings {
-            srs: 0,
-            ..Default::default()
-        },
-        &std::sync::atomic::AtomicUsize::new(0),
-    )
-    .unwrap();
-    let shape = sc.start_shape(3).unwrap();
-    let mut start = vec![sc.start.x, sc.start.y, sc.start.z];
-    start.extend(shape.as_slice().iter().map(|&v| v as f64));
+    let (sc, params, tables, start) = window(3);
+    let refused = |settings: &ExploreSettings, start: &[f64]| {
+        explore(
+            &sc.grid,
+            params,
+            tables.clone(),
+            start,
+            sc.goal,
+            0.3,
+            None,
+            settings,
+        )
+        .unwrap_err()
+    };
     let mut settings = ExploreSettings {
         time_limit_s: 10.0,
         ..ExploreSettings::default()
     };
     settings.online.deadline_s = 0.0;
-    let e = explore(
-        &sc.grid,
-        params,
-        tables.clone(),
-        &start,
-        sc.goal,
-        0.3,
-        None,
-        &settings,
-    )
-    .unwrap_err();
+    let e = refused(&settings, &start);
     assert!(e.to_string().contains("deadline_s"), "{e}");
     settings.online.deadline_s = 0.3;
     settings.time_limit_s = -1.0;
-    let e = explore(
-        &sc.grid,
-        params,
-        tables.clone(),
-        &start,
-        sc.goal,
-        0.3,
-        None,
-        &settings,
-    )
-    .unwrap_err();
+    let e = refused(&settings, &start);
     assert!(matches!(e, ExploreError::TimeLimit(_)), "{e}");
     // A start that touches the world is refused.
     settings.time_limit_s = 10.0;
     let mut inside = start.clone();
     inside[0] = 4.1; // in the dividing wall
-    let e = explore(
-        &sc.grid, params, tables, &inside, sc.goal, 0.3, None, &settings,
-    )
-    .unwrap_err();
+    let e = refused(&settings, &inside);
     assert!(matches!(e, ExploreError::Start { .. }), "{e}");
 }

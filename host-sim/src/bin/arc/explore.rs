@@ -173,8 +173,7 @@ pub fn run(a: ExploreArgs) -> CliResult {
     };
     settings.online.deadline_s = a.deadline;
     settings.online.plan.clearance = a.clearance;
-    let mut start = vec![query.start.x, query.start.y, query.start.z];
-    start.extend(query.start_shape.as_slice().iter().map(|&v| v as f64));
+    let start = aerial_chain::plan_file::Waypoint::new(query.start.into(), &query.start_shape).zeta;
     let run = explore(
         &truth,
         params,

@@ -9,10 +9,12 @@ use std::fmt::Write as _;
 
 use aerial_chain::online::{explore, quantile, ExploreEnd, ExploreSettings};
 use aerial_chain::picture::{palette, stroke, Axis, Figure, Mark, Panel};
+use aerial_chain::plan_file::Waypoint;
 use aerial_chain::planning::PlanOptions;
 use aerial_chain::problem::scenarios;
-use aerial_chain::tables::{ShapeTables, TableSettings};
+use aerial_chain::tables::ShapeTables;
 use aerial_chain_core::ChainParams;
+use std::sync::atomic::AtomicUsize;
 
 use super::report::csv_field;
 
@@ -86,20 +88,11 @@ fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
     let params = ChainParams::new(run.units)
         .validate()
         .map_err(|e| e.to_string())?;
-    let plan = PlanOptions::default();
-    let tables = ShapeTables::build(
-        params,
-        &TableSettings {
-            srs: plan.srs,
-            seed: plan.srs_seed,
-            ..Default::default()
-        },
-        &std::sync::atomic::AtomicUsize::new(0),
-    )
-    .map_err(|e| e.to_string())?;
+    let table_settings = PlanOptions::default().table_settings();
+    let tables = ShapeTables::build(params, &table_settings, &AtomicUsize::new(0))
+        .map_err(|e| e.to_string())?;
     let shape = sc.start_shape(run.units).map_err(|e| e.to_string())?;
-    let mut start = vec![sc.start.x, sc.start.y, sc.start.z];
-    start.extend(shape.as_slice().iter().map(|&v| v as f64));
+    let start = Waypoint::new(sc.start.into(), &shape).zeta;
     let settings = ExploreSettings {
         time_limit_s,
         audit: true,
