@@ -77,7 +77,8 @@ pub enum Outcome {
     Looked,
     /// The route was searched again; nothing was committed (none was due).
     Rerouted,
-    /// Nothing was seen since the last replan: nothing to do.
+    /// Nothing to do: nothing was seen since the route was searched, or a due piece
+    /// was tried on exactly what is known now and its retries are spent.
     NothingNew,
     /// The route leaves known space too soon for a piece: the chain waits to see more.
     NoRoom,
@@ -160,6 +161,7 @@ pub struct OnlinePlanner {
     route_at: f64,
     reached: bool,
     failures: u32,
+    failed_on: Option<usize>,
     keep_maps: bool,
     records: Vec<ReplanRecord>,
 }
@@ -215,6 +217,7 @@ impl OnlinePlanner {
             route_at: f64::NEG_INFINITY,
             reached: false,
             failures: 0,
+            failed_on: None,
             keep_maps: false,
             records: Vec::new(),
         })
@@ -266,9 +269,16 @@ impl OnlinePlanner {
             changed - self.seen_at_last
         };
         let commit = matches!(trigger, Trigger::Start | Trigger::CommitShort);
+        // A due piece is tried whatever was seen, unless the last try failed on exactly
+        // what is known now and its retries are spent; a route is searched again only
+        // when something was seen.
+        let idle = match commit {
+            true => self.failed_on == Some(changed) && !self.retry_due(),
+            false => !fresh && self.route.is_some(),
+        };
         let (outcome, committed_m) = if self.reached {
             (Outcome::Reached, 0.0)
-        } else if !fresh && self.route.is_some() && !(commit && self.retry_due()) {
+        } else if idle {
             self.route_at = now;
             (Outcome::NothingNew, 0.0)
         } else {
@@ -294,8 +304,14 @@ impl OnlinePlanner {
             }
         };
         match outcome {
-            Outcome::NoRoom => self.failures += 1,
-            Outcome::Committed | Outcome::Looked => self.failures = 0,
+            Outcome::NoRoom => {
+                self.failures += 1;
+                self.failed_on = Some(changed);
+            }
+            Outcome::Committed | Outcome::Looked => {
+                self.failures = 0;
+                self.failed_on = None;
+            }
             _ => {}
         }
         let record = ReplanRecord {

@@ -90,3 +90,43 @@ fn bad_settings_are_refused_by_name() {
     let e = refused(&settings, &inside);
     assert!(matches!(e, ExploreError::Start { .. }), "{e}");
 }
+
+#[test]
+fn a_due_piece_is_tried_even_when_a_route_search_took_in_what_was_seen() {
+    let (sc, params, tables, start) = window(4);
+    let mut planner = OnlinePlanner::new(
+        params,
+        tables,
+        &start,
+        sc.goal,
+        0.3,
+        &sc.grid,
+        None,
+        OnlineSettings::default(),
+        87.0,
+    )
+    .unwrap();
+    planner.replan(0.0, Trigger::Start);
+    // Space along the first metre of the route is seen free...
+    let route = planner.route().expect("a route").points.clone();
+    let from = route[0];
+    let ahead: Vec<_> = route
+        .iter()
+        .take_while(|p| (*p - from).norm() < 1.0)
+        .copied()
+        .collect();
+    planner.observe_flown(&ahead, 0.45).unwrap();
+    // ...a route replan takes it in, and the piece that falls due just after, with
+    // nothing new seen in between, is still tried.
+    let rerouted = planner.replan(1.0, Trigger::Period);
+    assert_eq!(rerouted.outcome, Outcome::Rerouted);
+    let due = planner.replan(1.1, Trigger::CommitShort);
+    assert!(
+        matches!(
+            due.outcome,
+            Outcome::Committed | Outcome::Looked | Outcome::NoRoom
+        ),
+        "{:?}",
+        due.outcome
+    );
+}
