@@ -379,6 +379,11 @@ impl OnlinePlanner {
     /// free, or nearer; or a turn to look along the route.
     fn commit(&mut self, began: Instant) -> (Outcome, f64) {
         let route = self.route.clone().expect("searched");
+        // Look before moving: where the route leaves the sensors' middle view, a piece
+        // planned now would be squeezed into what they saw elsewhere.
+        if self.turn_to_look(&route) {
+            return (Outcome::Looked, 0.0);
+        }
         let known = self.known_prefix(&route);
         let last = route.points.len() - 1;
         let mut candidates: Vec<usize> = [1.0, 2.0 / 3.0, 1.0 / 3.0]
