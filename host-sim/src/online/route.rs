@@ -4,12 +4,16 @@
 //!
 //! # Radii
 //! A valid configuration keeps the head's sphere grown by the clearance, radius
-//! `R = r_u + c`, off every obstacle cube. A voxel centre lies within `sqrt(3)/2 r_v`
-//! of any point of its cube, and the field's bound loses at most `sqrt(3)/2 r_v` (its
-//! `G(n)` table), so a centre some head position passes through has a bound of at least
-//! `R - sqrt(3) r_v`: the **proof radius**. Voxels 26-connected at the proof radius are
-//! a superset of where the head can go, so when the search at that radius reaches no
-//! voxel near the goal, no plan exists even if every unknown voxel were free (the
+//! `R = r_u + c`, off every obstacle cube. A voxel centre `v` lies within
+//! `sqrt(3)/2 r_v` of any point of its cube, so a centre some head position passes
+//! through is at least `R - sqrt(3)/2 r_v` from every obstacle cube. The field stores a
+//! lower bound `r_v G(n)` of that distance, `n` the squared distance to the nearest
+//! obstacle centre in voxels; the distance itself is at most `r_v (sqrt(n) - 1/2)` (the
+//! cube holds the ball of radius `r_v / 2` about its centre), and `sqrt(n) <= G(n) +
+//! sqrt(3)/2` (docs of `crate::map::DistanceField`). So such a centre's bound is at least
+//! `R - (sqrt(3) - 1/2) r_v`: the **proof radius**. Voxels 26-connected at the proof
+//! radius are a superset of where the head can go, so when the search at that radius
+//! reaches no voxel near the goal, no plan exists even if every unknown voxel were free (the
 //! separation proof's head flood, made on the optimistic map). The **route radius**
 //! `R` keeps the route where the head fits at the voxel centres; the search tries it
 //! first and falls back to the proof radius.
@@ -77,7 +81,7 @@ pub enum Found {
 pub struct Radii {
     /// Where the head fits at voxel centres: `r_u + c`.
     pub route: f64,
-    /// The proof radius, `r_u + c - sqrt(3) r_v` (see the module docs).
+    /// The proof radius, `r_u + c - (sqrt(3) - 1/2) r_v` (see the module docs).
     pub proof: f64,
 }
 
@@ -86,10 +90,14 @@ impl Radii {
     pub fn new(grown: f64, r_v: f64) -> Self {
         Self {
             route: grown,
-            proof: grown - 3f64.sqrt() * r_v,
+            proof: grown - (3f64.sqrt() - 0.5) * r_v - PROOF_ROUNDING,
         }
     }
 }
+
+/// What the field's `f32` bounds may lose to rounding at the scale of a map (m): the
+/// proof radius gives it up so that the proof holds. Not tuning.
+const PROOF_ROUNDING: f64 = 1e-6;
 
 /// The scratch of the searches, kept between them: per voxel of the box, the best
 /// cost found and the voxel it came from, valid where stamped with the current search
@@ -126,13 +134,18 @@ impl Scratch {
 }
 
 /// How much more a metre of route costs where the head's sphere does not fit at the
-/// voxel centres (bound below the route radius, at or above the proof radius): the
-/// route takes a detour up to this many times longer rather than squeeze through a
-/// narrow place, which the piece planner may not pass.
-pub const NARROW_COST: f64 = 10.0;
+/// voxel centres (bound below the route radius, at or above the proof radius), in a box
+/// of `voxels` voxels: more than any route that keeps the head's bound can cost (it
+/// passes each voxel once, in steps of at most `sqrt(3)` voxels, while a narrow step
+/// is at least one voxel long). So the route passes a narrow place, which the piece
+/// planner may not pass (an unseen voxel in a seen wall is one), only where no way
+/// through the box keeps the head's bound; derived, not tuning.
+fn narrow_cost(voxels: usize) -> f64 {
+    voxels as f64 * 3f64.sqrt()
+}
 
 /// Searches `field` from `from` to within `tol` of `goal` through the voxels at the
-/// proof radius, those below the route radius at [`NARROW_COST`] times their length.
+/// proof radius, those below the route radius at [`narrow_cost`] times their length.
 pub fn search(
     scratch: &mut Scratch,
     field: &DistanceField,
@@ -155,7 +168,7 @@ pub fn search(
 }
 
 /// A* over the 26-connected voxels whose bound is at least the proof radius (the start
-/// voxel always), Euclidean costs ([`NARROW_COST`] times that below the route radius).
+/// voxel always), Euclidean costs ([`narrow_cost`] times that below the route radius).
 /// Goal voxels: centres within `tol` plus half a voxel diagonal of `goal`, so that every
 /// head position within `tol` has its voxel among them. `Err` holds the number of
 /// voxels reached.
@@ -185,7 +198,9 @@ fn astar(
     let lattice = |l: [usize; 3]| [0, 1, 2].map(|a| o[a] + l[a] as i32);
     let centre = |l: [usize; 3]| grid.voxel_center(lattice(l));
     let h = |l: [usize; 3]| ((centre(l) - goal).norm() - reach).max(0.0);
-    scratch.begin(dims.iter().product());
+    let voxels = dims.iter().product();
+    let narrow = narrow_cost(voxels);
+    scratch.begin(voxels);
     let mut heap = BinaryHeap::new();
     let s = grid.linear(start);
     scratch.set(s, 0.0, s as u32);
@@ -210,7 +225,7 @@ fn astar(
             let len = r_v * ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
             let gm = gk
                 + if bound < radii.route {
-                    NARROW_COST * len
+                    narrow * len
                 } else {
                     len
                 };
@@ -320,7 +335,7 @@ mod tests {
     }
 
     #[test]
-    fn a_sealed_wall_is_proven_sealed_and_a_slit_is_left_to_the_planner() {
+    fn a_sealed_wall_and_a_small_hole_are_proven_sealed_and_a_larger_one_is_left_to_the_planner() {
         let radii = Radii::new(0.2, 0.1);
         let from = Point3::new(0.5, 1.0, 1.0);
         let goal = Point3::new(3.5, 1.0, 1.0);
@@ -336,18 +351,22 @@ mod tests {
             matches!(found, Found::Sealed { reached } if reached > 1000),
             "{found:?}"
         );
-        // A one-voxel slit is too narrow for the head, but the proof radius is
-        // conservative by two half diagonals: the route goes through it at that radius
-        // and the piece planner, exact, finds no way.
+        // A hole of two voxels a side is too narrow for the head (0.2 m against a
+        // sphere of 0.2 m radius), and the proof says so.
+        let two = search(&mut Scratch::default(), &walled(0.2), from, goal, 0.3, radii);
+        assert!(matches!(two, Found::Sealed { .. }), "{two:?}");
+        // Four voxels a side is still too narrow, but the proof radius is conservative
+        // by up to `(sqrt(3) - 1/2) r_v`: the route goes through at that radius and the
+        // piece planner, exact, finds no way.
         let Found::Route(r) = search(
             &mut Scratch::default(),
-            &walled(0.1),
+            &walled(0.4),
             from,
             goal,
             0.3,
             radii,
         ) else {
-            panic!("the proof cannot seal a slit");
+            panic!("the proof cannot seal a hole of four voxels");
         };
         assert!(
             r.radius < radii.route && r.radius >= radii.proof,
