@@ -403,10 +403,6 @@ impl Loop<'_> {
         if self.planner.pieces().len() > before {
             let piece = self.planner.pieces().last().expect("committed");
             let next = piece.trajectory.reference().clone();
-            if std::env::var("ARC_DEBUG_PIECES").is_ok() {
-                let tr = &piece.trajectory;
-                eprintln!("DEBUG t={t:.1} dur={:.2} stopgo={:.2} corners={} blended={} merged={} path={:.2} wps={}", tr.duration(), tr.stop_go_duration(), tr.corners(), tr.blended(), tr.merged(), tr.head_path_m(), piece.plan.waypoints.len());
-            }
             self.pending = Some((t + record.wall_s, next));
         }
         None
