@@ -38,7 +38,7 @@ impl Belief {
     pub fn new(bounds: &Grid, prior: Option<&Grid>) -> Result<Self, GridError> {
         let (res, origin, dims) = (bounds.resolution(), bounds.origin(), bounds.dims());
         let mut commit = Grid::new(res, origin, dims, Cell::Unknown, true)?;
-        let mut route = Grid::new(res, origin, dims, Cell::Unknown, false)?;
+        let mut route = walled_box(res, origin, dims)?;
         let mut seen = OccupancyMap::new(res).map_err(|_| GridError::Resolution(res))?;
         if let Some(prior) = prior {
             for (i, occupied) in prior.known_voxels() {
@@ -101,7 +101,7 @@ impl Belief {
     /// Updates both fields for `changes` (the voxels outside the box are kept in the
     /// seen map only: the planner never leaves the box).
     fn apply(&mut self, changes: &[VoxelChange]) -> Fused {
-        let grid = self.route.grid();
+        let grid = self.commit.grid();
         let inside: Vec<([i32; 3], Cell)> = changes
             .iter()
             .filter(|c| grid.local(c.voxel).is_some())
@@ -135,7 +135,9 @@ impl Belief {
         &self.commit
     }
 
-    /// The distance field with unknown space free.
+    /// The distance field with unknown space free, over the box and a layer of
+    /// occupied voxels around it: a plan never leaves the box (unknown space outside it
+    /// is occupied to the pieces), so neither may the route, nor its proof.
     pub fn route_field(&self) -> &DistanceField {
         &self.route
     }
@@ -149,4 +151,21 @@ impl Belief {
     pub fn update_s(&self) -> f64 {
         self.update_s
     }
+}
+
+/// The box of `dims` voxels from lattice index `origin`, unknown inside (free to the
+/// route) and wrapped in one layer of occupied voxels.
+fn walled_box(res: f64, origin: [i32; 3], dims: [usize; 3]) -> Result<Grid, GridError> {
+    let mut g = Grid::new(
+        res,
+        origin.map(|o| o - 1),
+        dims.map(|d| d + 2),
+        Cell::Occupied,
+        false,
+    )?;
+    // The centres of the box's first and last voxels along each axis.
+    let first = origin.map(|o| (o as f64 + 0.5) * res);
+    let last = [0, 1, 2].map(|a| (origin[a] as f64 + dims[a] as f64 - 0.5) * res);
+    g.fill_box(first, last, Cell::Unknown);
+    Ok(g)
 }

@@ -208,3 +208,4 @@ fn a_goal_behind_a_wall_across_the_box_is_proven_sealed_from_an_empty_map() {
     assert!(*t < 300.0);
     assert!(!ex.flight.report.contact);
 }
+
