@@ -353,7 +353,14 @@ mod tests {
         );
         // A hole of two voxels a side is too narrow for the head (0.2 m against a
         // sphere of 0.2 m radius), and the proof says so.
-        let two = search(&mut Scratch::default(), &walled(0.2), from, goal, 0.3, radii);
+        let two = search(
+            &mut Scratch::default(),
+            &walled(0.2),
+            from,
+            goal,
+            0.3,
+            radii,
+        );
         assert!(matches!(two, Found::Sealed { .. }), "{two:?}");
         // Four voxels a side is still too narrow, but the proof radius is conservative
         // by up to `(sqrt(3) - 1/2) r_v`: the route goes through at that radius and the

@@ -8,11 +8,11 @@ use super::*;
 use crate::collision::verify_plan;
 use crate::map::Grid;
 use crate::plan_file::Waypoint;
-use nalgebra::Point3;
 use crate::planning::PlanOptions;
 use crate::problem::scenarios::{self, Scenario};
 use crate::tables::ShapeTables;
 use aerial_chain_core::ChainParams;
+use nalgebra::Point3;
 
 /// Scenario `window` for `units` units: the chain, `arc plan`'s tables, and the start
 /// configuration.
@@ -143,8 +143,16 @@ fn two_lanes() -> Grid {
         g.fill_box(lo.map(|v| v + e), hi.map(|v| v - e), cell);
     };
     fill([0.1, 0.1, 0.1], [11.9, 5.9, 2.5], crate::map::Cell::Free);
-    fill([2.0, 2.9, 0.0], [12.0, 3.1, 2.6], crate::map::Cell::Occupied);
-    fill([9.8, 0.0, 0.0], [10.0, 3.0, 2.6], crate::map::Cell::Occupied);
+    fill(
+        [2.0, 2.9, 0.0],
+        [12.0, 3.1, 2.6],
+        crate::map::Cell::Occupied,
+    );
+    fill(
+        [9.8, 0.0, 0.0],
+        [10.0, 3.0, 2.6],
+        crate::map::Cell::Occupied,
+    );
     g
 }
 
@@ -171,26 +179,44 @@ fn a_dead_end_seen_late_is_left_the_way_the_chain_came() {
     assert!(verify_plan(&world, &ex.plan).ok);
     // The route first led down lane A (unknown space is free to the route); the chain
     // went in, saw its end, and came back out to take lane B.
-    let heads: Vec<[f64; 2]> = ex.plan.waypoints.iter().map(|w| [w.zeta[0], w.zeta[1]]).collect();
+    let heads: Vec<[f64; 2]> = ex
+        .plan
+        .waypoints
+        .iter()
+        .map(|w| [w.zeta[0], w.zeta[1]])
+        .collect();
     let deepest_in_a = heads
         .iter()
         .filter(|h| h[1] < 2.9)
         .map(|h| h[0])
         .fold(f64::NEG_INFINITY, f64::max);
-    assert!(deepest_in_a > 4.0, "the chain never went down lane A: {heads:?}");
+    assert!(
+        deepest_in_a > 4.0,
+        "the chain never went down lane A: {heads:?}"
+    );
     let back = heads.iter().position(|h| h[0] < 2.0 && h[1] > 3.0);
-    assert!(back.is_some(), "the chain never came back to the hall: {heads:?}");
+    assert!(
+        back.is_some(),
+        "the chain never came back to the hall: {heads:?}"
+    );
 }
 
 #[test]
 fn a_goal_behind_a_wall_across_the_box_is_proven_sealed_from_an_empty_map() {
     // A room 6 x 4 x 2.6 m cut by a wall at x = 4 from side to side and floor to
     // ceiling; the goal lies behind it.
-    let mut world =
-        Grid::new(0.1, [0; 3], [60, 40, 26], crate::map::Cell::Occupied, true).unwrap();
+    let mut world = Grid::new(0.1, [0; 3], [60, 40, 26], crate::map::Cell::Occupied, true).unwrap();
     let e = 1e-6;
-    world.fill_box([0.1 + e; 3], [5.9 - e, 3.9 - e, 2.5 - e], crate::map::Cell::Free);
-    world.fill_box([4.0 + e, 0.0, 0.0], [4.2 - e, 4.0, 2.6], crate::map::Cell::Occupied);
+    world.fill_box(
+        [0.1 + e; 3],
+        [5.9 - e, 3.9 - e, 2.5 - e],
+        crate::map::Cell::Free,
+    );
+    world.fill_box(
+        [4.0 + e, 0.0, 0.0],
+        [4.2 - e, 4.0, 2.6],
+        crate::map::Cell::Occupied,
+    );
     let params = ChainParams::new(3).validate().unwrap();
     let settings = PlanOptions::default().table_settings();
     let tables = ShapeTables::build(params, &settings, &AtomicUsize::new(0)).unwrap();
@@ -208,4 +234,3 @@ fn a_goal_behind_a_wall_across_the_box_is_proven_sealed_from_an_empty_map() {
     assert!(*t < 300.0);
     assert!(!ex.flight.report.contact);
 }
-
