@@ -37,7 +37,7 @@ use super::check::{check_with_margin, Violation};
 use super::{group, merge};
 use super::{Plan, Settings, TrajectoryError, MAX_SAMPLES};
 use crate::map::Grid;
-use crate::sim::reference::{Reference, Scaling, Segment};
+use crate::trajectory::reference::{Reference, Scaling, Segment};
 
 /// Peak of the smoothstep's derivative: a ramp of length `R` that changes a rate by
 /// `dv` accelerates by at most `1.5 dv / R`. Derived (the smoothstep `3t^2 - 2t^3` has

@@ -5,7 +5,7 @@
 
 use super::build::{sample, Trajectory};
 use super::{Plan, Settings, TrajectoryError};
-use crate::sim::reference::{Reference, Scaling, Segment, SegmentKind};
+use crate::trajectory::reference::{Reference, Scaling, Segment, SegmentKind};
 
 /// One leg: the waypoints `from..=to` of the plan, and the hold at its end.
 #[derive(Clone, Copy, Debug, PartialEq)]
