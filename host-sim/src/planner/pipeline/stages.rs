@@ -113,6 +113,14 @@ fn measurements(cx: &Context, w: &Widening) -> Budget {
     }
 }
 
+/// Widens `draft`'s plan in its context (`super::super::widen`): what that did.
+fn widened(draft: &mut Draft, cx: &Context) -> Widening {
+    let steps = std::mem::take(&mut draft.steps);
+    let (steps, w) = widen(&draft.ctx, cx.ctx_min, steps, cx.deadline, &cx.s.widen);
+    draft.steps = steps;
+    w
+}
+
 /// The search's plan widened (`super::super::widen`), where it has the most stations
 /// to move; the result is noted for `WidenAgain` and the report.
 pub(super) struct WidenFirst;
@@ -123,10 +131,8 @@ impl Stage for WidenFirst {
     }
 
     fn run(&self, mut draft: Draft, cx: &Context) -> (Draft, Budget) {
-        let steps = std::mem::take(&mut draft.steps);
-        let (steps, w) = widen(&draft.ctx, cx.ctx_min, steps, cx.deadline, &cx.s.widen);
-        draft.notes.first_widening = Some(Arc::new((steps.clone(), w)));
-        draft.steps = steps;
+        let w = widened(&mut draft, cx);
+        draft.notes.first_widening = Some(Arc::new((draft.steps.clone(), w)));
         (draft, measurements(cx, &w))
     }
 }
@@ -217,9 +223,7 @@ impl Stage for WidenAgain {
                 return (draft, used);
             }
         }
-        let steps = std::mem::take(&mut draft.steps);
-        let (steps, w) = widen(&draft.ctx, cx.ctx_min, steps, cx.deadline, &cx.s.widen);
-        draft.steps = steps;
+        let w = widened(&mut draft, cx);
         draft.notes.widening = w;
         (draft, measurements(cx, &w))
     }
