@@ -27,6 +27,7 @@ mod group;
 mod legs;
 mod merge;
 pub(crate) mod reference;
+mod stages;
 #[cfg(test)]
 mod tests;
 
@@ -38,6 +39,7 @@ pub use build::{build, Trajectory};
 pub use check::{check_samples, CheckReport, Peaks, Problem, Violation, LIMIT_TOLERANCE};
 pub use file::{FileError, SampleError, SampleRow, TrajectoryFile, TrajectoryStats, FORMAT};
 pub use reference::{LimitsError, Reference, ReferenceError, ReferenceLimits};
+pub use stages::{Stage, StageReport, Stages};
 
 use serde::{Deserialize, Serialize};
 
