@@ -57,7 +57,8 @@ fn draft(cx: &Context) -> Draft {
 
 /// Runs `list` one stage after the other from the search's plan, holding every
 /// plan a stage gives to the exact verifier, its start to the search's start and its
-/// head's end to the search's; the last draft.
+/// head's end to the search's; the last draft (where a stage gives its lane up, as
+/// the driver would, the draft it gave up).
 fn each_verified(planner: &ArcPlanner, raw: &[Step], grid: &Grid, list: &[&dyn Stage]) -> Draft {
     let cx = planner.post_context(raw, None);
     let params = *cx.ctx.params();
@@ -66,7 +67,7 @@ fn each_verified(planner: &ArcPlanner, raw: &[Step], grid: &Grid, list: &[&dyn S
         let (out, _) = s.run(d, &cx);
         d = out;
         if d.notes.withdrawn {
-            continue;
+            break;
         }
         let name = s.name();
         verified(grid, &params, &d.steps).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -92,7 +93,10 @@ fn every_main_lane_stage_gives_a_plan_the_exact_verifier_passes() {
         &stages::WidenAgain,
     ];
     let out = each_verified(&planner, &raw, &grid, &list);
-    assert!(out.notes.carried.is_some(), "the maze is carried");
+    assert!(
+        !out.notes.withdrawn && out.notes.carried.is_some(),
+        "the maze is carried"
+    );
     assert!(Quality::of(&out.steps).shape_motion_rad < Quality::of(&raw).shape_motion_rad);
 }
 
@@ -109,6 +113,10 @@ fn widening_keeping_its_margin_and_threading_give_plans_the_exact_verifier_passe
         &stages::ReplaceRuns,
     ];
     let out = each_verified(&planner, &raw, &grid, &widened);
+    assert!(
+        !out.notes.withdrawn,
+        "the window keeps the margin widening won"
+    );
     let first = out.notes.first_widening.as_ref().expect("widened").1;
     assert!(first.moves > 0 && first.in_passages.is_some(), "{first:?}");
     let out = each_verified(&planner, &raw, &grid, &[&stages::Thread]);
