@@ -8,7 +8,8 @@
 //! Each family is a module with a small face (the names below are the common ones):
 //! - [`map`]: [`map::OcTree`] (OctoMap `.bt`/`.ot`), [`map::Grid`], [`map::DistanceField`];
 //! - [`problem`]: built-in scenarios ([`problem::scenarios::build`]) and the `passage:`
-//!   family of hard cases;
+//!   family of hard cases; [`witness`]: plans made from their own geometry (the
+//!   witness that an instance can be flown);
 //! - [`collision`]: [`collision::CollisionContext`] (conservative checks for planners) and
 //!   [`collision::verify_plan`] (the exact test);
 //! - [`tables`]: [`tables::ShapeTables`], the LSC, SRS and G_SRS of a chain;
@@ -75,3 +76,4 @@ mod shape_index;
 pub mod sim;
 pub mod tables;
 pub mod trajectory;
+pub mod witness;

@@ -9,6 +9,7 @@
 use std::io::Read;
 use std::path::Path;
 
+use crate::collision::Verifiable;
 use crate::map::grid::Grid;
 use aerial_chain_core::{ChainParams, Shape};
 use serde::{Deserialize, Serialize};
@@ -339,6 +340,21 @@ impl Waypoint {
     /// The shape part eta.
     pub fn eta(&self) -> &[f64] {
         &self.zeta[3..]
+    }
+}
+
+/// A plan file as the exact verifier reads it (`crate::collision::verify_plan`).
+impl Verifiable for Plan {
+    fn chain(&self) -> Result<ChainParams, String> {
+        self.check().map_err(|e| e.to_string())
+    }
+
+    fn configurations(&self) -> Vec<&[f64]> {
+        self.waypoints.iter().map(|w| w.zeta.as_slice()).collect()
+    }
+
+    fn map_assumptions(&self) -> (f64, bool) {
+        (self.map.resolution, self.map.unknown_is_occupied)
     }
 }
 

@@ -8,6 +8,7 @@ use aerial_chain::map::DistanceField;
 use aerial_chain::map::Grid;
 use aerial_chain::map::OcTree;
 use aerial_chain::problem::scenarios;
+use aerial_chain::witness::route_plan;
 use aerial_chain_core::ChainParams;
 
 #[test]
@@ -38,7 +39,7 @@ fn exported_scenarios_fly_from_the_file() {
             .unwrap();
             let shape = s.start_shape(s.default_units).unwrap();
             assert_eq!(ctx.check_config(s.start, &shape), Ok(()), "{name}");
-            let mut plan = s.route_plan(&p, 0.1).unwrap();
+            let mut plan = route_plan(&s, &p, 0.1).unwrap();
             plan.map.unknown_is_occupied = unknown_is_occupied;
             let rep = verify_plan(&grid, &plan);
             assert!(rep.ok, "{name}: {:?}", rep.violation);

@@ -4,8 +4,9 @@
 use std::path::Path;
 
 use aerial_chain::plan_file::Plan;
-use aerial_chain::problem::passages::{witness, PassageSpec};
+use aerial_chain::problem::passages::PassageSpec;
 use aerial_chain::problem::scenarios;
+use aerial_chain::witness::{opening_clearances, witness};
 mod support;
 
 use support::{plan_across_sealed_rooms, plan_verified};
@@ -45,7 +46,7 @@ fn half_metre_windows_at_45_degrees_and_tunnels_plan_for_5_and_6_units() {
         witness(&sc, &params).unwrap();
         let plan = plan_and_verify(name, n, dir.path());
         let spec = PassageSpec::parse(&name["passage:".len()..]).unwrap();
-        for o in spec.opening_clearances(&plan, &params).unwrap() {
+        for o in opening_clearances(&spec, &plan, &params).unwrap() {
             assert!(o.clearance >= o.target, "{name} N = {n}: {o:?}");
         }
     }
@@ -64,7 +65,7 @@ fn the_search_threads_an_opening_that_whole_shapes_cannot_pass_without_a_roadmap
     assert!(plan.stats["follow_uses"].as_u64().unwrap() > 0);
     let spec = PassageSpec::parse(&name["passage:".len()..]).unwrap();
     let params = aerial_chain_core::ChainParams::new(8);
-    for o in spec.opening_clearances(&plan, &params).unwrap() {
+    for o in opening_clearances(&spec, &plan, &params).unwrap() {
         assert!(o.clearance >= o.target, "{o:?}");
     }
 }

@@ -52,7 +52,8 @@ use nalgebra::{Point3, Vector3};
 use crate::map::distance::DistanceField;
 
 pub use verify::{
-    verify_plan, verify_plan_with, EdgeKind, VerifyOptions, VerifyReport, SAMPLES_PER_VOXEL,
+    verify_plan, verify_plan_with, EdgeKind, Verifiable, VerifyOptions, VerifyReport,
+    SAMPLES_PER_VOXEL,
 };
 
 /// Default clearance margin added to every body's radius by the planner's checks (m).

@@ -17,7 +17,6 @@ use aerial_chain_core::validity::Body;
 
 use super::exact::{check_config_exact, ExactViolation};
 use crate::map::grid::Grid;
-use crate::plan_file::Plan;
 use aerial_chain_core::ChainParams;
 
 /// Tolerance for "stays" when classifying an edge (docs/model.md).
@@ -249,15 +248,29 @@ pub struct VerifyReport {
     pub notes: Vec<String>,
 }
 
+/// What the verifier reads of a plan: its chain (or why it breaks its format's rules),
+/// its waypoints' configurations and the map assumptions it was made with. A plan file
+/// (`crate::plan_file::Plan`) is one; the verifier itself reads no file format.
+pub trait Verifiable {
+    /// The chain, or, where the plan breaks its format's rules, why.
+    fn chain(&self) -> Result<ChainParams, String>;
+    /// Every waypoint's configuration `zeta`, the start first (at least one where
+    /// [`Self::chain`] is `Ok`).
+    fn configurations(&self) -> Vec<&[f64]>;
+    /// The voxel edge (m) the plan was made for, and whether it took unknown space
+    /// as occupied.
+    fn map_assumptions(&self) -> (f64, bool);
+}
+
 /// Verifies `plan` on `grid` with the default options (see [`verify_plan_with`]).
-pub fn verify_plan(grid: &Grid, plan: &Plan) -> VerifyReport {
+pub fn verify_plan(grid: &Grid, plan: &impl Verifiable) -> VerifyReport {
     verify_plan_with(grid, plan, &VerifyOptions::default())
 }
 
 /// Verifies every waypoint and edge of `plan` on `grid` by the exact test, with the
 /// grid's choice of whether unknown space is occupied. Goes through the whole plan: the
 /// report names the FIRST violation and the smallest clearance over the valid samples.
-pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> VerifyReport {
+pub fn verify_plan_with(grid: &Grid, plan: &impl Verifiable, opts: &VerifyOptions) -> VerifyReport {
     let mut rep = VerifyReport {
         ok: false,
         edges: Vec::new(),
@@ -273,12 +286,12 @@ pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> Verif
         sample: 0,
         t: 0.0,
     };
-    let params = match plan.check() {
+    let params = match plan.chain() {
         Ok(p) => p,
         Err(e) => {
             rep.violation = Some(PlanViolation {
                 site: first,
-                problem: PlanProblem::Format(e.to_string()),
+                problem: PlanProblem::Format(e),
             });
             return rep;
         }
@@ -290,9 +303,10 @@ pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> Verif
         horizon: opts.horizon,
         rep,
     };
-    v.check(&plan.waypoints[0].zeta, first);
-    for (e, w) in plan.waypoints.windows(2).enumerate() {
-        v.check_edge(e, &w[0].zeta, &w[1].zeta);
+    let zetas = plan.configurations();
+    v.check(zetas[0], first);
+    for (e, w) in zetas.windows(2).enumerate() {
+        v.check_edge(e, w[0], w[1]);
     }
     let mut rep = v.rep;
     rep.ok = rep.violation.is_none();
@@ -301,20 +315,21 @@ pub fn verify_plan_with(grid: &Grid, plan: &Plan, opts: &VerifyOptions) -> Verif
 
 /// Notes where the plan's own map assumptions differ from the map it is checked on
 /// (the check uses the caller's map; the notes only say so).
-fn assumption_notes(grid: &Grid, plan: &Plan) -> Vec<String> {
+fn assumption_notes(grid: &Grid, plan: &impl Verifiable) -> Vec<String> {
     let mut notes = Vec::new();
-    if (plan.map.resolution - grid.resolution()).abs() > 1e-9 {
+    let (resolution, unknown_is_occupied) = plan.map_assumptions();
+    if (resolution - grid.resolution()).abs() > 1e-9 {
         notes.push(format!(
             "the plan was made for resolution {} m, the map has {} m",
-            plan.map.resolution,
+            resolution,
             grid.resolution()
         ));
     }
-    if plan.map.unknown_is_occupied != grid.unknown_is_occupied() {
+    if unknown_is_occupied != grid.unknown_is_occupied() {
         let word = |occupied: bool| if occupied { "occupied" } else { "free" };
         notes.push(format!(
             "the plan assumed unknown space {}, this check treats it as {}",
-            word(plan.map.unknown_is_occupied),
+            word(unknown_is_occupied),
             word(grid.unknown_is_occupied())
         ));
     }
@@ -453,7 +468,7 @@ pub fn check_edge_exact(
 mod tests {
     use super::*;
     use crate::map::grid::{Cell, Grid};
-    use crate::plan_file::{ChainSection, MapSection, Waypoint, FORMAT};
+    use crate::plan_file::{ChainSection, MapSection, Plan, Waypoint, FORMAT};
     use aerial_chain_core::Shape;
 
     fn plan(points: &[([f64; 3], Shape)]) -> Plan {

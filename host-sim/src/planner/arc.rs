@@ -378,12 +378,14 @@ impl ArcPlanner {
         if threading.narrowest_middle() >= self.refine.thread.opening * super::widen::CAP {
             return None;
         }
-        let (steps, checks) = threading.follow(
-            &self.ctx,
-            &query.start_step(),
-            self.settings.follow_step,
-            deadline,
-        )?;
+        let (steps, checks) = threading
+            .follow(
+                &self.ctx,
+                &query.start_step(),
+                self.settings.follow_step,
+                deadline,
+            )
+            .ok()?;
         let mut stats = Stats::default();
         super::construction::count_sources(&steps, &mut stats);
         stats.min_margin = self.ctx.clearance_margin();

@@ -50,8 +50,8 @@ use nalgebra::{Point3, Vector3};
 
 use super::candidates::{headings, Source};
 use super::lattice::{offsets26, KeyHasher};
-use super::numeric::{SAME_HEADING, TIE};
-use super::refine::{differs, shape_motion, Quality};
+use super::numeric::SAME_HEADING;
+use super::plan_ops::{differs, farthest, head_route, shape_motion, Quality};
 use super::{CarrySettings, Checker, Step};
 
 /// Costs of the search are kept in micrometres, so that its heap orders integers: an
@@ -84,12 +84,14 @@ struct Takeover {
 }
 
 /// The plan `steps` with a stretch of it flown in one library shape, if that moves
-/// the angles less (see the module docs); checks by `checker`.
+/// the angles less (see the module docs); checks by `checker`. The placements its
+/// searches make (its budget, `CarrySettings::total_points`) are added to `spent`.
 pub(super) fn carried(
     checker: &mut Checker,
     library: &[LscEntry],
     steps: &[Step],
     s: &CarrySettings,
+    spent: &mut usize,
 ) -> Option<(Vec<Step>, Carried)> {
     if Quality::of(steps).shape_changes < s.min_changes {
         return None;
@@ -98,18 +100,18 @@ pub(super) fn carried(
     // The coarse lattice first; where it found no way at all (rather than running out
     // of placements), the fine one may pass a spot the coarse one steps over.
     let r_v = checker.ctx.field().grid().resolution();
-    let mut spent = 0;
+    let start = *spent;
     for spacing in s.spacings {
         let mut closed = Vec::new();
         for t in tried {
-            if spent >= s.total_points {
+            if *spent - start >= s.total_points {
                 return None;
             }
             let route = head_route(&steps[t.i..=t.j]);
             let guide = Guide::new(&route, middle(checker, &t.x), s.tube);
-            let budget = s.search_points.min(s.total_points - spent);
+            let budget = s.search_points.min(s.total_points - (*spent - start));
             let (found, used) = search(checker, &guide, &t.x, spacing * r_v, budget, s.greed);
-            spent += used;
+            *spent += used;
             let path = match found {
                 Found::Path(path) => path,
                 Found::Closed => {
@@ -237,17 +239,6 @@ fn splice(
         out.extend_from_slice(&steps[j + 1..]);
     }
     out
-}
-
-/// The head's positions along the plan, without repeats.
-fn head_route(steps: &[Step]) -> Vec<Point3<f64>> {
-    let mut route: Vec<Point3<f64>> = Vec::with_capacity(steps.len());
-    for s in steps {
-        if route.last().is_none_or(|p| (s.xi - p).norm() > TIE) {
-            route.push(s.xi);
-        }
-    }
-    route
 }
 
 /// The library's shapes at every heading, the start's head yaw held, least motion
@@ -509,40 +500,8 @@ fn taut(checker: &mut Checker, path: &[Point3<f64>], x: &Shape) -> Option<Vec<Po
     let mut i = 0;
     let last = path.len() - 1;
     while i < last {
-        // Gallop ahead while jumps pass, then bisect between the last pass and the
-        // first failure.
-        let mut good = None;
-        let mut stride = 1;
-        let mut bad = None;
-        while i + stride <= last {
-            if checker.translation(path[i], path[i + stride], x) {
-                good = Some(i + stride);
-                stride *= 2;
-            } else {
-                bad = Some(i + stride);
-                break;
-            }
-        }
-        let mut lo = good?;
-        if good != Some(last) && bad.is_none() {
-            if checker.translation(path[i], path[last], x) {
-                lo = last;
-            } else {
-                bad = Some(last);
-            }
-        }
-        if let Some(mut hi) = bad {
-            while hi - lo > 1 {
-                let mid = (lo + hi) / 2;
-                if checker.translation(path[i], path[mid], x) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-        }
-        out.push(path[lo]);
-        i = lo;
+        i = farthest(i, last, |j| checker.translation(path[i], path[j], x))?;
+        out.push(path[i]);
     }
     Some(out)
 }

@@ -64,7 +64,8 @@ fn a_restless_plan_in_open_space_is_flown_in_its_start_shape() {
     let mut checker = Checker::new(ctx.clone(), None);
     let steps = restless_plan();
     assert!(Quality::of(&steps).shape_changes >= d().min_changes);
-    let (out, carried) = carried(&mut checker, &lsc, &steps, &d()).expect("the line flies it all");
+    let (out, carried) =
+        carried(&mut checker, &lsc, &steps, &d(), &mut 0).expect("the line flies it all");
     assert_eq!(carried.kind, LscKind::Li);
     // No change at all: the line is the start shape, and the goal needs none.
     assert_eq!(Quality::of(&out).shape_changes, 0);
@@ -81,7 +82,8 @@ fn a_carried_plan_passes_the_checks_through_a_window() {
     let lsc = library(ctx.params()).entries;
     let mut checker = Checker::new(ctx.clone(), None);
     let steps = restless_plan();
-    let (out, _) = carried(&mut checker, &lsc, &steps, &d()).expect("a line passes the window");
+    let (out, _) =
+        carried(&mut checker, &lsc, &steps, &d(), &mut 0).expect("a line passes the window");
     assert_carried_plan_holds(&ctx, &steps, &out);
 }
 
@@ -164,7 +166,7 @@ proptest::proptest! {
         proptest::prop_assume!(valid);
         let lsc = library(ctx.params()).entries;
         let mut checker = Checker::new(ctx.clone(), None);
-        if let Some((out, carried)) = carried(&mut checker, &lsc, &steps, &d()) {
+        if let Some((out, carried)) = carried(&mut checker, &lsc, &steps, &d(), &mut 0) {
             assert_carried_plan_holds(&ctx, &steps, &out);
             proptest::prop_assert!(carried.head_path_m > 0.0);
         }
@@ -184,7 +186,7 @@ fn plans_with_few_changes_are_left_alone() {
         step(3.0, line, true),
         step(4.0, line, false),
     ];
-    assert!(carried(&mut checker, &lsc, &steps, &d()).is_none());
+    assert!(carried(&mut checker, &lsc, &steps, &d(), &mut 0).is_none());
 }
 
 #[test]

@@ -69,3 +69,55 @@ impl Checker {
         self.timed(|c| c.check_shape_change(xi, s, t).is_ok())
     }
 }
+
+/// The checks the check-counting stages of post-processing ask for (refinement's
+/// shortcuts, shortening), and whether they may still ask (a budget or a deadline).
+pub(super) trait Checks {
+    /// The chain in shape `s` can translate from `a` to `b`.
+    fn translation(&mut self, a: Point3<f64>, b: Point3<f64>, s: &Shape) -> bool;
+    /// The chain can change shape from `s` to `t` with the head at `xi`.
+    fn shape_change(&mut self, xi: Point3<f64>, s: &Shape, t: &Shape) -> bool;
+    /// No more checks may be made.
+    fn exhausted(&self) -> bool;
+}
+
+/// A [`Checker`] whose checks count against a budget that several stages share: each
+/// takes over the count the one before left.
+pub(super) struct Counted {
+    checker: Checker,
+    /// Checks made so far, the earlier stages' included.
+    pub(super) checks: u64,
+    budget: u64,
+}
+
+impl Counted {
+    /// Checks in `ctx` until `deadline`, `spent` of `budget` already made.
+    pub(super) fn new(
+        ctx: CollisionContext,
+        deadline: Option<Instant>,
+        spent: u64,
+        budget: u64,
+    ) -> Self {
+        Self {
+            checker: Checker::new(ctx, deadline),
+            checks: spent,
+            budget,
+        }
+    }
+}
+
+impl Checks for Counted {
+    fn translation(&mut self, a: Point3<f64>, b: Point3<f64>, s: &Shape) -> bool {
+        self.checks += 1;
+        self.checker.translation(a, b, s)
+    }
+
+    fn shape_change(&mut self, xi: Point3<f64>, s: &Shape, t: &Shape) -> bool {
+        self.checks += 1;
+        self.checker.shape_change(xi, s, t)
+    }
+
+    fn exhausted(&self) -> bool {
+        self.checks >= self.budget || expired(self.checker.deadline)
+    }
+}

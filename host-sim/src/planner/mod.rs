@@ -13,7 +13,8 @@
 //! - [`ArcPlanner`], the paper's ARCplanner (`arc`): a lazy head roadmap
 //!   (`roadmap`, `lattice`) and, per head edge, the cheapest shape that gets the
 //!   chain along it (`construction`, `connect`, `candidates`, `follow`,
-//!   `srs_connect`), then `refine`, `shorten`, `carry`, `widen` and `thread`;
+//!   `srs_connect`), then post-processing: the stages of `pipeline` over `refine`,
+//!   `shorten`, `carry`, `widen` and `thread`, sharing `plan_ops`;
 //! - the full-state PRM baseline, [`crate::baseline::FullStatePrm`].
 //!
 //! Both search their roadmaps with the one lazy graph search of `graph`.
@@ -31,6 +32,8 @@ pub(crate) mod graph;
 pub(crate) mod lattice;
 pub(crate) mod motion;
 mod numeric;
+mod pipeline;
+pub(crate) mod plan_ops;
 pub(crate) mod refine;
 mod refine_settings;
 pub(crate) mod roadmap;
@@ -51,7 +54,8 @@ pub use carry::Carried;
 pub(crate) use checker::Checker;
 pub use error::PlanError;
 pub use motion::{annotate_quality, source_label, to_plan};
-pub use refine::{Quality, Refinement};
+pub use pipeline::{Budget, Effect, Refinement, StageReport, Unit};
+pub use plan_ops::Quality;
 pub use refine_settings::{
     CarrySettings, RefineSettings, ShortenSettings, ThreadSettings, WidenSettings,
 };

@@ -9,7 +9,7 @@ use aerial_chain_core::ChainParams;
 use serde_json::Value;
 
 use super::candidates::Source;
-use super::refine::{Quality, Refinement};
+use super::{Quality, Refinement};
 use super::{Solution, SolutionStats};
 use crate::plan_file::{MapSection, Plan};
 

@@ -33,22 +33,9 @@ use aerial_chain_core::{angle, Shape, MAX_SHAPE_DIM};
 use nalgebra::Point3;
 
 use super::candidates::Source;
-use super::refine::shape_motion;
-use super::Step;
-
-use super::numeric::SAME_SHAPE;
-use super::RefineSettings;
-
-/// The checks shortening asks for, and whether it may still ask (a budget or a
-/// deadline).
-pub(super) trait Checks {
-    /// The chain in shape `s` can translate from `a` to `b`.
-    fn translation(&mut self, a: Point3<f64>, b: Point3<f64>, s: &Shape) -> bool;
-    /// The chain can change shape from `s` to `t` with the head at `xi`.
-    fn shape_change(&mut self, xi: Point3<f64>, s: &Shape, t: &Shape) -> bool;
-    /// No more checks may be made.
-    fn exhausted(&self) -> bool;
-}
+use super::checker::Checks;
+use super::plan_ops::{differs, shape_motion};
+use super::{RefineSettings, Step};
 
 /// One shape of the plan and where it is flown: changed into at `pts[0]` (the end of
 /// the run before), then translated through `pts[1..]`.
@@ -61,14 +48,28 @@ struct Run {
     changed: usize,
 }
 
-/// The plan's steps with less shape motion (see the module docs); the start and the
-/// goal stay, and the result passes the same checks as the input.
-/// Tuned by `s.shorten` and the shares `s.partial_shares` (tried largest first).
-pub(super) fn shorten(checks: &mut impl Checks, steps: Vec<Step>, s: &RefineSettings) -> Vec<Step> {
+/// The plan's steps with every shape's head yaw held at the start's (see
+/// [`hold_head_yaw`]); makes no check.
+pub(super) fn hold_yaw(steps: Vec<Step>) -> Vec<Step> {
     if steps.len() < 2 {
         return steps;
     }
-    let mut runs = hold_head_yaw(to_runs(&steps));
+    to_steps(&hold_head_yaw(to_runs(&steps)))
+}
+
+/// The plan's steps with less shape motion: each run's shape replaced (see the module
+/// docs) in passes while one improves the plan. The start and the goal stay, and the
+/// result passes the same checks as the input. Tuned by `s.shorten` and the shares
+/// `s.partial_shares` (tried largest first).
+pub(super) fn replace_runs(
+    checks: &mut impl Checks,
+    steps: Vec<Step>,
+    s: &RefineSettings,
+) -> Vec<Step> {
+    if steps.len() < 2 {
+        return steps;
+    }
+    let mut runs = to_runs(&steps);
     for pass in 1..=s.shorten.max_passes {
         let mut improved = false;
         let mut i = 1;
@@ -93,6 +94,16 @@ pub(super) fn shorten(checks: &mut impl Checks, steps: Vec<Step>, s: &RefineSett
             break;
         }
     }
+    to_steps(&runs)
+}
+
+/// The plan's steps with the translations of each run straightened where a direct one
+/// passes (see [`straighten`]).
+pub(super) fn straightened(checks: &mut impl Checks, steps: Vec<Step>) -> Vec<Step> {
+    if steps.len() < 2 {
+        return steps;
+    }
+    let mut runs = to_runs(&steps);
     for r in &mut runs {
         straighten(checks, r);
     }
@@ -161,7 +172,7 @@ fn hold_head_yaw(runs: Vec<Run>) -> Vec<Run> {
     for mut r in runs {
         r.shape.set_head_yaw(yaw);
         match out.last_mut() {
-            Some(last) if last.shape.max_angle_diff(&r.shape) <= SAME_SHAPE => {
+            Some(last) if !differs(&last.shape, &r.shape) => {
                 last.pts.extend_from_slice(&r.pts[1..]);
             }
             _ => out.push(r),
@@ -235,14 +246,13 @@ fn replacement(
 fn flies(checks: &mut impl Checks, runs: &[Run], i: usize, x: &Shape) -> bool {
     let r = &runs[i];
     let prev = &runs[i - 1].shape;
-    let same = |a: &Shape, b: &Shape| a.max_angle_diff(b) <= SAME_SHAPE;
     // Changes first: a run's translations are most of its checks' cost.
-    if !same(prev, x) && !checks.shape_change(r.pts[0], prev, x) {
+    if differs(prev, x) && !checks.shape_change(r.pts[0], prev, x) {
         return false;
     }
     if let Some(n) = runs.get(i + 1) {
         let end = *r.pts.last().expect("runs hold points");
-        if !same(x, &n.shape) && !checks.shape_change(end, x, &n.shape) {
+        if differs(x, &n.shape) && !checks.shape_change(end, x, &n.shape) {
             return false;
         }
     }

@@ -1,5 +1,5 @@
 use super::*;
-use crate::planner::refine::Quality;
+use crate::planner::plan_ops::Quality;
 use nalgebra::Point3;
 
 /// Checks from two rules, one for translations (by where they begin along x and the
@@ -23,6 +23,12 @@ impl<T: Fn(f64, &Shape) -> bool, C: Fn(&Shape, &Shape) -> bool> Checks for Rule<
     fn exhausted(&self) -> bool {
         false
     }
+}
+
+/// Shortening's three stages in their pipeline order.
+fn shorten(checks: &mut impl Checks, steps: Vec<Step>, s: &RefineSettings) -> Vec<Step> {
+    let steps = replace_runs(checks, hold_yaw(steps), s);
+    straightened(checks, steps)
 }
 
 fn rule(

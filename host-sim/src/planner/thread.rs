@@ -25,7 +25,8 @@ use aerial_chain_core::Shape;
 use nalgebra::{Point3, Vector3};
 
 use super::candidates::Source;
-use super::numeric::{SAME_SHAPE, TIE, TINY, TINY_F32};
+use super::numeric::{TIE, TINY, TINY_F32};
+use super::plan_ops::{differs, head_route};
 use super::widen::{distance, gradient, zeta};
 use super::{follow, Checker, Step, ThreadSettings};
 use crate::collision::exact::{exact_clearance, positions_f64};
@@ -59,13 +60,7 @@ impl Threading {
     /// The head route of `raw` straightened through its pinches; `None` when it has
     /// no pinch.
     pub(super) fn of(ctx: &CollisionContext, raw: &[Step], s: &ThreadSettings) -> Option<Self> {
-        let mut route: Vec<Point3<f64>> = Vec::with_capacity(raw.len());
-        for s in raw {
-            if route.last() != Some(&s.xi) {
-                route.push(s.xi);
-            }
-        }
-        Self::along(ctx, &route, s)
+        Self::along(ctx, &head_route(raw), s)
     }
 
     /// The head route `route` (start first) straightened through its pinches; `None`
@@ -93,19 +88,24 @@ impl Threading {
     }
 
     /// The plan that follows the route from `start` in follow-the-leader steps of at
-    /// most `step` (m), and the time its checks took; `None` where any step fails the
-    /// checks of `ctx`, or the checks run past `deadline` (the query's time limit).
+    /// most `step` (m), and the time its checks took; else, where any step fails the
+    /// checks of `ctx`, the plan grows past `ThreadSettings::max_steps` or the checks
+    /// run past `deadline` (the query's time limit), the number of steps it had made.
     pub(super) fn follow(
         &self,
         ctx: &CollisionContext,
         start: &Step,
         step: f64,
         deadline: Option<Instant>,
-    ) -> Option<(Vec<Step>, Duration)> {
+    ) -> Result<(Vec<Step>, Duration), usize> {
         if step <= 0.0 {
-            return None;
+            return Err(0);
         }
-        Follower::new(ctx, start, step, deadline, &self.s).along(&self.route)
+        let mut f = Follower::new(ctx, start, step, deadline, &self.s);
+        match f.along(&self.route) {
+            Some(()) => Ok((f.steps, f.checker.time)),
+            None => Err(f.steps.len()),
+        }
     }
 
     /// How `steps` passes the pinches, over the samples of every edge at twice the
@@ -568,9 +568,9 @@ impl<'a> Follower<'a> {
         }
     }
 
-    /// The steps that fly the head along `route` (which starts at the start's head),
-    /// and the time their checks took.
-    fn along(mut self, route: &[Point3<f64>]) -> Option<(Vec<Step>, Duration)> {
+    /// Flies the head along `route` (which starts at the start's head), step by step;
+    /// `None` where a step fails.
+    fn along(&mut self, route: &[Point3<f64>]) -> Option<()> {
         self.align(route[1] - route[0]);
         for w in route.windows(2) {
             let mut p = self.head();
@@ -599,7 +599,7 @@ impl<'a> Follower<'a> {
                 p = q;
             }
         }
-        Some((self.steps, self.checker.time))
+        Some(())
     }
 
     fn head(&self) -> Point3<f64> {
@@ -617,7 +617,7 @@ impl<'a> Follower<'a> {
         // The head's yaw turns the units only: the start's is kept (`super::shorten`).
         laid.set_head_yaw(self.head_yaw);
         let shape = self.shape();
-        if laid.max_angle_diff(&shape) <= SAME_SHAPE {
+        if !differs(&laid, &shape) {
             return Some(shape);
         }
         if !(self.checker.config(p, &laid) && self.checker.shape_change(p, &shape, &laid)) {

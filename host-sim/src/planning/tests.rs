@@ -107,7 +107,7 @@ fn tuning_settings_reach_the_search_post_processing_and_the_trajectory() {
     let (request, mut options) = window();
     options.trajectory = Some(crate::trajectory::Settings::default());
     let base = plan(&request, None, &options).unwrap();
-    let widen = |p: &Planned| p.refinement.expect("refined").widening;
+    let widen = |p: &Planned| p.refinement.as_ref().expect("refined").widening;
     // Widening with one measurement moves nothing: what widening trades is its budget.
     let mut tight = options.clone();
     tight.refine.widen.budget = 1;

@@ -2,8 +2,9 @@
 //! parametric family of hard cases (`passage:`), each a map with a start, a goal and a
 //! hand-made route that shows the problem can be solved.
 //!
-//! This layer sits above the map and collision layers (a scenario is a grid; a witness
-//! is checked by the exact verifier) and below planning.
+//! This layer sits above the map and collision layers (a scenario is a grid; the
+//! reason a witness fails is the exact verifier's) and below plan files: the witness
+//! plan itself is made in `crate::witness`.
 
 pub mod large;
 pub mod passages;

@@ -32,7 +32,6 @@ use nalgebra::Point3;
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
 use crate::map::octomap::{MapFileError, OcTree};
-use crate::plan_file::{ChainSection, MapSection, MapSource, Plan, Waypoint};
 
 /// Resolution of every built-in scenario (m).
 pub const RESOLUTION: f64 = 0.1;
@@ -316,6 +315,15 @@ pub fn corridor(length: f64) -> Result<Scenario, ProblemError> {
     })
 }
 
+/// The poses of a witness plan ([`Scenario::route_poses`]) and the chain they are for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoutePoses {
+    /// The chain's parameters, checked.
+    pub params: ChainParams,
+    /// Head position and shape of every waypoint, the start first.
+    pub poses: Vec<([f64; 3], Shape)>,
+}
+
 impl Scenario {
     /// The scenario's map as an OctoMap tree (every voxel in the box known; pruned).
     pub fn octree(&self) -> Result<OcTree, MapFileError> {
@@ -335,11 +343,13 @@ impl Scenario {
         Ok(Shape::line(units, self.start_yaw as f32))
     }
 
-    /// A witness plan: the chain follows [`Self::route`] like a snake (every unit on the
-    /// route, `l` apart), alternating translations of the head by at most `step` metres
-    /// and shape changes that put the units back on the route. Not optimal in any way;
-    /// it shows that the scenario can be flown and gives the simulator something to fly.
-    pub fn route_plan(&self, params: &ChainParams, step: f64) -> Result<Plan, ProblemError> {
+    /// The poses (head position, shape) of a witness plan: the chain follows
+    /// [`Self::route`] like a snake (every unit on the route, `l` apart), alternating
+    /// translations of the head by at most `step` metres and shape changes that put
+    /// the units back on the route; with the chain's parameters, checked. Not optimal
+    /// in any way; it shows that the scenario can be flown (`crate::witness` makes it
+    /// a plan file).
+    pub fn route_poses(&self, params: &ChainParams, step: f64) -> Result<RoutePoses, ProblemError> {
         let params = params.validate().map_err(ProblemError::Chain)?;
         if !(step.is_finite() && step > 0.0) {
             return Err(ProblemError::Step(step));
@@ -370,13 +380,7 @@ impl Scenario {
         let s_start = n as f64 * l;
         let s_end = route.length();
         let mut shape = self.start_shape(params.units)?;
-        let mut plan = Plan {
-            format: crate::plan_file::FORMAT.into(),
-            chain: ChainSection::from_params(&params),
-            map: MapSection::of(&self.grid).with_source(MapSource::scenario(&self.name)),
-            waypoints: vec![Waypoint::new(start, &shape)],
-            stats: Default::default(),
-        };
+        let mut poses = vec![(start, shape)];
         let mut at = s_start;
         loop {
             let head = if at == s_start {
@@ -387,16 +391,16 @@ impl Scenario {
             let next = route.follow_shape(at, n, l)?;
             if next.max_angle_diff(&shape) > 0.0 {
                 shape = next;
-                plan.waypoints.push(Waypoint::new(head, &shape));
+                poses.push((head, shape));
             }
             if at >= s_end {
                 break;
             }
             at = (at + step).min(s_end);
             let head = if at >= s_end { goal } else { route.point(at) };
-            plan.waypoints.push(Waypoint::new(head, &shape));
+            poses.push((head, shape));
         }
-        Ok(plan)
+        Ok(RoutePoses { params, poses })
     }
 }
 

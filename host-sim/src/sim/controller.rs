@@ -29,8 +29,8 @@ use nalgebra::{DMatrix, DVector};
 use super::dynamics::{BodyState, UnitCommand, V3};
 use super::model::ChainModel;
 use super::mpc::{HeadMpc, MpcConfig, MpcError, MpcRef};
-use super::reference::{RefPoint, Reference};
 use super::{all_non_negative, all_positive, SettingsError};
+use crate::trajectory::reference::{RefPoint, Reference};
 
 /// Tuning of the control stack.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -18,9 +18,9 @@ use super::controller::ControlOutput;
 use super::controller::ControllerConfig;
 use super::dynamics::{BodyState, DynamicsError, V3};
 use super::model::ChainModel;
-use super::reference::{RefPoint, Reference, ReferenceError, ReferenceLimits};
 use super::run::FlightRun;
 use super::{all_positive, SettingsError};
+use crate::trajectory::reference::{RefPoint, Reference, ReferenceError, ReferenceLimits};
 
 /// A disturbance force held on units for a while.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -114,7 +114,7 @@ impl SimConfig {
             )?;
         }
         self.controller.validate()?;
-        self.limits.validate()
+        Ok(self.limits.validate()?)
     }
 }
 

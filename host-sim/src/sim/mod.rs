@@ -21,7 +21,6 @@ mod file;
 pub(crate) mod flight;
 pub(crate) mod model;
 pub(crate) mod mpc;
-pub(crate) mod reference;
 mod run;
 
 /// Simulation settings (controller, MPC, limits, model, run) outside their limits.
@@ -33,6 +32,9 @@ pub enum SettingsError {
     /// A physics and control rate outside its range.
     #[error("rate {0} Hz must lie in [500, 20000]")]
     Rate(f64),
+    /// The reference's timing limits outside their range.
+    #[error(transparent)]
+    Limits(#[from] crate::trajectory::LimitsError),
     /// Units too weak to hover with their share of the links.
     #[error(
         "unit thrust_max {thrust_max} N cannot lift a unit and a link ({hover:.2} N) with margin"
@@ -80,7 +82,9 @@ pub use flight::{
 };
 pub use model::ChainModel;
 pub use mpc::{HeadMpc, MpcConfig, MpcRef};
-pub use reference::{Reference, ReferenceError, ReferenceLimits};
+// The timing core lives in `crate::trajectory`; its names stay here for the
+// simulation's users.
+pub use crate::trajectory::{Reference, ReferenceError, ReferenceLimits};
 pub use run::{FlightEnd, FlightRun};
 
 #[cfg(test)]

@@ -19,7 +19,7 @@ use super::flight::{
     CLEARANCE_TOLERANCE,
 };
 use super::model::ChainModel;
-use super::reference::{RefPoint, Reference, ReferenceError};
+use crate::trajectory::reference::{RefPoint, Reference, ReferenceError};
 
 /// A flight in progress: dynamics, controller, the reference they follow, and what
 /// has been recorded.

@@ -34,10 +34,11 @@ use std::collections::HashSet;
 use aerial_chain_core::ChainParams;
 
 use super::check::{check_with_margin, Violation};
+use super::stages::{Stage, Stages};
 use super::{group, merge};
 use super::{Plan, Settings, TrajectoryError, MAX_SAMPLES};
 use crate::map::Grid;
-use crate::sim::reference::{Reference, Scaling, Segment};
+use crate::trajectory::reference::{Reference, Scaling, Segment};
 
 /// Peak of the smoothstep's derivative: a ramp of length `R` that changes a rate by
 /// `dv` accelerates by at most `1.5 dv / R`. Derived (the smoothstep `3t^2 - 2t^3` has
@@ -61,6 +62,7 @@ pub struct Trajectory {
     pub(super) merged: usize,
     pub(super) stop_go: f64,
     pub(super) head_path: f64,
+    pub(super) stages: Stages,
 }
 
 impl Trajectory {
@@ -109,6 +111,10 @@ impl Trajectory {
     pub fn head_path_m(&self) -> f64 {
         self.head_path
     }
+    /// What each stage of the generator did over its rounds (`super::stages`).
+    pub fn stages(&self) -> &Stages {
+        &self.stages
+    }
 }
 
 /// Times `plan` within `settings` and blends its corners where the blended motion is
@@ -152,8 +158,14 @@ fn build_leg(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
     let mut unblended: HashSet<u64> = HashSet::new();
     // What the last round checked: its segments, and the first sample it found wrong.
     let mut last: Option<(Vec<Segment>, usize)> = None;
+    let mut stages = Stages::default();
+    // Each round runs the stages in `Stage::ROUND`'s order.
     loop {
-        let motions = grouping.assemble(&edges, &mut demands, &limits, l);
+        let motions = stages.run(Stage::Group, || {
+            let m = grouping.assemble(&edges, &mut demands, &limits, l);
+            let n = m.segments.len() as u64;
+            (m, n)
+        });
         let starts: Vec<f64> = grouping.starts().collect();
         let mut blend_m: Vec<bool> = starts
             .iter()
@@ -165,7 +177,7 @@ fn build_leg(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
             edges: &motions.segments,
             max_rates: motions.rates,
         };
-        let segments = timing.segments(&mut blend_m);
+        let segments = stages.run(Stage::Fit, || timing.segments(&mut blend_m));
         for (m, (p, b)) in starts.iter().zip(&blend_m).enumerate() {
             if m > 0 && !b {
                 unblended.insert(p.to_bits());
@@ -186,7 +198,11 @@ fn build_leg(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
         });
         let lim = &settings.limits;
         let part = (&times[from..], &zetas[from..]);
-        let rep = check_with_margin(grid, &params, lim, part, margin, &required);
+        let rep = stages.run(Stage::Check, || {
+            let rep = check_with_margin(grid, &params, lim, part, margin, &required);
+            let n = rep.configurations as u64;
+            (rep, n)
+        });
         let Some(mut v) = rep.violation else {
             // Corners of the plan flown blended: a motion that starts where an edge does.
             let blended = starts
@@ -205,17 +221,24 @@ fn build_leg(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
                 merged: grouping.merged_corners(),
                 stop_go,
                 head_path,
+                stages,
             });
         };
         v.sample += from;
         let segs = reference.segments();
         last = Some((segs.to_vec(), v.sample));
-        if let Some(m) = corner_near(segs, &blend_m, &v, settings.dt) {
-            unblended.insert(starts[m].to_bits());
-        } else if let Some(m) = merged_near(segs, &merged_m, &v, settings.dt) {
-            // A run is halved, a pair flies less of its translation or comes apart.
-            grouping.undo(m, &edges);
-        } else {
+        let gave_way = stages.run(Stage::GiveWay, || {
+            if let Some(m) = corner_near(segs, &blend_m, &v, settings.dt) {
+                unblended.insert(starts[m].to_bits());
+            } else if let Some(m) = merged_near(segs, &merged_m, &v, settings.dt) {
+                // A run is halved, a pair flies less of its translation or comes apart.
+                grouping.undo(m, &edges);
+            } else {
+                return (false, 0);
+            }
+            (true, 1)
+        });
+        if !gave_way {
             return Err(TrajectoryError::Inadmissible(v));
         }
     }
@@ -338,13 +361,16 @@ impl Timing<'_> {
     }
 
     /// The timed segments: cruise rates lowered until every edge's ramps fit (an edge
-    /// that never fits is unblended on both sides, which always fits), then laid out.
-    fn segments(&self, blend: &mut [bool]) -> Vec<Segment> {
+    /// that never fits is unblended on both sides, which always fits), then laid out;
+    /// and the rounds of fitting that took.
+    fn segments(&self, blend: &mut [bool]) -> (Vec<Segment>, u64) {
         let m = self.edges.len();
         let mut rates = self.max_rates.clone();
+        let mut rounds = 0;
         let (up, down) = loop {
             let mut fitted = false;
             for _ in 0..self.settings.fit_rounds {
+                rounds += 1;
                 let (up, down) = self.ramps(&rates, blend);
                 let mut all = true;
                 for k in 0..m {
@@ -389,6 +415,6 @@ impl Timing<'_> {
                 ..self.edges[k].clone()
             });
         }
-        out
+        (out, rounds)
     }
 }

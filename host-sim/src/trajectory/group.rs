@@ -18,8 +18,8 @@
 
 use super::merge::{head_length, straight, Demand};
 use super::Settings;
-use crate::sim::reference::{Segment, SegmentKind};
-use crate::sim::ReferenceLimits;
+use crate::trajectory::reference::{Segment, SegmentKind};
+use crate::trajectory::ReferenceLimits;
 
 /// Which side of its shape change a pair's translation lies on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -426,7 +426,7 @@ mod tests {
             start_hold: 0.0,
             ..Default::default()
         };
-        crate::sim::reference::Reference::new(4, 0.5, &w, &lim)
+        crate::trajectory::reference::Reference::new(4, 0.5, &w, &lim)
             .unwrap()
             .segments()
             .to_vec()

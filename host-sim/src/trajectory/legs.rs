@@ -4,8 +4,9 @@
 //! joined with the goal's hold between them, every leg starting on a sample time.
 
 use super::build::{sample, Trajectory};
+use super::stages::Stages;
 use super::{Plan, Settings, TrajectoryError};
-use crate::sim::reference::{Reference, Scaling, Segment, SegmentKind};
+use crate::trajectory::reference::{Reference, Scaling, Segment, SegmentKind};
 
 /// One leg: the waypoints `from..=to` of the plan, and the hold at its end.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,6 +86,7 @@ pub(super) fn join(
     let mut segments = Vec::new();
     let (mut offset, mut stop_go, mut head_path) = (0.0, 0.0, 0.0);
     let (mut corners, mut blended, mut merged) = (0, 0, 0);
+    let mut stages = Stages::default();
     for (tr, leg) in timed {
         for s in tr.reference.segments() {
             let mut s = s.clone();
@@ -103,6 +105,7 @@ pub(super) fn join(
         corners += tr.corners;
         blended += tr.blended;
         merged += tr.merged;
+        stages.add(&tr.stages);
     }
     let first = &timed[0].0;
     let start = &plan.waypoints[0].zeta;
@@ -119,5 +122,6 @@ pub(super) fn join(
         merged,
         stop_go,
         head_path,
+        stages,
     })
 }

@@ -17,8 +17,8 @@
 
 use super::build::max_angle;
 use crate::collision::exact::positions_f64;
-use crate::sim::reference::{Segment, SegmentKind};
-use crate::sim::ReferenceLimits;
+use crate::trajectory::reference::{Segment, SegmentKind};
+use crate::trajectory::ReferenceLimits;
 
 /// Measurements along a shape change for its fastest unit.
 ///

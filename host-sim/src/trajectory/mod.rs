@@ -26,6 +26,8 @@ mod file;
 mod group;
 mod legs;
 mod merge;
+pub(crate) mod reference;
+mod stages;
 #[cfg(test)]
 mod tests;
 
@@ -36,6 +38,8 @@ use crate::plan_file::{ChainSection, FormatError, MapSection, Plan};
 pub use build::{build, Trajectory};
 pub use check::{check_samples, CheckReport, Peaks, Problem, Violation, LIMIT_TOLERANCE};
 pub use file::{FileError, SampleError, SampleRow, TrajectoryFile, TrajectoryStats, FORMAT};
+pub use reference::{LimitsError, Reference, ReferenceError, ReferenceLimits};
+pub use stages::{Stage, StageReport, Stages};
 
 use serde::{Deserialize, Serialize};
 
@@ -76,7 +80,7 @@ pub struct Limits {
 
 impl Default for Limits {
     fn default() -> Self {
-        let r = crate::sim::ReferenceLimits::default();
+        let r = crate::trajectory::ReferenceLimits::default();
         Self {
             speed: r.speed,
             accel: r.accel,
@@ -103,8 +107,8 @@ impl Limits {
     }
 
     /// The same limits for `arc sim`'s reference, without a hold at the start.
-    pub fn to_reference(&self) -> crate::sim::ReferenceLimits {
-        crate::sim::ReferenceLimits {
+    pub fn to_reference(&self) -> crate::trajectory::ReferenceLimits {
+        crate::trajectory::ReferenceLimits {
             speed: self.speed,
             accel: self.accel,
             angular_rate: self.angular_rate,
@@ -207,7 +211,7 @@ pub enum TrajectoryError {
     Dt(f64),
     /// The plan cannot be timed (an edge that changes both head and shape).
     #[error("plan: {0}")]
-    Timing(#[from] crate::sim::ReferenceError),
+    Timing(#[from] crate::trajectory::ReferenceError),
     /// The flight would need more samples than [`MAX_SAMPLES`].
     #[error("the trajectory would take {0} samples, more than {MAX_SAMPLES}")]
     TooLong(usize),

@@ -136,6 +136,25 @@ pub fn write(tr: &Trajectory, plan: &Plan, out: &Path, report: &Report) -> CliRe
         tr.head_path_m(),
         tr.times().len()
     ));
+    let stages: Vec<String> = tr
+        .stages()
+        .reports()
+        .iter()
+        .map(|r| {
+            format!(
+                "{} {:.1} ms, {} rounds, {} {}",
+                r.stage.name(),
+                r.time_s * 1e3,
+                r.rounds,
+                r.used,
+                r.stage.unit()
+            )
+        })
+        .collect();
+    report.line(format_args!(
+        "  trajectory stages (each round in this order): {}",
+        stages.join("; ")
+    ));
     Ok(())
 }
 

@@ -5,6 +5,7 @@ use super::nodes::Nodes;
 use super::{dist, exact_clearance, norm, search::offsets26, sub, HeadLattice};
 use crate::collision::CollisionContext;
 use crate::planner::numeric::{DIV_GUARD, MILLIMETRE, TIE};
+use crate::planner::plan_ops::farthest;
 
 impl HeadLattice {
     /// Moves the path's points where it is narrower than the preferred radius across
@@ -93,32 +94,8 @@ impl HeadLattice {
         let mut i = 0;
         let last = pts.len() - 1;
         while i < last {
-            // Gallop, then bisect, for the farthest reachable point.
-            let mut good = i + 1;
-            let mut step = 1;
-            let mut bad = None;
-            while good < last {
-                let j = (i + 2 * step).min(last);
-                if ok(i, j) {
-                    good = j;
-                    step *= 2;
-                } else {
-                    bad = Some(j);
-                    break;
-                }
-            }
-            if let Some(mut b) = bad {
-                while b - good > 1 {
-                    let m = (good + b) / 2;
-                    if ok(i, m) {
-                        good = m;
-                    } else {
-                        b = m;
-                    }
-                }
-            }
-            out.push(pts[good]);
-            i = good;
+            i = farthest(i, last, |j| ok(i, j)).expect("the next point is always reached");
+            out.push(pts[i]);
         }
         out
     }

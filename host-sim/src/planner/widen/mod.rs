@@ -77,6 +77,9 @@ pub struct Widening {
     pub in_passages: Option<f64>,
     /// Moves taken: stations moved, and translations split.
     pub moves: usize,
+    /// Edge measurements spent, of `WidenSettings::budget` (0 for a widening not made
+    /// again, or a threaded plan's figures).
+    pub measured: usize,
 }
 
 /// Moves the stations of `steps` towards the middle of narrow passages (see the module
@@ -118,6 +121,7 @@ pub(super) fn widen(
     moves += w.other_passages();
     let after = w.narrowest();
     let in_passages = w.narrowest_in_passages();
+    let measured = w.spent;
     (
         w.steps,
         Widening {
@@ -125,8 +129,17 @@ pub(super) fn widen(
             after,
             in_passages,
             moves,
+            measured,
         },
     )
+}
+
+/// The narrowest unit clearance of `steps` over every edge (m, at most [`CAP`]), as
+/// widening measures it: exactly, at twice the verifier's sample spacing.
+pub(super) fn narrowest(ctx: &CollisionContext, steps: &[Step]) -> f64 {
+    (0..steps.len().saturating_sub(1))
+        .map(|e| measure_whole(ctx, e, steps).clearance)
+        .fold(CAP, f64::min)
 }
 
 struct Widener<'a> {

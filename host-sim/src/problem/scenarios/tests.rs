@@ -91,7 +91,7 @@ fn start_and_goal_are_free() {
 fn scenarios_can_be_flown() {
     for s in all() {
         let p = ChainParams::new(s.default_units);
-        let plan = s.route_plan(&p, 0.05).unwrap();
+        let plan = crate::witness::route_plan(&s, &p, 0.05).unwrap();
         let rep = verify_plan(&s.grid, &plan);
         assert!(rep.ok, "{}: {:?}", s.name, rep.violation);
         assert!(

@@ -18,7 +18,7 @@ use super::{CliError, CliResult};
 use aerial_chain::collision::DEFAULT_CLEARANCE;
 use aerial_chain::map::DistanceField;
 use aerial_chain::plan_file::MapSection;
-use aerial_chain::planner::{Mode, Preference, Quality, Refinement, Settings};
+use aerial_chain::planner::{Mode, Preference, Quality, Refinement, Settings, StageReport, Unit};
 use aerial_chain::planning::{
     self, PlanOptions, PlanningError, Request, SettingsFile, DEFAULT_TIME_LIMIT_S,
 };
@@ -553,5 +553,39 @@ fn print_quality(report: &Report, q: &Quality, refinement: Option<&Refinement>) 
                 c.kind.name()
             ));
         }
+        print_stages(report, &r.stages);
+    }
+}
+
+/// Prints what each stage of post-processing did, in the order they are declared.
+fn print_stages(report: &Report, stages: &[StageReport]) {
+    report.line(format_args!(
+        "  post-processing stages (lane stage: time, budget used of limit, then head path, shape motion, narrowest unit clearance):"
+    ));
+    for s in stages {
+        let b = &s.budget;
+        let budget = match b.unit {
+            Unit::Nothing => String::from("no budget"),
+            u => format!("{} of {} {}", b.used, b.limit, u.name()),
+        };
+        let effect = match &s.effect {
+            None => String::from("gave no plan"),
+            Some(e) => format!(
+                "{:.2} m, {:.2} rad, {}",
+                e.head_path_m,
+                e.shape_motion_rad,
+                e.narrowest_m
+                    .map_or(String::from("not measured"), |n| format!("{n:.3} m"))
+            ),
+        };
+        let taken = s.taken.map_or(String::new(), |l| format!(", kept {l}"));
+        let stage = match s.lane.as_str() {
+            "" => s.name.to_string(),
+            lane => format!("{lane} {}", s.name),
+        };
+        report.line(format_args!(
+            "    {stage}: {:.1} ms, {budget}{taken}; {effect}",
+            s.time_s * 1e3
+        ));
     }
 }

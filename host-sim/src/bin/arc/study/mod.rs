@@ -50,9 +50,10 @@ use aerial_chain::planner::{
     to_plan, ArcPlanner, Failure, Planner, Settings, Solution, SolutionStats, Termination,
 };
 use aerial_chain::planning;
-use aerial_chain::problem::passages::{OpeningClearance, PassageSpec};
+use aerial_chain::problem::passages::PassageSpec;
 use aerial_chain::problem::scenarios::{self, Scenario};
 use aerial_chain::tables::{ShapeTables, TableSettings};
+use aerial_chain::witness::{opening_clearances, OpeningClearance};
 
 /// Start and goal of a query (at the default goal tolerance).
 pub use aerial_chain::planner::Query;
@@ -505,8 +506,8 @@ fn passage_result(
         .ok()?
         .plan;
     let post_s = t.elapsed().as_secs_f64();
-    let raw_o = spec.opening_clearances(&raw, &params).ok()?;
-    let post_o = spec.opening_clearances(&post, &params).ok()?;
+    let raw_o = opening_clearances(&spec, &raw, &params).ok()?;
+    let post_o = opening_clearances(&spec, &post, &params).ok()?;
     Some(PassageResult {
         post_s,
         verified: verify_plan(g, &post).ok,

@@ -10,7 +10,8 @@
 use rand::{Rng, SeedableRng};
 
 use super::{plot, run_all, ArcMode, Envs, Method, RunKey, RunResult, RunSpec, Spread, StudyError};
-use aerial_chain::problem::passages::{witness, PassageSpec};
+use aerial_chain::problem::passages::PassageSpec;
+use aerial_chain::witness::witness;
 
 /// Options of the study.
 #[derive(Clone, Debug)]
