@@ -145,7 +145,8 @@ fn narrow_cost(voxels: usize) -> f64 {
 }
 
 /// Searches `field` from `from` to within `tol` of `goal` through the voxels at the
-/// proof radius, those below the route radius at [`narrow_cost`] times their length.
+/// proof radius, a metre below the route radius costing more than any route that keeps
+/// it (`narrow_cost`).
 pub fn search(
     scratch: &mut Scratch,
     field: &DistanceField,
