@@ -19,7 +19,9 @@ use aerial_chain_core::ChainParams;
 use nalgebra::Point3;
 use serde::{Deserialize, Serialize};
 
-use super::planner::{OnlineError, OnlinePlanner, OnlineSettings, Outcome, ReplanRecord, Trigger};
+use super::planner::OnlinePlanner;
+use super::record::{Outcome, ReplanRecord, Trigger};
+use super::settings::{OnlineError, OnlineSettings};
 use crate::collision::{verify::verify_plan, CollisionContext, FK_TOLERANCE};
 use crate::flying::FlyOptions;
 use crate::map::{DistanceField, Grid};

@@ -9,6 +9,8 @@
 //!   clouds in the world frame, replans under a deadline, and commits pieces that lie
 //!   in space known free, pass the trajectory's exact check with unknown space
 //!   occupied, and end at rest;
+//! - [`settings`]: [`OnlineSettings`] and [`OnlineError`]; [`record`]: what every
+//!   replan records ([`ReplanRecord`]);
 //! - [`mod@explore`]: [`explore()`], the simulator as a client: sensors read the true map,
 //!   the chain's dynamics fly what is committed (`arc explore`).
 //!
@@ -24,17 +26,19 @@
 pub mod belief;
 pub mod explore;
 pub mod planner;
+pub mod record;
 pub mod route;
+pub mod settings;
 
 pub use belief::{Belief, Fused};
 pub use explore::{
     explore, quantile, Exploration, ExploreEnd, ExploreError, ExploreRecord, ExploreSettings,
     ExploreSummary, SensingStats, RECORD_FORMAT,
 };
-pub use planner::{
-    OnlineError, OnlinePlanner, OnlineSettings, Outcome, Piece, ReplanRecord, Trigger,
-};
+pub use planner::{OnlinePlanner, Piece};
+pub use record::{Outcome, ReplanRecord, Trigger};
 pub use route::{Radii, Route};
+pub use settings::{OnlineError, OnlineSettings, DEFAULT_DEADLINE_S};
 
 #[cfg(test)]
 mod tests;

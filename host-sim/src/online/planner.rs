@@ -5,107 +5,20 @@ use std::time::Instant;
 
 use aerial_chain_core::{ChainParams, Shape};
 use nalgebra::Point3;
-use serde::{Deserialize, Serialize};
 
 use super::belief::{Belief, Fused};
+use super::record::{Outcome, ReplanRecord, Trigger};
 use super::route::{self, Found, Radii, Route};
+use super::settings::{check_settings, OnlineError, OnlineSettings};
 use crate::collision::FK_TOLERANCE;
 use crate::goal::GoalPose;
 use crate::map::Grid;
 use crate::plan_file::{MapSection, Plan};
 use crate::planner::Query;
-use crate::planning::{plan, PlanOptions, PlanningError, Request};
-use crate::sensing::occupancy::FusionError;
+use crate::planning::{plan, Request};
 use crate::sensing::PointCloud;
 use crate::tables::ShapeTables;
 use crate::trajectory::Trajectory;
-
-/// Wall time a replan may take by default (s): the built-in scenarios' pieces through
-/// their narrow places are found within it on 2 cores (docs/online.md).
-pub const DEFAULT_DEADLINE_S: f64 = 0.3;
-
-/// How the online planner plans.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct OnlineSettings {
-    /// How every piece is planned (`arc plan`'s options; its time limit is replaced
-    /// by `deadline_s`, its trajectory settings by `trajectory`).
-    pub plan: PlanOptions,
-    /// How every piece is timed and checked.
-    pub trajectory: crate::trajectory::Settings,
-    /// Wall time a replan may take (s): what a piece's search and post-processing
-    /// get. Longer finds pieces through harder places; shorter keeps the chain from
-    /// waiting for its next piece. Default 0.3 s.
-    pub deadline_s: f64,
-    /// Period of the route's replans when nothing cuts it (s): how soon a shortcut
-    /// that sensing opened is taken. Default 1 s.
-    pub route_period_s: f64,
-}
-
-impl Default for OnlineSettings {
-    fn default() -> Self {
-        Self {
-            plan: PlanOptions::default(),
-            trajectory: crate::trajectory::Settings::default(),
-            deadline_s: DEFAULT_DEADLINE_S,
-            route_period_s: 1.0,
-        }
-    }
-}
-
-/// Why a replan ran.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Trigger {
-    /// The first plan, at the start.
-    Start,
-    /// A new observation cut the route.
-    RouteCut,
-    /// The route's period elapsed.
-    Period,
-    /// The committed motion ends soon: the next piece is due.
-    CommitShort,
-}
-
-/// What a replan did.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", tag = "kind", content = "why")]
-pub enum Outcome {
-    /// A piece was committed.
-    Committed,
-    /// A turn in place was committed, to look along the route.
-    Looked,
-    /// The route was searched again; nothing was committed (none was due).
-    Rerouted,
-    /// Nothing to do: nothing was seen since the route was searched, or a due piece
-    /// was tried on exactly what is known now and its retries are spent.
-    NothingNew,
-    /// The route leaves known space too soon for a piece: the chain waits to see more.
-    NoRoom,
-    /// The committed motion already ends at the goal.
-    Reached,
-    /// The goal cannot be reached: the reason.
-    Sealed(String),
-}
-
-/// The record of one replan.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ReplanRecord {
-    /// Simulated time when it began (s).
-    pub t: f64,
-    /// Why it ran.
-    pub trigger: Trigger,
-    /// What it did.
-    pub outcome: Outcome,
-    /// Wall time it took (s).
-    pub wall_s: f64,
-    /// Voxels inside the box whose state changed since the previous replan.
-    pub voxels_changed: usize,
-    /// Head path of the piece committed (m; 0 when none).
-    pub committed_m: f64,
-    /// Length of the route to the goal (m; 0 when none).
-    pub route_m: f64,
-}
 
 /// A committed piece: its plan, timed and checked on the map of its commit.
 #[derive(Clone, Debug)]
@@ -117,30 +30,6 @@ pub struct Piece {
     /// The map it was planned and checked on (unknown space occupied), when the
     /// planner keeps them ([`OnlinePlanner::keep_maps`]).
     pub map: Option<Grid>,
-}
-
-/// Why the online planner cannot start or go on.
-#[derive(Debug, thiserror::Error)]
-pub enum OnlineError {
-    /// The box or the prior map cannot be used.
-    #[error("map: {0}")]
-    Map(String),
-    /// A fusion argument was refused.
-    #[error("sensing: {0}")]
-    Fusion(#[from] FusionError),
-    /// A planning input was refused (tables, settings).
-    #[error("planning: {0}")]
-    Planning(PlanningError),
-    /// A setting outside its range.
-    #[error("{field} = {value}: {rule}")]
-    Setting {
-        /// The setting.
-        field: &'static str,
-        /// Its value.
-        value: f64,
-        /// The rule it breaks.
-        rule: &'static str,
-    },
 }
 
 /// Plans a chain's motion toward a goal while the map grows (see the module docs).
@@ -645,32 +534,4 @@ pub(super) fn bodies(
     let mut out: Vec<_> = centres.iter().map(|c| (*c, *c, r_u)).collect();
     out.extend(centres.windows(2).map(|w| (w[0], w[1], r_l)));
     out
-}
-
-/// Refuses settings outside their ranges.
-fn check_settings(s: &OnlineSettings) -> Result<(), OnlineError> {
-    let positive = |field, value: f64, limit: f64, rule| {
-        if value.is_finite() && value > 0.0 && value <= limit {
-            Ok(())
-        } else {
-            Err(OnlineError::Setting { field, value, rule })
-        }
-    };
-    positive(
-        "deadline_s",
-        s.deadline_s,
-        60.0,
-        "a positive number of seconds, at most 60",
-    )?;
-    positive(
-        "route_period_s",
-        s.route_period_s,
-        3600.0,
-        "a positive number of seconds, at most 3600",
-    )?;
-    s.plan.termination().map_err(OnlineError::Planning)?;
-    s.trajectory
-        .validate()
-        .map_err(|e| OnlineError::Map(format!("trajectory settings: {e}")))?;
-    Ok(())
 }

@@ -46,7 +46,7 @@ pub struct ExploreArgs {
     #[arg(long, default_value_t = 600.0)]
     time_limit: f64,
     /// Wall time each replan may take (s).
-    #[arg(long, default_value_t = aerial_chain::online::planner::DEFAULT_DEADLINE_S)]
+    #[arg(long, default_value_t = aerial_chain::online::DEFAULT_DEADLINE_S)]
     deadline: f64,
     /// Clearance margin added to every body's radius while planning (m).
     #[arg(long, default_value_t = aerial_chain::collision::DEFAULT_CLEARANCE)]

@@ -1,0 +1,92 @@
+//! How the online planner plans ([`OnlineSettings`]), and why it cannot
+//! ([`OnlineError`]).
+
+use serde::{Deserialize, Serialize};
+
+use crate::planning::{PlanOptions, PlanningError};
+use crate::sensing::occupancy::FusionError;
+
+/// Wall time a replan may take by default (s): the built-in scenarios' pieces through
+/// their narrow places are found within it on 2 cores (docs/online.md).
+pub const DEFAULT_DEADLINE_S: f64 = 0.3;
+
+/// How the online planner plans.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OnlineSettings {
+    /// How every piece is planned (`arc plan`'s options; its time limit is replaced
+    /// by `deadline_s`, its trajectory settings by `trajectory`).
+    pub plan: PlanOptions,
+    /// How every piece is timed and checked.
+    pub trajectory: crate::trajectory::Settings,
+    /// Wall time a replan may take (s): what a piece's search and post-processing
+    /// get. Longer finds pieces through harder places; shorter keeps the chain from
+    /// waiting for its next piece. Default 0.3 s.
+    pub deadline_s: f64,
+    /// Period of the route's replans when nothing cuts it (s): how soon a shortcut
+    /// that sensing opened is taken. Default 1 s.
+    pub route_period_s: f64,
+}
+
+impl Default for OnlineSettings {
+    fn default() -> Self {
+        Self {
+            plan: PlanOptions::default(),
+            trajectory: crate::trajectory::Settings::default(),
+            deadline_s: DEFAULT_DEADLINE_S,
+            route_period_s: 1.0,
+        }
+    }
+}
+
+/// Why the online planner cannot start or go on.
+#[derive(Debug, thiserror::Error)]
+pub enum OnlineError {
+    /// The box or the prior map cannot be used.
+    #[error("map: {0}")]
+    Map(String),
+    /// A fusion argument was refused.
+    #[error("sensing: {0}")]
+    Fusion(#[from] FusionError),
+    /// A planning input was refused (tables, settings).
+    #[error("planning: {0}")]
+    Planning(PlanningError),
+    /// A setting outside its range.
+    #[error("{field} = {value}: {rule}")]
+    Setting {
+        /// The setting.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// The rule it breaks.
+        rule: &'static str,
+    },
+}
+
+/// Refuses settings outside their ranges.
+pub(super) fn check_settings(s: &OnlineSettings) -> Result<(), OnlineError> {
+    let positive = |field, value: f64, limit: f64, rule| {
+        if value.is_finite() && value > 0.0 && value <= limit {
+            Ok(())
+        } else {
+            Err(OnlineError::Setting { field, value, rule })
+        }
+    };
+    positive(
+        "deadline_s",
+        s.deadline_s,
+        60.0,
+        "a positive number of seconds, at most 60",
+    )?;
+    positive(
+        "route_period_s",
+        s.route_period_s,
+        3600.0,
+        "a positive number of seconds, at most 3600",
+    )?;
+    s.plan.termination().map_err(OnlineError::Planning)?;
+    s.trajectory
+        .validate()
+        .map_err(|e| OnlineError::Map(format!("trajectory settings: {e}")))?;
+    Ok(())
+}
