@@ -21,6 +21,17 @@ fn expect(args: &[&str], dir: &Path, code: i32) -> Outcome {
     o
 }
 
+/// Every output `arc explore` writes, into the test's directory: the flight, the
+/// flown plan and the seen map.
+const OUTPUTS: [&str; 6] = [
+    "--out",
+    "f.json",
+    "--plan-out",
+    "p.json",
+    "--map-out",
+    "seen.bt",
+];
+
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -30,15 +41,7 @@ fn json(path: &Path) -> serde_json::Value {
 /// world and on the map the sensors drew (unknown space occupied: nothing was flown
 /// through space never seen free), and returns the flight file.
 fn explore_to_goal(world: &[&str], dir: &Path) -> serde_json::Value {
-    let out = [
-        "--out",
-        "f.json",
-        "--plan-out",
-        "p.json",
-        "--map-out",
-        "seen.bt",
-    ];
-    expect(&[&["explore"][..], world, &out].concat(), dir, 0);
+    expect(&[&["explore"][..], world, &OUTPUTS].concat(), dir, 0);
     let flight = json(&dir.join("f.json"));
     assert_eq!(flight["format"], "arc-sim/1");
     assert_eq!(flight["explore"]["format"], "arc-explore/1");
@@ -140,27 +143,18 @@ fn a_sealed_goal_ends_the_run_with_the_reason() {
 fn a_sensor_that_sees_almost_nothing_keeps_the_chain_in_known_space() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let o = expect(
-        &[
-            "explore",
-            "--scenario",
-            "window",
-            "--units",
-            "4",
-            "--sensor-range",
-            "0.25",
-            "--time-limit",
-            "15",
-            "--out",
-            "f.json",
-            "--plan-out",
-            "p.json",
-            "--map-out",
-            "seen.bt",
-        ],
-        d,
-        1,
-    );
+    let run = [
+        "explore",
+        "--scenario",
+        "window",
+        "--units",
+        "4",
+        "--sensor-range",
+        "0.25",
+        "--time-limit",
+        "15",
+    ];
+    let o = expect(&[&run[..], &OUTPUTS].concat(), d, 1);
     assert!(o.stderr.contains("time limit"), "{o:?}");
     let o = expect(&["verify", "--map", "seen.bt", "--plan", "p.json"], d, 0);
     assert!(o.stdout.contains("VALID"), "{o:?}");

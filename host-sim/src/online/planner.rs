@@ -265,7 +265,7 @@ impl OnlinePlanner {
 
     /// Commits the next piece along the route: to the goal when the route is known
     /// free to its end, else to the farthest route point whose head sphere is known
-    /// free, or nearer; or a turn to look along the route.
+    /// free, or nearer; first a turn to look along the route when it leaves the view.
     fn commit(&mut self, began: Instant) -> (Outcome, f64) {
         let route = self.route.clone().expect("searched");
         // Look before moving: where the route leaves the sensors' middle view, a piece
@@ -312,10 +312,8 @@ impl OnlinePlanner {
                 return (Outcome::Committed, m);
             }
         }
-        match self.turn_to_look(&route) {
-            true => (Outcome::Looked, 0.0),
-            false => (Outcome::NoRoom, 0.0),
-        }
+        // The route lies in view (looked at above): the chain waits to see more.
+        (Outcome::NoRoom, 0.0)
     }
 
     /// Index of the last route point up to which every point's head sphere is known

@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicUsize;
 
 use super::*;
 use crate::collision::verify_plan;
-use crate::map::Grid;
+use crate::map::{Cell, Grid};
 use crate::plan_file::Waypoint;
 use crate::planning::PlanOptions;
 use crate::problem::scenarios::{self, Scenario};
@@ -18,11 +18,24 @@ use nalgebra::Point3;
 /// configuration.
 fn window(units: u8) -> (Scenario, ChainParams, ShapeTables, Vec<f64>) {
     let sc = scenarios::build("window").unwrap();
+    let (params, tables) = chain(units);
+    let start = Waypoint::new(sc.start.into(), &sc.start_shape(units).unwrap()).zeta;
+    (sc, params, tables, start)
+}
+
+/// A chain of `units` units and `arc plan`'s tables for it.
+fn chain(units: u8) -> (ChainParams, ShapeTables) {
     let params = ChainParams::new(units).validate().unwrap();
     let settings = PlanOptions::default().table_settings();
     let tables = ShapeTables::build(params, &settings, &AtomicUsize::new(0)).unwrap();
-    let start = Waypoint::new(sc.start.into(), &sc.start_shape(units).unwrap()).zeta;
-    (sc, params, tables, start)
+    (params, tables)
+}
+
+/// Sets the voxels of `g` whose centres lie in the box `lo..hi` to `cell` (the box
+/// shrunk by a hair, so that faces on the lattice take exactly the voxels inside).
+fn fill(g: &mut Grid, lo: [f64; 3], hi: [f64; 3], cell: Cell) {
+    let e = 1e-6;
+    g.fill_box(lo.map(|v| v + e), hi.map(|v| v - e), cell);
 }
 
 #[test]
@@ -48,8 +61,8 @@ fn the_window_from_an_empty_map_commits_only_pieces_valid_on_what_was_seen() {
     assert!(!ex.flight.report.contact);
     // The seen map knows less than the world, and never an obstacle where there is none.
     for (i, state) in ex.seen.voxels() {
-        if state == crate::map::Cell::Occupied {
-            assert_eq!(sc.grid.cell(i), crate::map::Cell::Occupied, "{i:?}");
+        if state == Cell::Occupied {
+            assert_eq!(sc.grid.cell(i), Cell::Occupied, "{i:?}");
         }
     }
     let record = ex.record();
@@ -137,31 +150,17 @@ fn a_due_piece_is_tried_even_when_a_route_search_took_in_what_was_seen() {
 /// ends in a wall at x = 10 that the sensors first see from 5 m; lane B (y > 3) is
 /// open to the goal at its far end.
 fn two_lanes() -> Grid {
-    let mut g = Grid::new(0.1, [0; 3], [120, 60, 26], crate::map::Cell::Occupied, true).unwrap();
-    let e = 1e-6;
-    let mut fill = |lo: [f64; 3], hi: [f64; 3], cell| {
-        g.fill_box(lo.map(|v| v + e), hi.map(|v| v - e), cell);
-    };
-    fill([0.1, 0.1, 0.1], [11.9, 5.9, 2.5], crate::map::Cell::Free);
-    fill(
-        [2.0, 2.9, 0.0],
-        [12.0, 3.1, 2.6],
-        crate::map::Cell::Occupied,
-    );
-    fill(
-        [9.8, 0.0, 0.0],
-        [10.0, 3.0, 2.6],
-        crate::map::Cell::Occupied,
-    );
+    let mut g = Grid::new(0.1, [0; 3], [120, 60, 26], Cell::Occupied, true).unwrap();
+    fill(&mut g, [0.1, 0.1, 0.1], [11.9, 5.9, 2.5], Cell::Free);
+    fill(&mut g, [2.0, 2.9, 0.0], [12.0, 3.1, 2.6], Cell::Occupied);
+    fill(&mut g, [9.8, 0.0, 0.0], [10.0, 3.0, 2.6], Cell::Occupied);
     g
 }
 
 #[test]
 fn a_dead_end_seen_late_is_left_the_way_the_chain_came() {
     let world = two_lanes();
-    let params = ChainParams::new(4).validate().unwrap();
-    let settings = PlanOptions::default().table_settings();
-    let tables = ShapeTables::build(params, &settings, &AtomicUsize::new(0)).unwrap();
+    let (params, tables) = chain(4);
     let line = aerial_chain_core::Shape::line(4, 0.0);
     let start = Waypoint::new([2.2, 1.5, 1.3], &line).zeta;
     let goal = Point3::new(11.0, 4.5, 1.3);
@@ -205,21 +204,10 @@ fn a_dead_end_seen_late_is_left_the_way_the_chain_came() {
 fn a_goal_behind_a_wall_across_the_box_is_proven_sealed_from_an_empty_map() {
     // A room 6 x 4 x 2.6 m cut by a wall at x = 4 from side to side and floor to
     // ceiling; the goal lies behind it.
-    let mut world = Grid::new(0.1, [0; 3], [60, 40, 26], crate::map::Cell::Occupied, true).unwrap();
-    let e = 1e-6;
-    world.fill_box(
-        [0.1 + e; 3],
-        [5.9 - e, 3.9 - e, 2.5 - e],
-        crate::map::Cell::Free,
-    );
-    world.fill_box(
-        [4.0 + e, 0.0, 0.0],
-        [4.2 - e, 4.0, 2.6],
-        crate::map::Cell::Occupied,
-    );
-    let params = ChainParams::new(3).validate().unwrap();
-    let settings = PlanOptions::default().table_settings();
-    let tables = ShapeTables::build(params, &settings, &AtomicUsize::new(0)).unwrap();
+    let mut world = Grid::new(0.1, [0; 3], [60, 40, 26], Cell::Occupied, true).unwrap();
+    fill(&mut world, [0.1; 3], [5.9, 3.9, 2.5], Cell::Free);
+    fill(&mut world, [4.0, 0.0, 0.0], [4.2, 4.0, 2.6], Cell::Occupied);
+    let (params, tables) = chain(3);
     let start = Waypoint::new([2.0, 2.0, 1.3], &aerial_chain_core::Shape::line(3, 0.0)).zeta;
     let settings = ExploreSettings {
         time_limit_s: 300.0,
