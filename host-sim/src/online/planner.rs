@@ -1,7 +1,7 @@
 //! [`OnlinePlanner`]: plans as the map grows, committing pieces that end at rest in
 //! space known free (see the module docs of `crate::online`).
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use aerial_chain_core::{ChainParams, Shape};
 use nalgebra::Point3;
@@ -358,6 +358,7 @@ impl OnlinePlanner {
         look: Option<f32>,
         deadline: f64,
     ) -> Option<Piece> {
+        let stop = Instant::now().checked_add(Duration::from_secs_f64(deadline));
         let shape = Shape::from_slice(self.params.units, &eta(&self.end)).ok()?;
         let mut query = Query::new(head(&self.end), shape, goal);
         query.goal_tol = tol;
@@ -384,13 +385,15 @@ impl OnlinePlanner {
                 });
             }
         }
-        self.timed(plan, request.grid())
+        self.timed(plan, request.grid(), stop)
     }
 
-    /// `plan` as a piece: timed and checked exactly on `grid` (the map with unknown
-    /// space occupied), which the piece keeps when the planner keeps maps.
-    fn timed(&self, plan: Plan, grid: &Grid) -> Option<Piece> {
-        let trajectory = crate::trajectory::build(&plan, grid, &self.settings.trajectory).ok()?;
+    /// `plan` as a piece: timed (its blending rounds stopped at `deadline`) and checked
+    /// exactly on `grid` (the map with unknown space occupied), which the piece keeps
+    /// when the planner keeps maps.
+    fn timed(&self, plan: Plan, grid: &Grid, deadline: Option<Instant>) -> Option<Piece> {
+        let settings = &self.settings.trajectory;
+        let trajectory = crate::trajectory::build_until(&plan, grid, settings, deadline).ok()?;
         let map = self.keep_maps.then(|| grid.clone());
         Some(Piece {
             plan,
@@ -419,7 +422,7 @@ impl OnlinePlanner {
         let map = MapSection::of(field.grid());
         let mut plan = Plan::from_zetas(&self.params, map, vec![self.end.clone(), to]);
         plan.stats.insert("turn_to_look".into(), true.into());
-        let Some(piece) = self.timed(plan, field.grid()) else {
+        let Some(piece) = self.timed(plan, field.grid(), None) else {
             return false;
         };
         self.push(piece);

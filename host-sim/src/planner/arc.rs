@@ -175,11 +175,11 @@ impl ArcPlanner {
         spent
     }
 
-    /// Labels the map's free regions if that has not been done. Returns the time
-    /// spent (s).
-    fn ensure_regions(&self) -> f64 {
+    /// Labels the map's free regions if that has not been done, unless `deadline`
+    /// passes first. Returns the time spent (s).
+    fn ensure_regions(&self, deadline: Option<Instant>) -> f64 {
         let t = Instant::now();
-        self.lattice.regions(self.ctx.field());
+        self.lattice.regions(self.ctx.field(), deadline);
         t.elapsed().as_secs_f64()
     }
 
@@ -413,11 +413,14 @@ impl ArcPlanner {
             return Ok(None);
         }
         let (start, goal) = query.ends();
-        built.regions_s += self.ensure_regions();
-        if let Some(sep) = self.lattice.separation(self.ctx.field(), start, goal) {
+        let (budget, deadline) = (self.lattice.budget, stop.deadline(began));
+        built.regions_s += self.ensure_regions(deadline);
+        if let Some(sep) = self
+            .lattice
+            .separation(self.ctx.field(), start, goal, deadline)
+        {
             return Err(self.separated(sep));
         }
-        let (budget, deadline) = (self.lattice.budget, stop.deadline(began));
         built.route = self.head_route(start, goal, budget, deadline, &mut built.lattice_s)?;
         self.solve_on_route(query, stop, began, built)
     }

@@ -5,6 +5,7 @@
 //! mark the goals they reach.
 
 use std::sync::atomic::AtomicUsize;
+use std::time::Instant;
 
 use aerial_chain_core::Shape;
 use nalgebra::Point3;
@@ -50,7 +51,8 @@ impl LegError {
 
 /// Plans `mission` on `base`'s map and chain from `base`'s start and start shape (its
 /// goal is not used), with `tables` (built once from the options when `None`) and
-/// `options` (the time limit applies to each leg; the leg's preference is the goal's).
+/// `options` (the time limit applies to each leg, and to the joined plan's trajectory;
+/// the leg's preference is the goal's).
 pub fn plan_mission(
     base: &Request,
     mission: &Mission,
@@ -101,9 +103,15 @@ pub fn plan_mission(
         legs.push(planned);
     }
     let plan = join(mission, &legs);
+    // The joined plan's trajectory is one more piece of work with a time limit of its
+    // own (the legs were checked, so the termination is).
+    let deadline = options
+        .termination()
+        .ok()
+        .and_then(|t| t.deadline(Instant::now()));
     let trajectory = options
         .trajectory
-        .map(|s| crate::trajectory::build(&plan, base.grid(), &s));
+        .map(|s| crate::trajectory::build_until(&plan, base.grid(), &s, deadline));
     Ok(MissionPlanned {
         plan,
         legs,

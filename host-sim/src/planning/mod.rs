@@ -5,8 +5,8 @@
 //! defaults), and runs what `arc plan` runs: the ARCplanner's search, post-processing
 //! (`ArcPlanner::refine`, unless `no_smooth`), the plan file (`planner::to_plan`)
 //! with its quality annotated, and, when asked, the plan timed into a trajectory.
-//! The time limit ([`DEFAULT_TIME_LIMIT_S`] unless given) covers the search and
-//! post-processing; setup is timed apart. [`finish`] is the second half alone, for
+//! The time limit ([`DEFAULT_TIME_LIMIT_S`] unless given) covers the search,
+//! post-processing and the trajectory's blending rounds; setup is timed apart. [`finish`] is the second half alone, for
 //! callers that ran the search themselves (the benchmarks measure search apart).
 //!
 //! The `arc plan` command, the Python package, the examples and the benchmarks plan
@@ -154,19 +154,20 @@ pub fn plan(
         goal: request.query.goal,
         pose: request.pose,
     };
+    let deadline = stop.deadline(began);
     let done = finish(
         &planner,
         solution,
         request.map.clone(),
         smooth,
-        stop.deadline(began),
+        deadline,
         &arrive,
     )?;
     let post_s = post.elapsed().as_secs_f64();
     let made = Instant::now();
     let trajectory = options
         .trajectory
-        .map(|s| crate::trajectory::build(&done.plan, request.grid(), &s));
+        .map(|s| crate::trajectory::build_until(&done.plan, request.grid(), &s, deadline));
     let trajectory_s = match trajectory {
         Some(_) => made.elapsed().as_secs_f64(),
         None => 0.0,

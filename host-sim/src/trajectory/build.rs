@@ -28,8 +28,13 @@
 //! halved, a pair flies less of its translation or comes apart), and the timing is
 //! redone, until the whole passes. Without blends the chain is on the plan's own edges, resting
 //! on a sample at every waypoint, so only a plan that is itself inadmissible fails.
+//!
+//! A deadline ([`build_until`]) bounds the rounds: a round that begins after it gives
+//! way everywhere at once (no blend, no merge: the plan's own edges, stop and go) and is
+//! the last, so what is kept is a trajectory as valid as the plan, less smooth.
 
 use std::collections::HashSet;
+use std::time::Instant;
 
 use aerial_chain_core::ChainParams;
 
@@ -63,6 +68,7 @@ pub struct Trajectory {
     pub(super) stop_go: f64,
     pub(super) head_path: f64,
     pub(super) stages: Stages,
+    pub(super) cut_short: bool,
 }
 
 impl Trajectory {
@@ -111,6 +117,13 @@ impl Trajectory {
     pub fn head_path_m(&self) -> f64 {
         self.head_path
     }
+
+    /// Whether the deadline ([`build_until`]) stopped the rounds: the plan timed stop
+    /// and go, without the blends and merges that more rounds might have kept.
+    pub fn cut_short(&self) -> bool {
+        self.cut_short
+    }
+
     /// What each stage of the generator did over its rounds (`super::stages`).
     pub fn stages(&self) -> &Stages {
         &self.stages
@@ -125,21 +138,39 @@ impl Trajectory {
 /// leg by leg: every leg ends at rest on its goal, the chain holds there for the goal's
 /// `hold_s`, and the next leg starts on the next sample time.
 pub fn build(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory, TrajectoryError> {
+    build_until(plan, grid, settings, None)
+}
+
+/// [`build`] that stops giving way at `deadline` (none: no deadline): a round that
+/// begins after it times the plan stop and go (no blend, no merge) and is the last
+/// ([`Trajectory::cut_short`]). Its work after the deadline is that round's timing and
+/// one exact check of its samples. Below the deadline the result is [`build`]'s.
+pub fn build_until(
+    plan: &Plan,
+    grid: &Grid,
+    settings: &Settings,
+    deadline: Option<Instant>,
+) -> Result<Trajectory, TrajectoryError> {
     plan.check()?;
     settings.validate()?;
     let legs = super::legs::legs(plan);
     if legs.len() == 1 && legs[0].hold_s == 0.0 {
-        return build_leg(plan, grid, settings);
+        return build_leg(plan, grid, settings, deadline);
     }
     let mut timed = Vec::with_capacity(legs.len());
     for leg in &legs {
-        timed.push((build_leg(&leg.plan(plan), grid, settings)?, leg));
+        timed.push((build_leg(&leg.plan(plan), grid, settings, deadline)?, leg));
     }
     super::legs::join(plan, settings, &timed)
 }
 
-/// [`build`] of one leg: a plan whose goals, if any, are at its ends.
-fn build_leg(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory, TrajectoryError> {
+/// [`build_until`] of one leg: a plan whose goals, if any, are at its ends.
+fn build_leg(
+    plan: &Plan,
+    grid: &Grid,
+    settings: &Settings,
+    deadline: Option<Instant>,
+) -> Result<Trajectory, TrajectoryError> {
     let params = plan.check()?;
     let waypoints: Vec<Vec<f64>> = plan.waypoints.iter().map(|w| w.zeta.clone()).collect();
     let l = params.link_length as f64;
@@ -159,8 +190,14 @@ fn build_leg(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
     // What the last round checked: its segments, and the first sample it found wrong.
     let mut last: Option<(Vec<Segment>, usize)> = None;
     let mut stages = Stages::default();
+    // Set by the first round that begins after the deadline: it gives way everywhere.
+    let mut cut_short = false;
     // Each round runs the stages in `Stage::ROUND`'s order.
     loop {
+        if !cut_short && deadline.is_some_and(|d| Instant::now() >= d) {
+            cut_short = true;
+            grouping = group::Grouping::new(&edges, l, false, settings);
+        }
         let motions = stages.run(Stage::Group, || {
             let m = grouping.assemble(&edges, &mut demands, &limits, l);
             let n = m.segments.len() as u64;
@@ -170,7 +207,9 @@ fn build_leg(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
         let mut blend_m: Vec<bool> = starts
             .iter()
             .enumerate()
-            .map(|(m, p)| m > 0 && settings.blend && !unblended.contains(&p.to_bits()))
+            .map(|(m, p)| {
+                m > 0 && settings.blend && !cut_short && !unblended.contains(&p.to_bits())
+            })
             .collect();
         let timing = Timing {
             settings,
@@ -222,6 +261,7 @@ fn build_leg(plan: &Plan, grid: &Grid, settings: &Settings) -> Result<Trajectory
                 stop_go,
                 head_path,
                 stages,
+                cut_short,
             });
         };
         v.sample += from;

@@ -123,5 +123,6 @@ pub(super) fn join(
         stop_go,
         head_path,
         stages,
+        cut_short: timed.iter().any(|(tr, _)| tr.cut_short),
     })
 }

@@ -11,7 +11,8 @@
 //! "finish one edge, then start the next". The result is sampled on a uniform time grid, and the samples are the
 //! trajectory: [`check_samples`] checks them independently of how they were made.
 //!
-//! - `build`: [`build`] and [`Trajectory`], the generator;
+//! - `build`: [`build`] and [`Trajectory`], the generator ([`build_until`]: within a
+//!   deadline);
 //! - `clock`: [`Trajectory::waypoint_times`], when it passes the plan's waypoints;
 //! - `check`: [`check_samples`], the exact check of sampled motion and its limits;
 //! - `group`: which edges fly together as one motion, and how a merge gives way;
@@ -35,7 +36,7 @@ mod tests;
 // from here.
 use crate::plan_file::{ChainSection, FormatError, MapSection, Plan};
 
-pub use build::{build, Trajectory};
+pub use build::{build, build_until, Trajectory};
 pub use check::{check_samples, CheckReport, Peaks, Problem, Violation, LIMIT_TOLERANCE};
 pub use file::{FileError, SampleError, SampleRow, TrajectoryFile, TrajectoryStats, FORMAT};
 pub use reference::{LimitsError, Reference, ReferenceError, ReferenceLimits};

@@ -194,6 +194,33 @@ fn a_blend_that_would_touch_the_map_is_not_flown() {
 }
 
 #[test]
+fn a_deadline_that_has_passed_keeps_the_plan_stop_and_go() {
+    let params = ChainParams::new(3);
+    let s = Settings::default();
+    let mut grid = room();
+    grid.fill_box([1.71, 0.51, 1.21], [1.79, 1.49, 1.29], Cell::Occupied);
+    for (plan, grid) in [(tour(&params), room()), (corner(&params), grid)] {
+        let full = build(&plan, &grid, &s).unwrap();
+        let later = std::time::Instant::now() + std::time::Duration::from_secs(600);
+        let within = build_until(&plan, &grid, &s, Some(later)).unwrap();
+        assert!(!within.cut_short());
+        assert_eq!(
+            (within.times(), within.zetas()),
+            (full.times(), full.zetas()),
+            "below the deadline the trajectory is build's"
+        );
+        let cut = build_until(&plan, &grid, &s, Some(std::time::Instant::now())).unwrap();
+        assert!(cut.cut_short());
+        assert_eq!((cut.blended(), cut.merged()), (0, 0));
+        assert!((cut.duration() - cut.stop_go_duration()).abs() <= 4.0 * s.dt);
+        assert_eq!(cut.stages().reports()[0].rounds, 1, "one round, the last");
+        let rep = check_samples(&grid, &params, &s.limits, cut.times(), cut.zetas(), 0.0);
+        assert!(rep.ok, "{:?}", rep.violation);
+        assert_respects_limits(&grid, &params, &s.limits, cut.times(), cut.zetas());
+    }
+}
+
+#[test]
 fn the_check_names_what_is_wrong() {
     let params = ChainParams::new(3);
     let grid = room();

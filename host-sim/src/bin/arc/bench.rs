@@ -41,6 +41,11 @@ pub enum BenchCommand {
         after_help = "Example:\n  RAYON_NUM_THREADS=2 arc bench online --out-dir docs/bench"
     )]
     Online(OnlineArgs),
+    /// The time limit's promise: `arc plan --trajectory --time-limit T` on every
+    /// built-in scenario and a sample of the hard-case family, T = 1, 10 and 50 ms by
+    /// default; time after setup against 1.1 T + 50 ms; CSV and markdown.
+    #[command(after_help = "Example:\n  arc bench limit --robust 50 --out-dir docs/bench")]
+    Limit(LimitArgs),
     /// One plan by the full-state lazy PRM baseline (arc-plan/1, verified exactly).
     #[command(
         after_help = "Example:\n  arc bench prm --scenario window --units 4 --vertices 15000 --out prm.json"
@@ -187,6 +192,28 @@ pub struct OnlineArgs {
     #[arg(long, default_value_t = 600.0)]
     time_limit: f64,
     /// Where CSV, markdown and the plot go.
+    #[arg(long, default_value = "bench-out")]
+    out_dir: PathBuf,
+}
+
+/// Hard-case instances `arc bench limit` draws at most: each is built, witnessed and
+/// planned at every limit.
+const MAX_LIMIT_INSTANCES: usize = 1000;
+
+/// `arc bench limit`
+#[derive(Args, Debug)]
+pub struct LimitArgs {
+    /// Time limits to try (ms), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,10,50")]
+    limits_ms: Vec<f64>,
+    /// Built-in scenarios, each at its default N (default: all of them).
+    #[arg(long, value_delimiter = ',')]
+    scenarios: Option<Vec<String>>,
+    /// Instances of the hard-case family (`arc bench robust`'s first ones), at most
+    /// 1000.
+    #[arg(long, default_value_t = 50)]
+    robust: usize,
+    /// Where CSV and markdown go.
     #[arg(long, default_value = "bench-out")]
     out_dir: PathBuf,
 }
@@ -582,6 +609,63 @@ fn run_flight(a: FlightArgs) -> CliResult {
     Ok(())
 }
 
+fn run_limit(a: LimitArgs) -> CliResult {
+    for &t in &a.limits_ms {
+        if !(t > 0.0 && t <= 1e6) {
+            return Err(checks::bad(
+                "--limits-ms",
+                t,
+                "positive milliseconds, at most 1e6",
+            ));
+        }
+    }
+    if a.robust > MAX_LIMIT_INSTANCES {
+        return Err(checks::bad(
+            "--robust",
+            a.robust,
+            "at most 1000 (each instance is drawn, witnessed and planned at every limit)",
+        ));
+    }
+    let began = Instant::now();
+    let names = a
+        .scenarios
+        .unwrap_or_else(|| study::limit::BUILT_IN.map(String::from).to_vec());
+    let mut jobs = Vec::new();
+    for name in names {
+        let units = aerial_chain::problem::scenarios::build(&name)
+            .map_err(|e| CliError::input(format!("--scenarios: {e}")))?
+            .default_units;
+        jobs.push((name, units));
+    }
+    jobs.extend(
+        study::flight::robust_sample(a.robust)
+            .into_iter()
+            .map(|(sc, n, _)| (sc, n)),
+    );
+    let limits: Vec<f64> = a.limits_ms.iter().map(|t| t / 1e3).collect();
+    let runs = study::limit::run(&jobs, &limits)?;
+    let md = format!(
+        "{}\n`arc plan --trajectory --time-limit T`'s defaults through the library's facade, {} queries a limit; {} build; whole study {:.0} s.\n",
+        study::limit::markdown(&runs),
+        jobs.len(),
+        if cfg!(debug_assertions) { "debug" } else { "release" },
+        began.elapsed().as_secs_f64()
+    );
+    let files = [
+        study::write_out(
+            &a.out_dir,
+            "limit_runs.csv",
+            study::limit::csv(&runs).as_bytes(),
+        )?,
+        study::write_out(&a.out_dir, "limit.md", md.as_bytes())?,
+    ];
+    println!("{md}");
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
 fn run_online(a: OnlineArgs) -> CliResult {
     a.runs.check()?;
     if !(a.time_limit > 0.0 && a.time_limit <= 86_400.0) {
@@ -716,6 +800,7 @@ pub fn run(c: BenchCommand) -> CliResult {
         BenchCommand::Robust(a) => run_robust(a),
         BenchCommand::Flight(a) => run_flight(a),
         BenchCommand::Online(a) => run_online(a),
+        BenchCommand::Limit(a) => run_limit(a),
         BenchCommand::Prm(a) => run_prm(*a),
     }
 }

@@ -155,6 +155,11 @@ pub fn write(tr: &Trajectory, plan: &Plan, out: &Path, report: &Report) -> CliRe
         "  trajectory stages (each round in this order): {}",
         stages.join("; ")
     ));
+    if tr.cut_short() {
+        report.line(format_args!(
+            "  trajectory: the time limit stopped the blending rounds; the plan is flown stop and go"
+        ));
+    }
     Ok(())
 }
 

@@ -59,6 +59,8 @@ pub(in crate::planner) use nodes::KeyHasher;
 pub use regions::Regions;
 pub(in crate::planner) use search::offsets26;
 
+use std::time::Instant;
+
 use super::dist;
 use crate::collision::{CollisionContext, FK_TOLERANCE};
 use crate::map::distance::DistanceField;
@@ -92,7 +94,8 @@ pub enum LatticeOutcome {
         /// "start" or "goal".
         side: &'static str,
     },
-    /// The search visited its budget of lattice points without an answer.
+    /// The search visited its budget of lattice points, or reached its deadline,
+    /// without an answer.
     Budget,
 }
 
@@ -179,10 +182,14 @@ impl HeadLattice {
     }
 
     /// The map's free regions for the head's sphere ([`Regions`]), labelled on the
-    /// first call (part of the planner's setup: its cost follows the map's size).
-    pub fn regions(&self, field: &DistanceField) -> &Regions {
-        self.regions
-            .get_or_init(|| Regions::label(field, self.r_min, self.tuning.min_block))
+    /// first call (its cost follows the map's size); `None` when `deadline` passes
+    /// before they are (the next call labels them again).
+    pub fn regions(&self, field: &DistanceField, deadline: Option<Instant>) -> Option<&Regions> {
+        if let Some(r) = self.regions.get() {
+            return Some(r);
+        }
+        let labelled = Regions::label(field, self.r_min, self.tuning.min_block, deadline)?;
+        Some(self.regions.get_or_init(|| labelled))
     }
 
     /// Forgets the labelled regions (the next query that needs them labels them
@@ -192,14 +199,16 @@ impl HeadLattice {
     }
 
     /// [`LatticeOutcome::Separated`] when the labelled regions prove that no lattice
-    /// route joins `start` and `goal`; `None` when they cannot tell.
+    /// route joins `start` and `goal`; `None` when they cannot tell (or are not
+    /// labelled by `deadline`).
     pub fn separation(
         &self,
         field: &DistanceField,
         start: [f64; 3],
         goal: [f64; 3],
+        deadline: Option<Instant>,
     ) -> Option<LatticeOutcome> {
-        let regions = self.regions(field);
+        let regions = self.regions(field, deadline)?;
         let mut nodes = Nodes::new(self, field);
         let mut sides = [("start", start), ("goal", goal)].map(|(side, p)| {
             let mut found: Vec<u32> = self
@@ -334,12 +343,14 @@ impl HeadLattice {
         start: [f64; 3],
         goal: [f64; 3],
         budget: usize,
-        deadline: Option<std::time::Instant>,
+        deadline: Option<Instant>,
     ) -> LatticeOutcome {
         let limit = Limit { budget, deadline };
         let field = ctx_min.field();
+        let Some(regions) = self.regions(field, deadline) else {
+            return LatticeOutcome::Budget;
+        };
         let mut nodes = Nodes::new(self, field);
-        let regions = self.regions(field);
         let starts = self.anchors(&mut nodes, start, 1);
         let goals = self.anchors(&mut nodes, goal, 1);
         let guide = guide::Guide::new(self, regions, &starts, &goals, goal);

@@ -43,9 +43,12 @@
 //! graph sees every opening the voxels see (a door in a thin wall included) and never
 //! steps through a wall: its edges are voxel adjacencies.
 
+use std::time::Instant;
+
 use rayon::prelude::*;
 
 use crate::map::distance::DistanceField;
+use crate::planner::expired;
 
 /// Allowance for rounding in the relaxed test (m): relaxing further is always safe.
 const ROUND_EPS: f64 = 1e-6;
@@ -105,8 +108,15 @@ pub struct CoarseGraph {
 
 impl Regions {
     /// Labels the regions of `field`'s grid for a sphere of radius `radius` (m), in
-    /// blocks of at least `min_block` (m, `planner::LatticeSettings::min_block`).
-    pub fn label(field: &DistanceField, radius: f64, min_block: f64) -> Self {
+    /// blocks of at least `min_block` (m, `planner::LatticeSettings::min_block`);
+    /// `None` when `deadline` passes first (checked every plane of every pass, so a
+    /// labelling stops within a plane's work of it).
+    pub fn label(
+        field: &DistanceField,
+        radius: f64,
+        min_block: f64,
+        deadline: Option<Instant>,
+    ) -> Option<Self> {
         let g = field.grid();
         let dims = g.dims();
         let r = g.resolution();
@@ -118,11 +128,10 @@ impl Regions {
         let slabs: Vec<Vec<Vec<[u32; 2]>>> = (0..dims[2])
             .into_par_iter()
             .map(|z| {
-                (0..dims[1])
-                    .map(|y| cut(row_runs(field, [y, z], threshold), block))
-                    .collect()
+                let plane = (0..dims[1]).map(|y| cut(row_runs(field, [y, z], threshold), block));
+                (!expired(deadline)).then(|| plane.collect())
             })
-            .collect();
+            .collect::<Option<_>>()?;
         let mut row_start = Vec::with_capacity(dims[1] * dims[2] + 1);
         let mut segs = Vec::new();
         for row in slabs.into_iter().flatten() {
@@ -140,10 +149,10 @@ impl Regions {
             node: Vec::new(),
             coarse: CoarseGraph::default(),
         };
-        let across = regions.join_rows();
-        let voxels = regions.build_coarse(field, &across);
+        let across = regions.join_rows(deadline)?;
+        let voxels = regions.build_coarse(field, &across, deadline)?;
         regions.label_regions(&voxels);
-        regions
+        Some(regions)
     }
 
     /// The segments of row `(y, z)`.
@@ -229,13 +238,14 @@ impl Regions {
     /// that reach back into the slab before are joined afterwards. The sets, and so
     /// the numbering (nodes in order of their first segment), are the same as a
     /// serial sweep's.
-    fn join_rows(&mut self) -> Vec<Vec<(u32, u32)>> {
+    /// `None` when `deadline` passes first.
+    fn join_rows(&mut self, deadline: Option<Instant>) -> Option<Vec<Vec<(u32, u32)>>> {
         let nz = self.dims[2];
         let slab = nz.div_ceil(rayon::current_num_threads().max(1) * 4).max(1);
         let slabs: Vec<Slab> = (0..nz.div_ceil(slab))
             .into_par_iter()
-            .map(|k| self.join_slab(k * slab, ((k + 1) * slab).min(nz)))
-            .collect();
+            .map(|k| self.join_slab(k * slab, ((k + 1) * slab).min(nz), deadline))
+            .collect::<Option<_>>()?;
         let mut parent = Vec::with_capacity(self.segs.len());
         let (mut back, mut across) = (Vec::new(), Vec::new());
         for s in slabs {
@@ -261,11 +271,12 @@ impl Regions {
                 number[root]
             })
             .collect();
-        across
+        Some(across)
     }
 
-    /// The union-find of the segments of planes `z0..z1` alone.
-    fn join_slab(&self, z0: usize, z1: usize) -> Slab {
+    /// The union-find of the segments of planes `z0..z1` alone; `None` when
+    /// `deadline` passes first.
+    fn join_slab(&self, z0: usize, z1: usize, deadline: Option<Instant>) -> Option<Slab> {
         let (s0, s1) = (self.plane_start(z0), self.plane_start(z1));
         let mut slab = Slab {
             first: s0,
@@ -274,13 +285,16 @@ impl Regions {
             across: Vec::new(),
         };
         for z in z0..z1 {
+            if expired(deadline) {
+                return None;
+            }
             self.touching_in(z, |i, j, same_block| match (same_block, j >= s0) {
                 (false, _) => slab.across.push((i as u32, j as u32)),
                 (true, true) => union(&mut slab.parent, (i - s0) as u32, (j - s0) as u32),
                 (true, false) => slab.back.push((i as u32, j as u32)),
             });
         }
-        slab
+        Some(slab)
     }
 
     /// The regions: the connected components of the coarse graph (its nodes are
@@ -306,13 +320,22 @@ impl Regions {
     }
 
     /// The coarse graph: node centres from the segments, edges where segments of two
-    /// nodes touch across a block boundary. Returns the voxels of each node.
-    fn build_coarse(&mut self, field: &DistanceField, across: &[Vec<(u32, u32)>]) -> Vec<f64> {
+    /// nodes touch across a block boundary. Returns the voxels of each node; `None`
+    /// when `deadline` passes first.
+    fn build_coarse(
+        &mut self,
+        field: &DistanceField,
+        across: &[Vec<(u32, u32)>],
+        deadline: Option<Instant>,
+    ) -> Option<Vec<f64>> {
         let nodes = self.node.iter().map(|&k| k as usize + 1).max().unwrap_or(0);
         let mut sum = vec![[0f64; 3]; nodes];
         let mut count = vec![0f64; nodes];
         let [_, ny, nz] = self.dims;
         for z in 0..nz {
+            if expired(deadline) {
+                return None;
+            }
             for y in 0..ny {
                 for i in self.row(y, z) {
                     let [x0, x1] = self.segs[i];
@@ -363,7 +386,7 @@ impl Regions {
             edge_start,
             edges,
         };
-        count
+        Some(count)
     }
 
     /// The segment holding voxel `v` (local indices), when it is relaxed-free.
@@ -488,11 +511,8 @@ mod tests {
     /// nodes, and voxels of one block that touch share a node.
     fn coarse_and_brute_force(g: Grid, radius: f64) -> (Edges, Edges) {
         let field = DistanceField::new(g);
-        let regions = Regions::label(
-            &field,
-            radius,
-            crate::planner::LatticeSettings::default().min_block,
-        );
+        let min_block = crate::planner::LatticeSettings::default().min_block;
+        let regions = Regions::label(&field, radius, min_block, None).expect("no deadline");
         let c = regions.coarse();
         let graph = (0..c.centre.len())
             .flat_map(|a| {

@@ -133,7 +133,7 @@ fn labelled_regions_refuse_a_sealed_wall_and_keep_a_one_voxel_hole() {
     let res = 0.35;
     let (a, b) = ([1.5, 1.5, 1.5], [5.5, 5.5, 1.5]);
     let (c, lat) = walled(res, [20, 20, 10], 10..11, [0..0, 0..0]);
-    match lat.separation(c.field(), a, b) {
+    match lat.separation(c.field(), a, b, None) {
         Some(LatticeOutcome::Separated {
             side, size, unit, ..
         }) => {
@@ -144,7 +144,26 @@ fn labelled_regions_refuse_a_sealed_wall_and_keep_a_one_voxel_hole() {
         other => panic!("not separated: {other:?}"),
     }
     let (c, lat) = walled(res, [20, 20, 10], 10..11, [10..11, 5..6]);
-    assert_eq!(lat.separation(c.field(), a, b), None);
+    assert_eq!(lat.separation(c.field(), a, b, None), None);
+}
+
+#[test]
+fn regions_not_labelled_by_the_deadline_prove_nothing_and_are_labelled_later() {
+    let (a, b) = ([1.5, 1.5, 1.5], [5.5, 5.5, 1.5]);
+    let (c, lat) = walled(0.35, [20, 20, 10], 10..11, [0..0, 0..0]);
+    let passed = Some(std::time::Instant::now());
+    assert!(lat.regions(c.field(), passed).is_none());
+    assert_eq!(lat.separation(c.field(), a, b, passed), None);
+    assert_eq!(
+        lat.guided_route(&c, a, b, usize::MAX, passed),
+        LatticeOutcome::Budget
+    );
+    assert!(matches!(
+        lat.separation(c.field(), a, b, None),
+        Some(LatticeOutcome::Separated { .. })
+    ));
+    // Once labelled, a deadline no longer matters.
+    assert!(lat.regions(c.field(), passed).is_some());
 }
 
 #[test]
@@ -156,7 +175,13 @@ fn the_coarse_guide_leads_through_the_door_not_the_wall() {
     let mut nodes = Nodes::new(&lat, c.field());
     let starts = lat.anchors(&mut nodes, a, 1);
     let goals = lat.anchors(&mut nodes, b, 1);
-    let guide = super::guide::Guide::new(&lat, lat.regions(c.field()), &starts, &goals, b);
+    let guide = super::guide::Guide::new(
+        &lat,
+        lat.regions(c.field(), None).unwrap(),
+        &starts,
+        &goals,
+        b,
+    );
     let door = [2.1, 3.3, 1.0];
     let around = dist(a, door) + dist(door, b);
     let h = guide.estimate(starts[0], lat.point(starts[0]));
@@ -236,7 +261,7 @@ proptest! {
         let (a, b) = (pick(&mut rng), pick(&mut rng));
         let reference = flood_connects(&lat, &c, a, b);
         // The labelled regions only ever prove what the flood confirms.
-        if let Some(sep) = lat.separation(c.field(), a, b) {
+        if let Some(sep) = lat.separation(c.field(), a, b, None) {
             prop_assert_eq!(reference, Some(false), "regions said {:?}", sep);
         }
         let got = lat.route(&c, a, b);

@@ -34,6 +34,14 @@ pub enum StudyError {
         /// Why (the core's errors are `no_std`: no `std::error::Error` source).
         why: ParamError,
     },
+    /// Shape tables that cannot be built for a chain.
+    #[error("shape tables of N = {units}: {why}")]
+    Tables {
+        /// The chain size.
+        units: u8,
+        /// Why.
+        why: String,
+    },
     /// A collision context that cannot be made.
     #[error(transparent)]
     Context(#[from] ContextError),
@@ -71,6 +79,7 @@ impl StudyError {
             | StudyError::WideWindow { .. }
             | StudyError::NotBuilt(_)
             | StudyError::Chain { .. }
+            | StudyError::Tables { .. }
             | StudyError::Context(_)
             | StudyError::NoFittingStart { .. }
             | StudyError::ThreadPool(_)

@@ -18,6 +18,7 @@
 
 mod error;
 pub mod flight;
+pub mod limit;
 pub mod online;
 pub mod paper;
 pub mod plot;
