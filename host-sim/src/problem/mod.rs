@@ -39,7 +39,7 @@ pub enum ProblemError {
         value: String,
     },
     /// A `passage:` key that the family does not have.
-    #[error("unknown key {0:?}; known: w, angle, offset, wall, door, door_offset, res, sealed")]
+    #[error("unknown key {0:?}; known: w, angle, offset, wall, door, door_offset, res, sealed, slit, slits")]
     UnknownKey(String),
     /// A parameter outside its range.
     #[error("{name} = {value} is outside {lo}..={hi}")]

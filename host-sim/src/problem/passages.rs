@@ -14,6 +14,12 @@
 //! | `door_offset` | 0 | door centre off the room's axis (m), -0.4 to 0.4 |
 //! | `res` | 0.05 | map resolution (m), 0.025 to 0.1 |
 //! | `sealed` | 0 | 1: the window is walled up (no way through; for failure reports) |
+//! | `slit` | none | width (m) of slits that replace the window, 0.05 to 0.3, widened to whole voxels: vertical, 1.5 m tall, [`SLIT_PITCH`] apart, centred on the window's place |
+//! | `slits` | 3 | how many slits, 1 to 5 (with `slit`) |
+//!
+//! Slits narrower than a unit (`slit` below `2 r_u`) leave a way through for a point
+//! but none for the chain: they are the stand-ins for the gaps of real scans that
+//! `arc plan` must refuse, quickly.
 //!
 //! Every instance carries a hand-made centre line ([`Scenario::route`]): straight in
 //! along the approach, a turn 1 m before the wall onto its normal, straight through the
@@ -43,6 +49,8 @@ pub struct PassageSpec {
     pub res: f64,
     /// The window is walled up: start and goal in separate free regions.
     pub sealed: bool,
+    /// Slits in place of the window: their width (m) and count.
+    pub slits: Option<(f64, u32)>,
 }
 
 impl Default for PassageSpec {
@@ -55,6 +63,7 @@ impl Default for PassageSpec {
             door: None,
             res: 0.05,
             sealed: false,
+            slits: None,
         }
     }
 }
@@ -70,6 +79,10 @@ const WALL_X: f64 = 6.0;
 const WALL_GAP: f64 = 2.5;
 /// Height of the window's centre (m): half way up the room.
 const Z_C: f64 = ROOM_Z / 2.0;
+/// Distance between neighbouring slits' centres (m).
+pub const SLIT_PITCH: f64 = 0.6;
+/// Height of a slit (m).
+const SLIT_HEIGHT: f64 = 1.5;
 
 impl PassageSpec {
     /// Parses `KEY=VALUE,...` (see the module docs).
@@ -77,6 +90,7 @@ impl PassageSpec {
         let mut s = Self::default();
         let mut door_offset = 0.0;
         let mut door = None;
+        let (mut slit, mut slits) = (None, 3.0);
         for part in text.split(',').filter(|p| !p.trim().is_empty()) {
             let (k, v) = part
                 .split_once('=')
@@ -94,10 +108,23 @@ impl PassageSpec {
                 "door_offset" => door_offset = v,
                 "res" => s.res = v,
                 "sealed" => s.sealed = v != 0.0,
+                "slit" => slit = Some(v),
+                "slits" => slits = v,
                 other => return Err(ProblemError::UnknownKey(other.into())),
             }
         }
         s.door = door.map(|d| (d, door_offset));
+        if let Some(w) = slit {
+            if !(slits.fract() == 0.0 && (1.0..=5.0).contains(&slits)) {
+                return Err(ProblemError::OutOfRange {
+                    name: "slits",
+                    value: slits,
+                    lo: 1.0,
+                    hi: 5.0,
+                });
+            }
+            s.slits = Some((w, slits as u32));
+        }
         s.check()?;
         Ok(s)
     }
@@ -125,6 +152,10 @@ impl PassageSpec {
             within("door", d, 0.4, 1.0)?;
             within("door_offset", o, -0.4, 0.4)?;
         }
+        if let Some((w, k)) = self.slits {
+            within("slit", w, 0.05, 0.3)?;
+            within("slits", k as f64, 1.0, 5.0)?;
+        }
         Ok(())
     }
 
@@ -142,6 +173,9 @@ impl PassageSpec {
         }
         if self.sealed {
             n += ",sealed=1";
+        }
+        if let Some((w, k)) = self.slits {
+            n += &format!(",slit={w},slits={k}");
         }
         n
     }
@@ -169,6 +203,7 @@ impl PassageSpec {
             door,
             res: 0.05,
             sealed: false,
+            slits: None,
         }
     }
 
@@ -199,6 +234,7 @@ impl PassageSpec {
             window_y: (down(yc - hw), up(yc + hw)),
             window_z: (down(Z_C - hw), up(Z_C + hw)),
             door,
+            slits: self.slits,
         }
     }
 
@@ -230,6 +266,10 @@ impl PassageSpec {
             goal = [d.x + 0.2 + 1.5, yd, zc];
         }
         route.push(goal);
+        let slit_text = match self.slits {
+            Some((w, k)) => format!(" (in its place {k} slits {w} m wide, {SLIT_HEIGHT} m tall)"),
+            None => String::new(),
+        };
         let door_text = match self.door {
             Some((d, o)) => format!(
                 ", then a second wall {WALL_GAP} m behind it with a door {d} m wide ({o:+} m off the axis)"
@@ -239,7 +279,7 @@ impl PassageSpec {
         Ok(Scenario {
             name: self.name(),
             description: format!(
-                "A room at {r} m with a {t} m wall holding a {w} m x {w} m window (a tunnel when the wall is thick) {off:+} m off the \
+                "A room at {r} m with a {t} m wall holding a {w} m x {w} m window{slit_text} (a tunnel when the wall is thick) {off:+} m off the \
                  axis, approached at {ang} degrees off its normal{door_text}.",
                 t = lay.t,
                 w = self.w,
@@ -268,9 +308,13 @@ impl PassageSpec {
         let mut walls = Vec::new();
         let mut grid = empty()?;
         lay.first_wall(&mut grid, self.sealed);
-        let window = (lay.window_y.1 - lay.window_y.0).min(lay.window_z.1 - lay.window_z.0);
+        let window = lay
+            .openings(r)
+            .iter()
+            .map(|(y, z)| (y.1 - y.0).min(z.1 - z.0))
+            .fold(f64::INFINITY, f64::min);
         walls.push(OpeningWall {
-            name: "window",
+            name: if self.slits.is_some() { "slits" } else { "window" },
             grid,
             width: window,
         });
@@ -290,7 +334,7 @@ impl PassageSpec {
 /// One opening of an instance and the wall that holds it, alone on a map.
 #[derive(Clone, Debug)]
 pub struct OpeningWall {
-    /// `window` or `door`.
+    /// `window`, `slits` or `door`.
     pub name: &'static str,
     /// A map of the instance's room holding only this wall.
     pub grid: Grid,
@@ -310,6 +354,8 @@ struct Layout {
     window_z: (f64, f64),
     /// The second wall, when there is one.
     door: Option<Door>,
+    /// Slits in place of the window: width (m) and count.
+    slits: Option<(f64, u32)>,
 }
 
 impl Layout {
@@ -324,7 +370,7 @@ impl Layout {
         )
     }
 
-    /// Puts the first wall into `g`, with its window unless `sealed`.
+    /// Puts the first wall into `g`, with its window (or its slits) unless `sealed`.
     fn first_wall(&self, g: &mut Grid, sealed: bool) {
         let size = self.size(g.resolution());
         let x1 = WALL_X + self.t;
@@ -334,10 +380,34 @@ impl Layout {
             [x1, size[1], size[2]],
             Cell::Occupied,
         );
-        if !sealed {
-            let (y, z) = (self.window_y, self.window_z);
+        if sealed {
+            return;
+        }
+        for (y, z) in self.openings(g.resolution()) {
             fill(g, [WALL_X, y.0, z.0], [x1, y.1, z.1], Cell::Free);
         }
+    }
+
+    /// The first wall's openings, their faces across the room (y) and in height (z):
+    /// the window, or the slits in its place.
+    fn openings(&self, r: f64) -> Vec<((f64, f64), (f64, f64))> {
+        let Some((w, k)) = self.slits else {
+            return vec![(self.window_y, self.window_z)];
+        };
+        // The fewest whole voxels at least `w` wide, on the lattice nearest the centre.
+        let voxels = (w / r - 1e-6).ceil();
+        let span = |c: f64, v: f64| {
+            let lo = ((c - v * r / 2.0) / r).round() * r;
+            (lo, lo + v * r)
+        };
+        let (yc, _) = self.window_centre();
+        let z = span(Z_C, (SLIT_HEIGHT / r).round());
+        (0..k)
+            .map(|i| {
+                let c = yc + (i as f64 - (k - 1) as f64 / 2.0) * SLIT_PITCH;
+                (span(c, voxels), z)
+            })
+            .collect()
     }
 }
 
@@ -384,6 +454,29 @@ mod tests {
         assert!(PassageSpec::parse("angle=80").is_err());
         assert!(PassageSpec::parse("nope=1").is_err());
         assert!(PassageSpec::parse("w").is_err());
+    }
+
+    #[test]
+    fn slits_replace_the_window_whole_voxels_wide() {
+        let s = PassageSpec::parse("slit=0.2,slits=3,res=0.087").unwrap();
+        assert_eq!(s.slits, Some((0.2, 3)));
+        assert_eq!(PassageSpec::parse(&s.name()["passage:".len()..]).unwrap(), s);
+        assert!(PassageSpec::parse("slit=0.2,slits=6").is_err());
+        assert!(PassageSpec::parse("slit=0.2,slits=1.5").is_err());
+        assert!(PassageSpec::parse("slit=0.4").is_err());
+        let sc = s.build().unwrap();
+        let (g, x) = (&sc.grid, WALL_X + 0.1);
+        let y = ROOM_Y / 2.0;
+        // The window's place is a slit; beside it, wall; a pitch on, the next slit.
+        assert!(!g.is_obstacle_at([x, y, Z_C]));
+        assert!(g.is_obstacle_at([x, y + 0.3, Z_C]));
+        assert!(!g.is_obstacle_at([x, y + SLIT_PITCH, Z_C]));
+        assert!(!g.is_obstacle_at([x, y - SLIT_PITCH, Z_C]));
+        assert!(g.is_obstacle_at([x, y + 2.0 * SLIT_PITCH, Z_C]));
+        // Three voxels of 0.087 m: the smallest whole number at least 0.2 m wide.
+        let walls = s.opening_walls().unwrap();
+        assert_eq!(walls[0].name, "slits");
+        assert!((walls[0].width - 3.0 * 0.087).abs() < 1e-9, "{}", walls[0].width);
     }
 
     #[test]

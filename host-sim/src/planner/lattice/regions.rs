@@ -11,7 +11,15 @@
 //! `c`. A lattice point `p` free for the sphere (distance `d(p) > R` to every obstacle
 //! cube) therefore lies in a voxel that
 //! - is not itself an obstacle (else `d(p) = 0`), and
-//! - has `d(c) > R - r sqrt(3) / 2` (the distance is 1-Lipschitz).
+//! - has `d(c) > R - r sqrt(3) / 2` (the distance is 1-Lipschitz), and
+//! - lies in no gap of fewer than `2R / r` voxels between two obstacle voxels along
+//!   an axis: the line through `p` along that axis meets both obstacle cubes (they
+//!   share the voxel's extent across the axis), so `d(p)` is at most half the gap.
+//!
+//! The last rule closes the slits a unit cannot pass (a gap of 0.25 m at 0.1 m holds
+//! voxel centres 0.125 m from both sides, which the second rule alone cannot rule
+//! out for a sphere of 0.15 m); it is asked only of voxels whose field bound is
+//! below `R`, the band where the second rule may be loose.
 //!
 //! The labelling only ever needs MORE free voxels than that (more voxels can only
 //! join regions), so it needs no exact measure: a voxel counts as relaxed-free when it
@@ -48,6 +56,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::map::distance::DistanceField;
+use crate::map::grid::Grid;
 use crate::planner::expired;
 
 /// Allowance for rounding in the relaxed test (m): relaxing further is always safe.
@@ -120,7 +129,6 @@ impl Regions {
         let g = field.grid();
         let dims = g.dims();
         let r = g.resolution();
-        let threshold = radius - r * 3f64.sqrt() / 2.0 - ROUND_EPS;
         let volume: f64 = dims.iter().map(|&d| d as f64 * r).product();
         let block_m = min_block.max((volume / MAX_BLOCKS).cbrt());
         let block = ((block_m / r).round() as u32).max(1);
@@ -128,7 +136,7 @@ impl Regions {
         let slabs: Vec<Vec<Vec<[u32; 2]>>> = (0..dims[2])
             .into_par_iter()
             .map(|z| {
-                let plane = (0..dims[1]).map(|y| cut(row_runs(field, [y, z], threshold), block));
+                let plane = (0..dims[1]).map(|y| cut(row_runs(field, [y, z], radius), block));
                 (!expired(deadline)).then(|| plane.collect())
             })
             .collect::<Option<_>>()?;
@@ -448,18 +456,27 @@ fn same_x_block(a: [u32; 2], b: [u32; 2], block: u32) -> bool {
     start <= end || end / block == start / block
 }
 
-/// The relaxed-free runs of row `(y, z)` (see the module docs).
-fn row_runs(field: &DistanceField, [y, z]: [usize; 2], threshold: f64) -> Vec<[u32; 2]> {
+/// The relaxed-free runs of row `(y, z)` for a sphere of radius `radius` (see the
+/// module docs).
+fn row_runs(field: &DistanceField, [y, z]: [usize; 2], radius: f64) -> Vec<[u32; 2]> {
     let g = field.grid();
     let r = g.resolution();
+    let threshold = radius - r * 3f64.sqrt() / 2.0 - ROUND_EPS;
     // The field's bound is at most r (sqrt(3) - 1) / 2 below the true distance of a
     // centre (see the module docs): a voxel it cannot rule out counts as free.
     let bar = (threshold - r * (3f64.sqrt() - 1.0) / 2.0 - ROUND_EPS) as f32;
+    // A voxel whose centre may lie closer than the radius is checked for a gap
+    // too narrow along an axis; one whose centre is surely far enough never is.
+    let sure = radius as f32;
+    let need = gap_voxels(radius, r);
+    let origin = g.origin();
     let mut runs = Vec::new();
     let mut open: Option<u32> = None;
     let row = g.obstacle_row(y, z).zip(field.row_bounds(y, z));
     for (x, (obstacle, &lb)) in row.enumerate() {
-        let free = !obstacle && lb > bar;
+        let at = [x, y, z].map(|v| v as i32);
+        let at = [0, 1, 2].map(|a| origin[a] + at[a]);
+        let free = !obstacle && lb > bar && (lb >= sure || !too_narrow(g, at, need));
         match (free, open) {
             (true, None) => open = Some(x as u32),
             (false, Some(x0)) => {
@@ -473,6 +490,36 @@ fn row_runs(field: &DistanceField, [y, z]: [usize; 2], threshold: f64) -> Vec<[u
         runs.push([x0, g.dims()[0] as u32 - 1]);
     }
     runs
+}
+
+/// The fewest voxels in a row, between two obstacle voxels, that can hold a centre
+/// at distance `radius` or more from both: the gap must be wider than `2 radius`
+/// (rounded toward keeping the gap, so that no gap is closed by rounding).
+fn gap_voxels(radius: f64, r: f64) -> i32 {
+    ((2.0 * radius - ROUND_EPS) / r).ceil().max(1.0) as i32
+}
+
+/// Whether voxel `at` (lattice indices) lies in a gap fewer than `need` voxels long
+/// between two obstacle voxels along some axis (see the module docs: no centre in
+/// it is far enough from both).
+fn too_narrow(g: &Grid, at: [i32; 3], need: i32) -> bool {
+    (0..3).any(|axis| {
+        let mut len = 1;
+        for dir in [-1, 1] {
+            let mut i = at;
+            loop {
+                i[axis] += dir;
+                if g.is_obstacle(i) {
+                    break;
+                }
+                len += 1;
+                if len >= need {
+                    return false;
+                }
+            }
+        }
+        true
+    })
 }
 
 /// The root of `i`, halving the path on the way.
@@ -579,7 +626,9 @@ mod tests {
                 }
             }
             let (graph, brute) = coarse_and_brute_force(g, radius);
-            prop_assert!(!brute.is_empty());
+            // A dense map can leave no gap wide enough for the sphere: nothing to
+            // compare; proptest draws another (and fails if it must draw too often).
+            prop_assume!(!brute.is_empty());
             prop_assert!(graph.is_subset(&brute), "{:?}", graph.difference(&brute));
             let next = |a: u32| graph.range((a, 0)..(a + 1, 0)).map(|&(_, b)| b);
             for &(a, b) in brute.difference(&graph) {

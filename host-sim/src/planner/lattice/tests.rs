@@ -148,6 +148,28 @@ fn labelled_regions_refuse_a_sealed_wall_and_keep_a_one_voxel_hole() {
 }
 
 #[test]
+fn labelled_regions_close_a_slit_narrower_than_the_sphere_and_keep_a_wider_one() {
+    // A 0.2 m wall across x at 2.0-2.2 m; the only opening a slit 1.4 m tall. Two
+    // voxels (0.2 m) hold centres 0.05 m from each side: the field's bound alone
+    // cannot close it for a sphere of 0.15 m; the gap along y can.
+    let (a, b) = ([1.0, 1.0, 1.0], [3.2, 1.0, 1.0]);
+    let (c, lat) = walled(0.1, [40, 40, 20], 20..22, [30..32, 1..15]);
+    assert!(matches!(
+        lat.separation(c.field(), a, b, None),
+        Some(LatticeOutcome::Separated { unit: "voxels", .. })
+    ));
+    // The lattice's own flood agrees.
+    assert!(matches!(
+        lat.route(&c, a, b),
+        LatticeOutcome::Separated { .. }
+    ));
+    // Four voxels (0.4 m) leave room for the sphere: no proof, and a route.
+    let (c, lat) = walled(0.1, [40, 40, 20], 20..22, [30..34, 1..15]);
+    assert_eq!(lat.separation(c.field(), a, b, None), None);
+    assert!(matches!(lat.route(&c, a, b), LatticeOutcome::Found(_)));
+}
+
+#[test]
 fn regions_not_labelled_by_the_deadline_prove_nothing_and_are_labelled_later() {
     let (a, b) = ([1.5, 1.5, 1.5], [5.5, 5.5, 1.5]);
     let (c, lat) = walled(0.35, [20, 20, 10], 10..11, [0..0, 0..0]);
