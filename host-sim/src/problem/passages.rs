@@ -314,7 +314,11 @@ impl PassageSpec {
             .map(|(y, z)| (y.1 - y.0).min(z.1 - z.0))
             .fold(f64::INFINITY, f64::min);
         walls.push(OpeningWall {
-            name: if self.slits.is_some() { "slits" } else { "window" },
+            name: if self.slits.is_some() {
+                "slits"
+            } else {
+                "window"
+            },
             grid,
             width: window,
         });
@@ -460,7 +464,10 @@ mod tests {
     fn slits_replace_the_window_whole_voxels_wide() {
         let s = PassageSpec::parse("slit=0.2,slits=3,res=0.087").unwrap();
         assert_eq!(s.slits, Some((0.2, 3)));
-        assert_eq!(PassageSpec::parse(&s.name()["passage:".len()..]).unwrap(), s);
+        assert_eq!(
+            PassageSpec::parse(&s.name()["passage:".len()..]).unwrap(),
+            s
+        );
         assert!(PassageSpec::parse("slit=0.2,slits=6").is_err());
         assert!(PassageSpec::parse("slit=0.2,slits=1.5").is_err());
         assert!(PassageSpec::parse("slit=0.4").is_err());
@@ -476,7 +483,11 @@ mod tests {
         // Three voxels of 0.087 m: the smallest whole number at least 0.2 m wide.
         let walls = s.opening_walls().unwrap();
         assert_eq!(walls[0].name, "slits");
-        assert!((walls[0].width - 3.0 * 0.087).abs() < 1e-9, "{}", walls[0].width);
+        assert!(
+            (walls[0].width - 3.0 * 0.087).abs() < 1e-9,
+            "{}",
+            walls[0].width
+        );
     }
 
     #[test]

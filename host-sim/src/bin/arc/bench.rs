@@ -46,6 +46,11 @@ pub enum BenchCommand {
     /// default; time after setup against 1.1 T + 50 ms; CSV and markdown.
     #[command(after_help = "Example:\n  arc bench limit --robust 50 --out-dir docs/bench")]
     Limit(LimitArgs),
+    /// Refusals: slits narrower than a unit and sealed windows at 0.025-0.1 m, and the
+    /// large maps with their goals walled in, N = 4, 6, 8, `arc plan`'s defaults; time
+    /// after setup against 1 s; CSV and markdown.
+    #[command(after_help = "Example:\n  arc bench refuse --out-dir docs/bench")]
+    Refuse(RefuseArgs),
     /// One plan by the full-state lazy PRM baseline (arc-plan/1, verified exactly).
     #[command(
         after_help = "Example:\n  arc bench prm --scenario window --units 4 --vertices 15000 --out prm.json"
@@ -192,6 +197,14 @@ pub struct OnlineArgs {
     #[arg(long, default_value_t = 600.0)]
     time_limit: f64,
     /// Where CSV, markdown and the plot go.
+    #[arg(long, default_value = "bench-out")]
+    out_dir: PathBuf,
+}
+
+/// `arc bench refuse`
+#[derive(Args, Debug)]
+pub struct RefuseArgs {
+    /// Where CSV and markdown go.
     #[arg(long, default_value = "bench-out")]
     out_dir: PathBuf,
 }
@@ -609,6 +622,31 @@ fn run_flight(a: FlightArgs) -> CliResult {
     Ok(())
 }
 
+fn run_refuse(a: RefuseArgs) -> CliResult {
+    let began = Instant::now();
+    let runs = study::refuse::run()?;
+    let md =
+        format!(
+        "{}\n`arc plan`'s defaults through the library's facade; {} build; whole study {:.0} s.\n",
+        study::refuse::markdown(&runs),
+        if cfg!(debug_assertions) { "debug" } else { "release" },
+        began.elapsed().as_secs_f64()
+    );
+    let files = [
+        study::write_out(
+            &a.out_dir,
+            "refuse_runs.csv",
+            study::refuse::csv(&runs).as_bytes(),
+        )?,
+        study::write_out(&a.out_dir, "refuse.md", md.as_bytes())?,
+    ];
+    println!("{md}");
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
 fn run_limit(a: LimitArgs) -> CliResult {
     for &t in &a.limits_ms {
         if !(t > 0.0 && t <= 1e6) {
@@ -801,6 +839,7 @@ pub fn run(c: BenchCommand) -> CliResult {
         BenchCommand::Flight(a) => run_flight(a),
         BenchCommand::Online(a) => run_online(a),
         BenchCommand::Limit(a) => run_limit(a),
+        BenchCommand::Refuse(a) => run_refuse(a),
         BenchCommand::Prm(a) => run_prm(*a),
     }
 }

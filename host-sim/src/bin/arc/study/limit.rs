@@ -91,23 +91,47 @@ fn one(name: &str, request: &Request, tables: &ShapeTables, limit_s: f64) -> Lim
         trajectory: Some(Default::default()),
         ..PlanOptions::default()
     };
-    let began = Instant::now();
-    let result = planning::plan(request, Some(tables.clone()), &options);
-    let wall = began.elapsed().as_secs_f64();
-    let (setup_s, outcome, cut_short) = match &result {
-        Ok(p) => {
-            let cut = matches!(&p.trajectory, Some(Ok(t)) if t.cut_short());
-            (p.timings.setup_s, "plan".to_string(), cut)
-        }
-        Err(PlanningError::NoPlan(np)) => (np.setup_s, "no plan".to_string(), false),
-        Err(e) => (0.0, e.to_string(), false),
-    };
+    let t = timed(request, tables, &options);
     LimitRun {
         scenario: name.to_string(),
         units: request.params.units,
         limit_s,
+        after_setup_s: t.after_setup_s,
+        outcome: t.outcome,
+        cut_short: t.cut_short,
+    }
+}
+
+/// One query through the facade, timed after its setup.
+pub struct Timed {
+    /// Wall time after setup (s).
+    pub after_setup_s: f64,
+    /// `plan`, `no plan` or the error's text.
+    pub outcome: String,
+    /// Why there is no plan (the message `arc plan` prints), or empty.
+    pub why: String,
+    /// The trajectory's blending rounds were stopped by the limit.
+    pub cut_short: bool,
+}
+
+/// `request` planned through the facade with `tables` and `options`, the time after
+/// the facade's own setup measured.
+pub fn timed(request: &Request, tables: &ShapeTables, options: &PlanOptions) -> Timed {
+    let began = Instant::now();
+    let result = planning::plan(request, Some(tables.clone()), options);
+    let wall = began.elapsed().as_secs_f64();
+    let (setup_s, outcome, why, cut_short) = match &result {
+        Ok(p) => {
+            let cut = matches!(&p.trajectory, Some(Ok(t)) if t.cut_short());
+            (p.timings.setup_s, "plan".into(), String::new(), cut)
+        }
+        Err(PlanningError::NoPlan(np)) => (np.setup_s, "no plan".into(), np.to_string(), false),
+        Err(e) => (0.0, e.to_string(), e.to_string(), false),
+    };
+    Timed {
         after_setup_s: wall - setup_s,
         outcome,
+        why,
         cut_short,
     }
 }

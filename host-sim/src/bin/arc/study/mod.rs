@@ -22,6 +22,7 @@ pub mod limit;
 pub mod online;
 pub mod paper;
 pub mod plot;
+pub mod refuse;
 mod report;
 pub mod robust;
 pub mod scale;
