@@ -405,3 +405,40 @@ fn refined_plans_verify_and_ask_less_of_the_chain() {
         );
     }
 }
+
+/// `arc plan` says where its time went, phase by phase, the trajectory included.
+#[test]
+fn arc_plan_reports_every_phase() {
+    let dir = tmp();
+    let o = support::run(
+        &[
+            "plan",
+            "--scenario",
+            "window",
+            "-n",
+            "4",
+            "--out",
+            "p.json",
+            "--trajectory",
+            "t.json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(o.code, Some(0), "{o:?}");
+    let line = o
+        .stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("phases: "))
+        .unwrap_or_else(|| panic!("no phases line: {}", o.stdout));
+    for phase in [
+        "setup",
+        "free regions",
+        "head roadmap",
+        "head route (lattice)",
+        "shape search",
+        "post-processing",
+        "trajectory",
+    ] {
+        assert!(line.contains(&format!("{phase} ")), "{phase}: {line}");
+    }
+}

@@ -353,6 +353,32 @@ fn options(a: &PlanArgs, file: Option<&Loaded>, given: &Given) -> Result<PlanOpt
     })
 }
 
+/// Where the time of `planned` went, phase by phase (ms), after `setup_s` of setup:
+/// the search's structures and its two searches (the head's route over the lattice,
+/// the chain's shapes along it), then post-processing and the trajectory.
+fn phases(setup_s: f64, planned: &planning::Planned) -> String {
+    let (s, t) = (&planned.stats, &planned.timings);
+    let mut parts = vec![
+        ("setup", setup_s),
+        ("free regions", s.regions_s),
+        ("head roadmap", (s.timings.roadmap_s - s.regions_s).max(0.0)),
+        ("head route (lattice)", s.lattice_s),
+        (
+            "shape search",
+            (s.timings.planning_s - s.lattice_s).max(0.0),
+        ),
+        ("post-processing", t.post_s),
+    ];
+    if planned.trajectory.is_some() {
+        parts.push(("trajectory", t.trajectory_s));
+    }
+    let parts: Vec<String> = parts
+        .iter()
+        .map(|(name, v)| format!("{name} {:.1} ms", v * 1e3))
+        .collect();
+    parts.join(", ")
+}
+
 /// How the plan is timed, by the rule of [`options`]: the timing flags where given,
 /// else the file's trajectory section where it sets a value, else the flags' defaults
 /// (the blending tuning, which has no flag: the file's or the default).
@@ -438,6 +464,7 @@ pub fn run(a: PlanArgs, given: &Given) -> CliResult {
         s.timings.collision_s * 1e3,
         s.collision_checks
     ));
+    report.line(format_args!("  phases: {}", phases(setup_s, &planned)));
     print_quality(&report, &planned.quality, planned.refinement.as_ref());
     match s.min_margin_at {
         Some(p) => report.line(format_args!(
