@@ -1,11 +1,12 @@
 //! Problems to plan for: the built-in scenarios (the paper's rooms and more) and the
-//! parametric family of hard cases (`passage:`), each a map with a start, a goal and a
+//! parametric families (hard cases `passage:`, `forest:` and `slot:`), each a map with a start, a goal and a
 //! hand-made route that shows the problem can be solved.
 //!
 //! This layer sits above the map and collision layers (a scenario is a grid; the
 //! reason a witness fails is the exact verifier's) and below plan files: the witness
 //! plan itself is made in `crate::witness`.
 
+pub mod families;
 pub mod large;
 pub mod passages;
 pub mod scenarios;
@@ -17,7 +18,7 @@ use crate::collision::verify::PlanViolation;
 pub enum ProblemError {
     /// A name that is no built-in scenario.
     #[error(
-        "unknown scenario {0:?}; known: {known}, corridor:LENGTH, passage:KEY=VALUE,..., campus[:RES], hall[:RES]",
+        "unknown scenario {0:?}; known: {known}, corridor:LENGTH, passage:KEY=VALUE,..., forest:KEY=VALUE,..., slot:KEY=VALUE,..., campus[:RES], hall[:RES]",
         known = scenarios::NAMES.join(", ")
     )]
     UnknownScenario(String),
@@ -38,8 +39,8 @@ pub enum ProblemError {
         /// The value as written.
         value: String,
     },
-    /// A `passage:` key that the family does not have.
-    #[error("unknown key {0:?}; known: w, angle, offset, wall, door, door_offset, res, sealed, slit, slits")]
+    /// A key that the family does not have.
+    #[error("unknown key {0:?}; known: w, angle, offset, wall, door, door_offset, res, sealed, slit, slits (passage:), spacing, seed, res (forest:), tilt, angle, res (slot:)")]
     UnknownKey(String),
     /// A parameter outside its range.
     #[error("{name} = {value} is outside {lo}..={hi}")]

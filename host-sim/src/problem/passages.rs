@@ -27,6 +27,7 @@
 //! follow-the-leader fashion, and the exact verifier checks the result: an instance
 //! with a witness is solvable, whatever the planner does.
 
+use super::families::{key_values, within};
 use super::scenarios::fill;
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
@@ -91,15 +92,8 @@ impl PassageSpec {
         let mut door_offset = 0.0;
         let mut door = None;
         let (mut slit, mut slits) = (None, 3.0);
-        for part in text.split(',').filter(|p| !p.trim().is_empty()) {
-            let (k, v) = part
-                .split_once('=')
-                .ok_or_else(|| ProblemError::ExpectedKeyValue(part.into()))?;
-            let v: f64 = v.trim().parse().map_err(|_| ProblemError::NotANumber {
-                part: part.into(),
-                value: v.into(),
-            })?;
-            match k.trim() {
+        for (k, v) in key_values(text)? {
+            match k.as_str() {
                 "w" => s.w = v,
                 "angle" => s.angle_deg = v,
                 "offset" => s.offset = v,
@@ -110,17 +104,16 @@ impl PassageSpec {
                 "sealed" => s.sealed = v != 0.0,
                 "slit" => slit = Some(v),
                 "slits" => slits = v,
-                other => return Err(ProblemError::UnknownKey(other.into())),
+                _ => return Err(ProblemError::UnknownKey(k)),
             }
         }
         s.door = door.map(|d| (d, door_offset));
         if let Some(w) = slit {
-            if !(slits.fract() == 0.0 && (1.0..=5.0).contains(&slits)) {
-                return Err(ProblemError::OutOfRange {
-                    name: "slits",
-                    value: slits,
-                    lo: 1.0,
-                    hi: 5.0,
+            within("slits", slits, 1.0, 5.0)?;
+            if slits.fract() != 0.0 {
+                return Err(ProblemError::NotANumber {
+                    part: format!("slits={slits}"),
+                    value: slits.to_string(),
                 });
             }
             s.slits = Some((w, slits as u32));
@@ -131,18 +124,6 @@ impl PassageSpec {
 
     /// Checks the ranges of the module docs.
     pub fn check(&self) -> Result<(), ProblemError> {
-        let within = |name: &'static str, value: f64, lo: f64, hi: f64| {
-            if value.is_finite() && (lo..=hi).contains(&value) {
-                Ok(())
-            } else {
-                Err(ProblemError::OutOfRange {
-                    name,
-                    value,
-                    lo,
-                    hi,
-                })
-            }
-        };
         within("w", self.w, 0.4, 1.0)?;
         within("angle", self.angle_deg, -60.0, 60.0)?;
         within("offset", self.offset, -0.4, 0.4)?;

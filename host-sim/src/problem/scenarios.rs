@@ -86,6 +86,10 @@ pub fn build(name: &str) -> Result<Scenario, ProblemError> {
                 large
             } else if let Some(spec) = name.strip_prefix("passage:") {
                 super::passages::PassageSpec::parse(spec)?.build()
+            } else if let Some(spec) = name.strip_prefix("forest:") {
+                super::families::ForestSpec::parse(spec)?.build()
+            } else if let Some(spec) = name.strip_prefix("slot:") {
+                super::families::SlotSpec::parse(spec)?.build()
             } else if let Some(len) = name.strip_prefix("corridor:") {
                 let l: f64 = len
                     .parse()

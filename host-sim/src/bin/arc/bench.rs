@@ -51,6 +51,11 @@ pub enum BenchCommand {
     /// after setup against 1 s; CSV and markdown.
     #[command(after_help = "Example:\n  arc bench refuse --out-dir docs/bench")]
     Refuse(RefuseArgs),
+    /// The forest and tilted-slot families (`forest:`, `slot:`): random instances,
+    /// forests at N = 5..8, slots at N = 4..6, `arc plan`'s defaults; plans verified,
+    /// query time after setup; CSV and markdown.
+    #[command(after_help = "Example:\n  arc bench families --instances 12 --out-dir docs/bench")]
+    Families(FamiliesArgs),
     /// One plan by the full-state lazy PRM baseline (arc-plan/1, verified exactly).
     #[command(
         after_help = "Example:\n  arc bench prm --scenario window --units 4 --vertices 15000 --out prm.json"
@@ -197,6 +202,20 @@ pub struct OnlineArgs {
     #[arg(long, default_value_t = 600.0)]
     time_limit: f64,
     /// Where CSV, markdown and the plot go.
+    #[arg(long, default_value = "bench-out")]
+    out_dir: PathBuf,
+}
+
+/// `arc bench families`
+#[derive(Args, Debug)]
+pub struct FamiliesArgs {
+    /// Instances of each family, 1 to 1000.
+    #[arg(long, default_value_t = 12)]
+    instances: usize,
+    /// Seed of the instance generator.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Where CSV and markdown go.
     #[arg(long, default_value = "bench-out")]
     out_dir: PathBuf,
 }
@@ -622,6 +641,36 @@ fn run_flight(a: FlightArgs) -> CliResult {
     Ok(())
 }
 
+fn run_families(a: FamiliesArgs) -> CliResult {
+    if !(1..=MAX_LIMIT_INSTANCES).contains(&a.instances) {
+        return Err(checks::bad("--instances", a.instances, "1 to 1000"));
+    }
+    let began = Instant::now();
+    let runs = study::families::run(a.instances, a.seed)?;
+    let md = format!(
+        "{}\n`arc plan`'s defaults through the library's facade, {} instances of each family (seed {}); {} build, {} worker threads; whole study {:.0} s.\n",
+        study::families::markdown(&runs),
+        a.instances,
+        a.seed,
+        if cfg!(debug_assertions) { "debug" } else { "release" },
+        std::env::var("RAYON_NUM_THREADS").unwrap_or_else(|_| "every core's".into()),
+        began.elapsed().as_secs_f64()
+    );
+    let files = [
+        study::write_out(
+            &a.out_dir,
+            "families_runs.csv",
+            study::families::csv(&runs).as_bytes(),
+        )?,
+        study::write_out(&a.out_dir, "families.md", md.as_bytes())?,
+    ];
+    println!("{md}");
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
 fn run_refuse(a: RefuseArgs) -> CliResult {
     let began = Instant::now();
     let runs = study::refuse::run()?;
@@ -840,6 +889,7 @@ pub fn run(c: BenchCommand) -> CliResult {
         BenchCommand::Online(a) => run_online(a),
         BenchCommand::Limit(a) => run_limit(a),
         BenchCommand::Refuse(a) => run_refuse(a),
+        BenchCommand::Families(a) => run_families(a),
         BenchCommand::Prm(a) => run_prm(*a),
     }
 }

@@ -42,6 +42,14 @@ pub enum StudyError {
         /// Why.
         why: String,
     },
+    /// A query the facade refuses as bad input (its start or goal, its options).
+    #[error("{scenario}: {why}")]
+    Refused {
+        /// The scenario.
+        scenario: String,
+        /// Why.
+        why: String,
+    },
     /// A collision context that cannot be made.
     #[error(transparent)]
     Context(#[from] ContextError),
@@ -80,6 +88,7 @@ impl StudyError {
             | StudyError::NotBuilt(_)
             | StudyError::Chain { .. }
             | StudyError::Tables { .. }
+            | StudyError::Refused { .. }
             | StudyError::Context(_)
             | StudyError::NoFittingStart { .. }
             | StudyError::ThreadPool(_)

@@ -17,6 +17,7 @@
 //! ratio is fair.
 
 mod error;
+pub mod families;
 pub mod flight;
 pub mod limit;
 pub mod online;
