@@ -95,6 +95,22 @@ mod tests {
     }
 
     #[test]
+    fn the_witness_turns_right_behind_the_window_to_a_door_to_the_side() {
+        // 1.8 m behind the window, 2.5 m to either side: the head turns while the
+        // tail is still in the window.
+        for side in [2.5, -2.5] {
+            let s = PassageSpec::parse(&format!(
+                "w=0.5,angle=17,door=0.8,door_offset={side},gap=1.8"
+            ))
+            .unwrap();
+            let sc = s.build().unwrap();
+            for n in [4u8, 6, 8] {
+                witness(&sc, &ChainParams::new(n)).unwrap_or_else(|e| panic!("{side} N={n}: {e}"));
+            }
+        }
+    }
+
+    #[test]
     fn the_centred_witness_keeps_the_opening_target_and_a_plan_off_centre_does_not() {
         let s = PassageSpec::parse("w=0.5,angle=30,door=0.7").unwrap();
         let sc = s.build().unwrap();

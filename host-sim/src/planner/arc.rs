@@ -397,7 +397,8 @@ impl ArcPlanner {
     /// joins the roadmap; else the lattice search guided by the labelled free regions
     /// (labelled now if need be) runs: a proof that start and goal lie in separate
     /// regions ends the query; a route found is flown alone
-    /// ([`Self::solve_on_route`]) and else joins the roadmap.
+    /// ([`Self::solve_on_route`], else threaded: [`Self::threaded_on_route`]) and
+    /// else joins the roadmap.
     fn guided_attempt(
         &self,
         query: &Query,
@@ -422,7 +423,12 @@ impl ArcPlanner {
             return Err(self.separated(sep));
         }
         built.route = self.head_route(start, goal, budget, deadline, &mut built.lattice_s)?;
-        self.solve_on_route(query, stop, began, built)
+        if let Some(solved) = self.solve_on_route(query, stop, began, built)? {
+            return Ok(Some(solved));
+        }
+        // As on the quick route: where whole shapes cannot fly the route through an
+        // opening, the chain follows its head along it, threading the opening.
+        Ok(self.threaded_on_route(query, built, deadline))
     }
 
     /// The online construction over the uniform head roadmap (joined by the lattice's

@@ -11,7 +11,8 @@
 //! | `offset` | 0 | window centre off the room's axis (m), -0.4 to 0.4 |
 //! | `wall` | 0.2 | wall thickness (m), 0.1 to 2.0: from 0.5 m on, the window is a square tunnel |
 //! | `door` | none | width (m) of a door in a second wall 2.5 m behind the first, 0.4 to 1.0 |
-//! | `door_offset` | 0 | door centre off the room's axis (m), -0.4 to 0.4 |
+//! | `door_offset` | 0 | door centre off the room's axis (m), -3 to 3: from 1 m on, the head turns to the side right behind the window |
+//! | `gap` | 2.5 | distance between the first wall and the second (m), 1 to 3 |
 //! | `res` | 0.05 | map resolution (m), 0.025 to 0.1 |
 //! | `sealed` | 0 | 1: the window is walled up (no way through; for failure reports) |
 //! | `slit` | none | width (m) of slits that replace the window, 0.05 to 0.3, widened to whole voxels: vertical, 1.5 m tall, [`SLIT_PITCH`] apart, centred on the window's place |
@@ -46,6 +47,8 @@ pub struct PassageSpec {
     pub wall: f64,
     /// Door in a second wall: width (m) and offset (m).
     pub door: Option<(f64, f64)>,
+    /// Distance between the first wall's far face and the second wall (m).
+    pub gap: f64,
     /// Map resolution (m).
     pub res: f64,
     /// The window is walled up: start and goal in separate free regions.
@@ -62,6 +65,7 @@ impl Default for PassageSpec {
             offset: 0.0,
             wall: 0.2,
             door: None,
+            gap: WALL_GAP,
             res: 0.05,
             sealed: false,
             slits: None,
@@ -76,7 +80,7 @@ const ROOM_Z: f64 = 2.6;
 const SHELL: f64 = 0.2;
 /// Where the first wall begins (x, m).
 const WALL_X: f64 = 6.0;
-/// Gap between the first wall and the second (m).
+/// Gap between the first wall and the second (m), unless `gap` is given.
 const WALL_GAP: f64 = 2.5;
 /// Height of the window's centre (m): half way up the room.
 const Z_C: f64 = ROOM_Z / 2.0;
@@ -100,6 +104,7 @@ impl PassageSpec {
                 "wall" => s.wall = v,
                 "door" => door = Some(v),
                 "door_offset" => door_offset = v,
+                "gap" => s.gap = v,
                 "res" => s.res = v,
                 "sealed" => s.sealed = v != 0.0,
                 "slit" => slit = Some(v),
@@ -129,9 +134,10 @@ impl PassageSpec {
         within("offset", self.offset, -0.4, 0.4)?;
         within("wall", self.wall, 0.1, 2.0)?;
         within("res", self.res, 0.025, 0.1)?;
+        within("gap", self.gap, 1.0, 3.0)?;
         if let Some((d, o)) = self.door {
             within("door", d, 0.4, 1.0)?;
-            within("door_offset", o, -0.4, 0.4)?;
+            within("door_offset", o, -3.0, 3.0)?;
         }
         if let Some((w, k)) = self.slits {
             within("slit", w, 0.05, 0.3)?;
@@ -148,6 +154,9 @@ impl PassageSpec {
         );
         if let Some((d, o)) = self.door {
             n += &format!(",door={d},door_offset={o}");
+            if self.gap != WALL_GAP {
+                n += &format!(",gap={}", self.gap);
+            }
         }
         if self.res != 0.05 {
             n += &format!(",res={}", self.res);
@@ -182,6 +191,30 @@ impl PassageSpec {
             offset: cm(rng.gen_range(-0.3..=0.3)),
             wall: cm(wall),
             door,
+            gap: WALL_GAP,
+            res: 0.05,
+            sealed: false,
+            slits: None,
+        }
+    }
+
+    /// A random instance of an opening, then a turn: a window (0.45-0.6 m, walls
+    /// 0.1-0.3 m, 0-45 degrees off its normal either way), then a door (0.6-0.9 m)
+    /// in a second wall 1-3 m on and 1-3 m to either side, so that the head turns
+    /// while the tail is still in the window; rounded as [`Self::random`] rounds.
+    pub fn random_turn(rng: &mut impl rand::Rng) -> Self {
+        let cm = |v: f64| (v * 100.0).round() / 100.0;
+        let angle_sign = if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
+        let angle = angle_sign * rng.gen_range(0.0f64..=45.0).round();
+        let side_sign = if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
+        let side = side_sign * rng.gen_range(1.0..=3.0);
+        Self {
+            w: cm(rng.gen_range(0.45..=0.6)),
+            angle_deg: angle,
+            offset: 0.0,
+            wall: cm(rng.gen_range(0.1..=0.3)),
+            door: Some((cm(rng.gen_range(0.6..=0.9)), cm(side))),
+            gap: cm(rng.gen_range(1.0..=3.0)),
             res: 0.05,
             sealed: false,
             slits: None,
@@ -199,7 +232,7 @@ impl PassageSpec {
         let yc = ROOM_Y / 2.0 + self.offset;
         let hw = self.w / 2.0;
         let door = self.door.map(|(dw, doff)| Door {
-            x: WALL_X + t + WALL_GAP,
+            x: WALL_X + t + self.gap,
             y: (
                 down(ROOM_Y / 2.0 + doff - dw / 2.0),
                 up(ROOM_Y / 2.0 + doff + dw / 2.0),
@@ -253,7 +286,8 @@ impl PassageSpec {
         };
         let door_text = match self.door {
             Some((d, o)) => format!(
-                ", then a second wall {WALL_GAP} m behind it with a door {d} m wide ({o:+} m off the axis)"
+                ", then a second wall {} m behind it with a door {d} m wide ({o:+} m off the axis)",
+                self.gap
             ),
             None => String::new(),
         };

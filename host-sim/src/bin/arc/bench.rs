@@ -144,6 +144,10 @@ pub struct RobustArgs {
     /// Worker threads (default: RAYON_NUM_THREADS, else every core).
     #[arg(long)]
     threads: Option<usize>,
+    /// Draw instances of an opening, then a turn (a door 1-3 m on and 1-3 m to the
+    /// side); the files are named turns* instead of robust*.
+    #[arg(long)]
+    turns: bool,
 }
 
 /// The runs of `arc bench flight` and `arc bench online`: scenarios times chain sizes,
@@ -551,7 +555,12 @@ fn run_robust(a: RobustArgs) -> CliResult {
             a.time_limit
         )));
     }
+    let family = match a.turns {
+        true => robust::Family::Turns,
+        false => robust::Family::Openings,
+    };
     let o = robust::RobustOptions {
+        family,
         instances: a.instances,
         seed: a.seed,
         time_limit: (a.time_limit > 0.0).then_some(a.time_limit),
@@ -560,13 +569,15 @@ fn run_robust(a: RobustArgs) -> CliResult {
     let t = Instant::now();
     let (specs, redrawn) = robust::draw(&o);
     eprintln!(
-        "arc bench robust: {} instances with witnesses ({redrawn} redrawn) in {:.0} s",
+        "arc bench {}: {} instances with witnesses ({redrawn} redrawn) in {:.0} s",
+        family.stem(),
         specs.len(),
         t.elapsed().as_secs_f64()
     );
     let results = robust::run(&specs, a.threads, 10)?;
     let md = robust::markdown(
         &results,
+        family,
         redrawn,
         &format!(
             "Seed {}, {} instances; wall time of the whole study {:.0} s.",
@@ -577,10 +588,12 @@ fn run_robust(a: RobustArgs) -> CliResult {
     );
     let svg = robust::figure(&results);
     let runs = study::runs_csv(&results);
+    let stem = family.stem();
+    let names = ["_runs.csv", ".md", ".svg"].map(|end| format!("{stem}{end}"));
     let files: [(&str, &[u8]); 3] = [
-        ("robust_runs.csv", runs.as_bytes()),
-        ("robust.md", md.as_bytes()),
-        ("robust.svg", svg.as_bytes()),
+        (&names[0], runs.as_bytes()),
+        (&names[1], md.as_bytes()),
+        (&names[2], svg.as_bytes()),
     ];
     publish(&a.out_dir, &md, &files)
 }

@@ -13,9 +13,54 @@ use super::{plot, run_all, ArcMode, Envs, Method, RunKey, RunResult, RunSpec, Sp
 use aerial_chain::problem::passages::PassageSpec;
 use aerial_chain::witness::witness;
 
+/// Which instances of the family the study draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Family {
+    /// Windows, tunnels and doors ([`PassageSpec::random`]).
+    Openings,
+    /// A window, then a door far to the side ([`PassageSpec::random_turn`]).
+    Turns,
+}
+
+impl Family {
+    /// One random instance.
+    fn draw(self, rng: &mut rand_pcg::Pcg64) -> PassageSpec {
+        match self {
+            Family::Openings => PassageSpec::random(rng),
+            Family::Turns => PassageSpec::random_turn(rng),
+        }
+    }
+
+    /// The study's name, and the stem of its files.
+    pub fn stem(self) -> &'static str {
+        match self {
+            Family::Openings => "robust",
+            Family::Turns => "turns",
+        }
+    }
+
+    /// The title and what the instances are, for the markdown.
+    fn words(self) -> (&'static str, &'static str) {
+        match self {
+            Family::Openings => (
+                "Robustness: the hard-case family (`arc bench robust`)",
+                "windows 0.45-0.6 m in walls of 0.1-0.3 m, or one in five a tunnel 0.5-0.6 m square and 0.6-1.5 m long; approach 0-60 degrees either way, \
+                 offsets up to 0.3 m, a second wall with a door in half",
+            ),
+            Family::Turns => (
+                "An opening, then a turn (`arc bench robust --turns`)",
+                "a window 0.45-0.6 m in a wall of 0.1-0.3 m, approached 0-45 degrees off its normal either way, then a door 0.6-0.9 m wide in a second wall \
+                 1-3 m on and 1-3 m to either side: the head turns while the tail is still in the window",
+            ),
+        }
+    }
+}
+
 /// Options of the study.
 #[derive(Clone, Debug)]
 pub struct RobustOptions {
+    /// Which instances.
+    pub family: Family,
     /// Instances.
     pub instances: usize,
     /// Seed of the instance generator (the planner's seed is the instance index + 1).
@@ -32,6 +77,7 @@ impl RobustOptions {
     /// The full study: 200 instances.
     pub fn full() -> Self {
         Self {
+            family: Family::Openings,
             instances: 200,
             seed: 1,
             vertices: 1500,
@@ -47,7 +93,7 @@ pub fn draw(o: &RobustOptions) -> (Vec<RunSpec>, usize) {
     let mut specs = Vec::with_capacity(o.instances);
     let mut redrawn = 0;
     while specs.len() < o.instances {
-        let p = PassageSpec::random(&mut rng);
+        let p = o.family.draw(&mut rng);
         let units: u8 = rng.gen_range(4..=8);
         let ok = p.build().ok().is_some_and(|sc| {
             aerial_chain_core::ChainParams::new(units)
@@ -98,7 +144,7 @@ fn quantile(v: &[f64], q: f64) -> f64 {
 }
 
 /// The markdown summary.
-pub fn markdown(results: &[RunResult], redrawn: usize, meta: &str) -> String {
+pub fn markdown(results: &[RunResult], family: Family, redrawn: usize, meta: &str) -> String {
     let n = results.len();
     let solved: Vec<&RunResult> = results.iter().filter(|r| r.success).collect();
     let verified = solved.iter().filter(|r| r.verified == Some(true)).count();
@@ -108,10 +154,10 @@ pub fn markdown(results: &[RunResult], redrawn: usize, meta: &str) -> String {
     let plan = ms(&|r| r.planning_s);
     let total = ms(&|r| r.roadmap_s + r.planning_s);
     let mut s = String::new();
-    s += "# Robustness: the hard-case family (`arc bench robust`)\n\n";
+    let (title, what) = family.words();
+    s += &format!("# {title}\n\n");
     s += &format!(
-        "{n} random instances of `passage:` (windows 0.45-0.6 m in walls of 0.1-0.3 m, or one in five a tunnel 0.5-0.6 m square and 0.6-1.5 m long; approach 0-60 degrees either way, \
-         offsets up to 0.3 m, a second wall with a door in half), N = 4..8, `arc plan`'s defaults. \
+        "{n} random instances of `passage:` ({what}), N = 4..8, `arc plan`'s defaults. \
          Every instance has a witness checked by the exact verifier; {redrawn} draws without one were redrawn.\n\n"
     );
     s += "Setup is the planner's `setup` before the query (with the head lattice it builds nothing); \
