@@ -1,6 +1,8 @@
 //! File output that is never lost or half-written: write to a temporary file in the
 //! destination's directory, then rename it over the destination. The path `-` names
-//! standard output (and standard input where a command reads a file).
+//! standard output (and standard input where a command reads a file). Files are told
+//! apart by their ending in one way, and a file format's JSON text is read in one way:
+//! parsed, then checked by the format's rules.
 
 use std::io::Write;
 use std::path::Path;
@@ -58,6 +60,31 @@ pub fn read_input(path: &Path) -> std::io::Result<String> {
         std::fs::File::open(path)?.read_to_string(&mut text)?;
     }
     Ok(text)
+}
+
+/// The entry of `table` (a lower-case ending without its dot, and what it names) that
+/// `path` ends in, in any case.
+pub fn by_extension<T: Copy>(path: &Path, table: &[(&str, T)]) -> Option<T> {
+    let ending = path.extension()?.to_str()?.to_ascii_lowercase();
+    table.iter().find(|(e, _)| *e == ending).map(|&(_, t)| t)
+}
+
+/// `text` parsed as a JSON file of `format` and checked by `check`; `Err` says what is
+/// wrong (not JSON of the file's shape, or the rule `check` found broken), for the
+/// caller to name the file.
+pub fn parse_checked<T, R, E>(
+    text: &str,
+    format: &str,
+    check: impl FnOnce(&T) -> Result<R, E>,
+) -> Result<T, String>
+where
+    T: serde::de::DeserializeOwned,
+    E: std::fmt::Display,
+{
+    let file: T =
+        serde_json::from_str(text).map_err(|e| format!("not an {format} JSON file: {e}"))?;
+    check(&file).map_err(|e| e.to_string())?;
+    Ok(file)
 }
 
 /// Writes `bytes` to standard output when `path` is `-`, else atomically to the file.

@@ -134,14 +134,10 @@ impl Mission {
 
     /// Parses and checks a mission's text; `name` names it in errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, MissionError> {
-        let err = |what: String| MissionError {
+        fsutil::parse_checked(text, FORMAT, Self::check).map_err(|what| MissionError {
             path: name.to_string(),
             what,
-        };
-        let m: Mission = serde_json::from_str(text)
-            .map_err(|e| err(format!("not an {FORMAT} JSON file: {e}")))?;
-        m.check().map_err(err)?;
-        Ok(m)
+        })
     }
 
     /// The rules that need no map nor chain.

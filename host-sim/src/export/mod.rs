@@ -107,15 +107,8 @@ pub enum Format {
 impl Format {
     /// The format of an output named `path`.
     pub fn of_path(path: &Path) -> Result<Self, ExportError> {
-        let ending = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ending.as_deref() {
-            Some("mcap") => Ok(Self::Mcap),
-            Some("tlog") => Ok(Self::Tlog),
-            _ => Err(ExportError::Format(path.display().to_string())),
-        }
+        crate::fsutil::by_extension(path, &[("mcap", Self::Mcap), ("tlog", Self::Tlog)])
+            .ok_or_else(|| ExportError::Format(path.display().to_string()))
     }
 }
 

@@ -228,8 +228,7 @@ impl PictureFormat {
 
     /// The format of `path` by its extension (any case).
     pub fn of(path: &Path) -> Option<Self> {
-        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
-        Self::ALL.iter().find(|(e, _)| *e == ext).map(|&(_, f)| f)
+        crate::fsutil::by_extension(path, &Self::ALL)
     }
 
     /// The supported extensions, for messages: `.svg or .png`.

@@ -61,14 +61,7 @@ impl FlightFile {
 
     /// Parses and checks a flight's text; `name` names it in errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, FileError> {
-        let invalid = |what: String| FileError::Invalid {
-            path: name.to_string(),
-            what,
-        };
-        let file: Self = serde_json::from_str(text)
-            .map_err(|e| invalid(format!("not an {FORMAT} JSON file: {e}")))?;
-        file.check().map_err(invalid)?;
-        Ok(file)
+        fsutil::parse_checked(text, FORMAT, Self::check).map_err(FileError::invalid(name))
     }
 
     /// Writes the file as JSON, atomically (`-`: standard output).

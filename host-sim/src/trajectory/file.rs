@@ -108,6 +108,14 @@ impl FileError {
             Err(source) => Err(FileError::Io { path: name, source }),
         }
     }
+
+    /// What a file `name` that breaks its format is, given what is wrong.
+    pub(crate) fn invalid(name: &str) -> impl FnOnce(String) -> FileError + '_ {
+        |what| FileError::Invalid {
+            path: name.to_string(),
+            what,
+        }
+    }
 }
 
 /// A rule of the `arc-trajectory/1` format that needs no map, broken: each names the
@@ -222,20 +230,7 @@ impl TrajectoryFile {
 
     /// Parses and checks a trajectory's text; `name` names it in errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, FileError> {
-        let path = name.to_string();
-        match serde_json::from_str::<Self>(text) {
-            Err(e) => Err(FileError::Invalid {
-                path,
-                what: format!("not an {FORMAT} JSON file: {e}"),
-            }),
-            Ok(file) => match file.check() {
-                Ok(_) => Ok(file),
-                Err(e) => Err(FileError::Invalid {
-                    path,
-                    what: e.to_string(),
-                }),
-            },
-        }
+        fsutil::parse_checked(text, FORMAT, Self::check).map_err(FileError::invalid(name))
     }
 
     /// Checks the format's rules that need no map: the tag, the chain, at least one

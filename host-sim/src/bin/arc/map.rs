@@ -89,6 +89,7 @@ fn grid_of(tree: &OcTree, path: &Path) -> Result<Grid, CliError> {
 }
 
 /// The OctoMap file kinds `arc map export` writes.
+#[derive(Clone, Copy)]
 enum MapFormat {
     /// `.bt`: OctoMap's binary, max-likelihood format.
     Binary,
@@ -98,18 +99,13 @@ enum MapFormat {
 
 /// The format `path`'s extension names, or a bad-input error naming the path.
 fn map_format(path: &Path) -> Result<MapFormat, CliError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("bt") => Ok(MapFormat::Binary),
-        Some("ot") => Ok(MapFormat::Full),
-        _ => Err(CliError::input(format!(
+    let table = [("bt", MapFormat::Binary), ("ot", MapFormat::Full)];
+    crate::fsutil::by_extension(path, &table).ok_or_else(|| {
+        CliError::input(format!(
             "--out {}: a map file must end in .bt or .ot",
             path.display()
-        ))),
-    }
+        ))
+    })
 }
 
 fn export(a: ExportArgs) -> CliResult {
