@@ -7,7 +7,7 @@ mod support;
 
 use std::path::Path;
 
-use support::{arc, s, spawn, wait_at_most, Outcome};
+use support::{arc, s, spawn, wait_at_most, words, Outcome};
 
 /// Wall time an exploration may take before it counts as hung: a maze flight of about
 /// 100 simulated seconds takes about a minute on one core.
@@ -75,32 +75,11 @@ fn a_maze_from_an_empty_map() {
 fn a_known_map_is_flown_as_known() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    expect(
-        &[
-            "map",
-            "export",
-            "--scenario",
-            "window",
-            "--out",
-            "window.bt",
-        ],
-        d,
-        0,
+    expect(&words("map export --scenario window --out window.bt"), d, 0);
+    let query = words(
+        "--map window.bt --known window.bt --units 4 \
+         --start 2,4.5,1.5 --start-yaw-deg 90 --goal 6.6,3,1.5",
     );
-    let query = [
-        "--map",
-        "window.bt",
-        "--known",
-        "window.bt",
-        "--units",
-        "4",
-        "--start",
-        "2,4.5,1.5",
-        "--start-yaw-deg",
-        "90",
-        "--goal",
-        "6.6,3,1.5",
-    ];
     let flight = explore_to_goal(&query, d);
     let summary = &flight["explore"]["summary"];
     assert!(summary["known"].as_u64().unwrap() > 100_000, "{summary}");
@@ -143,17 +122,7 @@ fn a_sealed_goal_ends_the_run_with_the_reason() {
 fn a_sensor_that_sees_almost_nothing_keeps_the_chain_in_known_space() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let run = [
-        "explore",
-        "--scenario",
-        "window",
-        "--units",
-        "4",
-        "--sensor-range",
-        "0.25",
-        "--time-limit",
-        "15",
-    ];
+    let run = words("explore --scenario window --units 4 --sensor-range 0.25 --time-limit 15");
     let o = expect(&[&run[..], &OUTPUTS].concat(), d, 1);
     assert!(o.stderr.contains("time limit"), "{o:?}");
     let o = expect(&["verify", "--map", "seen.bt", "--plan", "p.json"], d, 0);

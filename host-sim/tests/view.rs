@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use support::{expect, hover_plan, s};
+use support::{expect, hover_plan, s, words};
 
 /// Wall time one browser run may take before it counts as hung; a guard, not a timing.
 const BROWSER_GUARD: Duration = Duration::from_secs(180);
@@ -141,28 +141,12 @@ fn the_page_draws_the_plan_and_its_time_moves_the_chain() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     expect(
-        &[
-            "plan",
-            "--scenario",
-            "window",
-            "--units",
-            "5",
-            "--out",
-            "window.json",
-        ],
+        &words("plan --scenario window --units 5 --out window.json"),
         d,
         0,
     );
     let out = expect(
-        &[
-            "view",
-            "--scenario",
-            "window",
-            "--plan",
-            "window.json",
-            "--out",
-            "view.html",
-        ],
+        &words("view --scenario window --plan window.json --out view.html"),
         d,
         0,
     );
@@ -192,18 +176,9 @@ fn the_page_draws_a_flight() {
     let d = dir.path();
     std::fs::write(d.join("hover.json"), hover_plan(true)).unwrap();
     let sim = "sim --scenario window --plan hover.json --settle-time 1 --out flight.json";
-    expect(&sim.split(' ').collect::<Vec<_>>(), d, 0);
-    let view = [
-        "view",
-        "--scenario",
-        "window",
-        "--plan",
-        "hover.json",
-        "--flight",
-        "flight.json",
-        "--out",
-        "flight.html",
-    ];
+    expect(&words(sim), d, 0);
+    let view =
+        words("view --scenario window --plan hover.json --flight flight.json --out flight.html");
     let out = expect(&view, d, 0);
     assert!(out.stdout.contains("with the flight"), "{out:?}");
     assert_runs(d, &d.join("flight.html"));
@@ -250,25 +225,9 @@ fn bad_files_are_refused_with_one_line() {
 fn a_100_m_corridor_page_stays_small() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let plan = [
-        "plan",
-        "--scenario",
-        "corridor:100",
-        "--units",
-        "6",
-        "--out",
-        "corridor.json",
-    ];
+    let plan = words("plan --scenario corridor:100 --units 6 --out corridor.json");
     expect(&plan, d, 0);
-    let view = [
-        "view",
-        "--scenario",
-        "corridor:100",
-        "--plan",
-        "corridor.json",
-        "--out",
-        "corridor.html",
-    ];
+    let view = words("view --scenario corridor:100 --plan corridor.json --out corridor.html");
     expect(&view, d, 0);
     let bytes = std::fs::metadata(d.join("corridor.html")).unwrap().len();
     assert!(bytes <= 5_000_000, "the page weighs {bytes} bytes");

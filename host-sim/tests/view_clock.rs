@@ -11,7 +11,7 @@ use aerial_chain::flying::{self, FlyOptions};
 use aerial_chain::plan_file::Plan;
 use aerial_chain::problem::scenarios;
 use aerial_chain::sim::{Reference, ReferenceLimits};
-use support::expect;
+use support::{expect, words};
 
 /// The waypoint times (`t`) of the page `arc view` wrote to `page`.
 fn page_times(page: &Path) -> Vec<f64> {
@@ -50,7 +50,7 @@ fn the_page_ends_when_arc_sim_ends_its_plan() {
     let d = dir.path();
     let (plan, t) = plan_and_page("window", "5", d);
     let fly = "sim --scenario window --plan plan.json --record-every 100 --out flight.json";
-    expect(&fly.split(' ').collect::<Vec<_>>(), d, 0);
+    expect(&words(fly), d, 0);
     let text = std::fs::read_to_string(d.join("flight.json")).unwrap();
     let flight: serde_json::Value = serde_json::from_str(&text).unwrap();
     let flown = flight["report"]["planned_duration"].as_f64().unwrap();

@@ -68,6 +68,11 @@ pub fn spawn(c: &mut Command) -> Child {
         .expect("spawn arc")
 }
 
+/// The words of a command line written as one string, for `arc`'s arguments.
+pub fn words(line: &str) -> Vec<&str> {
+    line.split_whitespace().collect()
+}
+
 /// Runs `arc args` in `dir` and waits, killing it after [`GUARD_SECONDS`].
 pub fn run(args: &[&str], dir: &Path) -> Outcome {
     wait(spawn(&mut arc(args, dir)), args)
