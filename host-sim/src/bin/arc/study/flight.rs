@@ -10,7 +10,7 @@ use std::fmt::Write as _;
 
 use aerial_chain::collision::verify_plan;
 use aerial_chain::flying::{self, FlyOptions, Timed};
-use aerial_chain::picture::{palette, stroke, Axis, Figure, Mark, Panel};
+use aerial_chain::picture::palette;
 use aerial_chain::planner::{Query, Settings};
 use aerial_chain::planning::{self, PlanOptions, Request};
 use aerial_chain::problem::scenarios;
@@ -318,41 +318,17 @@ pub fn figure(runs: &[FlightRun], speed: f64) -> String {
     let (before, after) = (points(&|r| r.before), points(&|r| r.after));
     let xmax = before.iter().chain(&after).map(|p| p.0).fold(1.0, f64::max) * 1.05;
     let ymax = before.iter().chain(&after).map(|p| p.1).fold(1.0, f64::max) * 1.05;
-    let mut fig = Figure::new(900.0, 600.0, "");
-    let cell = fig.cells(1, 1, 0.0, 600.0)[0];
-    let x = Axis::linear("head path / speed (s)", (0.0, xmax));
-    let y = Axis::linear("simulated flight time (s)", (0.0, ymax));
-    let mut p = Panel::chart(
-        cell,
-        x,
-        y,
+    super::plot::times_svg(
         "arc bench flight: flight time against path length",
-    );
-    p.polyline(
-        &[(0.0, 0.0), (xmax, xmax)],
-        palette::INK,
-        stroke::HAIR,
-        true,
-    );
-    p.key_mark(Mark::Dashed, palette::INK, "path / speed");
-    p.polyline(
-        &[(0.0, 0.0), (xmax, 2.0 * xmax)],
-        palette::GOAL,
-        stroke::DATA,
-        true,
-    );
-    p.key_mark(Mark::Dashed, palette::GOAL, "target: 2 x path / speed");
-    for (pts, colour, label) in [
-        (&before, palette::series(3), "stop at every waypoint"),
-        (&after, palette::series(0), "blended trajectory"),
-    ] {
-        for &q in pts {
-            p.marker(q, 3.0, colour);
-        }
-        p.key_mark(Mark::Dot, colour, label);
-    }
-    fig.add(p);
-    fig.to_svg()
+        ("head path / speed (s)", xmax),
+        ("simulated flight time (s)", ymax),
+        "path / speed",
+        (2.0, "target: 2 x path / speed"),
+        &[
+            (&before, palette::series(3), "stop at every waypoint"),
+            (&after, palette::series(0), "blended trajectory"),
+        ],
+    )
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@
 use std::fmt::Write as _;
 
 use aerial_chain::online::{explore, quantile, ExploreEnd, ExploreSettings};
-use aerial_chain::picture::{palette, stroke, Axis, Figure, Mark, Panel};
+use aerial_chain::picture::palette;
 use aerial_chain::plan_file::Waypoint;
 use aerial_chain::planning::PlanOptions;
 use aerial_chain::problem::scenarios;
@@ -58,6 +58,11 @@ impl OnlineRun {
     /// Time to goal over the finished-map flight.
     pub fn ratio(&self) -> f64 {
         self.time_s / self.finished_s
+    }
+
+    /// How many times cheaper the median field update was than the rebuild.
+    pub fn speedup(&self) -> f64 {
+        self.rebuild_s / self.update_s
     }
 
     /// Whether the run reached the goal without contact and committed only valid
@@ -133,37 +138,41 @@ fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
     Ok(())
 }
 
-/// One line per run.
+/// The CSV's columns: each one's name and its cell for a run.
+const CSV_COLUMNS: [(&str, fn(&OnlineRun) -> String); 19] = [
+    ("scenario", |r| csv_field(&r.scenario)),
+    ("units", |r| r.units.to_string()),
+    ("end", |r| csv_field(&r.end)),
+    ("time_to_goal_s", |r| format!("{:.2}", r.time_s)),
+    ("finished_map_s", |r| format!("{:.2}", r.finished_s)),
+    ("ratio", |r| format!("{:.3}", r.ratio())),
+    ("replans", |r| r.replans.to_string()),
+    ("pieces", |r| r.pieces.to_string()),
+    ("pieces_invalid", |r| r.pieces_invalid.to_string()),
+    ("latency_median_ms", |r| {
+        format!("{:.2}", r.latency_s[0] * 1e3)
+    }),
+    ("latency_p95_ms", |r| format!("{:.2}", r.latency_s[1] * 1e3)),
+    ("latency_max_ms", |r| format!("{:.2}", r.latency_s[2] * 1e3)),
+    ("nothing_new_max_ms", |r| {
+        format!("{:.4}", r.nothing_new_max_s * 1e3)
+    }),
+    ("update_median_ms", |r| format!("{:.3}", r.update_s * 1e3)),
+    ("rebuild_ms", |r| format!("{:.2}", r.rebuild_s * 1e3)),
+    ("update_speedup", |r| format!("{:.1}", r.speedup())),
+    ("voxels_seen", |r| r.known.to_string()),
+    ("min_clearance_m", |r| format!("{:.4}", r.min_clearance_m)),
+    ("contact", |r| r.contact.to_string()),
+];
+
+/// One line per run, under a line of the column names.
 pub fn csv(runs: &[OnlineRun]) -> String {
-    let mut out = String::from(
-        "scenario,units,end,time_to_goal_s,finished_map_s,ratio,replans,pieces,pieces_invalid,\
-         latency_median_ms,latency_p95_ms,latency_max_ms,nothing_new_max_ms,update_median_ms,\
-         rebuild_ms,update_speedup,voxels_seen,min_clearance_m,contact\n",
-    );
+    let names: Vec<&str> = CSV_COLUMNS.iter().map(|(name, _)| *name).collect();
+    let mut out = names.join(",") + "\n";
     for r in runs {
-        let _ = writeln!(
-            out,
-            "{},{},{},{:.2},{:.2},{:.3},{},{},{},{:.2},{:.2},{:.2},{:.4},{:.3},{:.2},{:.1},{},{:.4},{}",
-            csv_field(&r.scenario),
-            r.units,
-            csv_field(&r.end),
-            r.time_s,
-            r.finished_s,
-            r.ratio(),
-            r.replans,
-            r.pieces,
-            r.pieces_invalid,
-            r.latency_s[0] * 1e3,
-            r.latency_s[1] * 1e3,
-            r.latency_s[2] * 1e3,
-            r.nothing_new_max_s * 1e3,
-            r.update_s * 1e3,
-            r.rebuild_s * 1e3,
-            r.rebuild_s / r.update_s,
-            r.known,
-            r.min_clearance_m,
-            r.contact
-        );
+        let cells: Vec<String> = CSV_COLUMNS.iter().map(|(_, cell)| cell(r)).collect();
+        out += &cells.join(",");
+        out.push('\n');
     }
     out
 }
@@ -179,7 +188,7 @@ pub fn markdown(runs: &[OnlineRun]) -> String {
     let ratios = sorted(&|r| r.ratio());
     let p95 = sorted(&|r| r.latency_s[1]);
     let max = sorted(&|r| r.latency_s[2]);
-    let speedup = sorted(&|r| r.rebuild_s / r.update_s);
+    let speedup = sorted(&|r| r.speedup());
     let mut md = String::from(
         "| scenario | N | end | time to goal (s) | finished map (s) | ratio | replans | pieces (invalid) | latency median / p95 / max (ms) | update (ms) | rebuild / update | min clearance (m) |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|\n",
@@ -201,7 +210,7 @@ pub fn markdown(runs: &[OnlineRun]) -> String {
             r.latency_s[1] * 1e3,
             r.latency_s[2] * 1e3,
             r.update_s * 1e3,
-            r.rebuild_s / r.update_s,
+            r.speedup(),
             r.min_clearance_m
         );
     }
@@ -232,29 +241,13 @@ pub fn figure(runs: &[OnlineRun]) -> String {
         .collect();
     let xmax = pts.iter().map(|p| p.0).fold(1.0, f64::max) * 1.1;
     let ymax = pts.iter().map(|p| p.1).fold(1.0, f64::max).max(1.5 * xmax) * 1.05;
-    let mut fig = Figure::new(900.0, 600.0, "");
-    let cell = fig.cells(1, 1, 0.0, 600.0)[0];
-    let x = Axis::linear("flight on the finished map (s)", (0.0, xmax));
-    let y = Axis::linear("time to goal from an empty map (s)", (0.0, ymax));
-    let mut p = Panel::chart(cell, x, y, "arc bench online: flying into the unknown");
-    p.polyline(
-        &[(0.0, 0.0), (xmax, xmax)],
-        palette::INK,
-        stroke::HAIR,
-        true,
-    );
-    p.key_mark(Mark::Dashed, palette::INK, "as fast as on the finished map");
-    p.polyline(
-        &[(0.0, 0.0), (xmax, 1.5 * xmax)],
-        palette::GOAL,
-        stroke::DATA,
-        true,
-    );
-    p.key_mark(Mark::Dashed, palette::GOAL, "target: 1.5 x");
-    for &q in &pts {
-        p.marker(q, 3.0, palette::series(0));
-    }
-    p.key_mark(Mark::Dot, palette::series(0), "a run that reached the goal");
-    fig.add(p);
-    fig.to_svg()
+    super::plot::times_svg(
+        "arc bench online: flying into the unknown",
+        ("flight on the finished map (s)", xmax),
+        ("time to goal from an empty map (s)", ymax),
+        "as fast as on the finished map",
+        (1.5, "target: 1.5 x"),
+        &[(&pts, palette::series(0), "a run that reached the goal")],
+    )
 }
+

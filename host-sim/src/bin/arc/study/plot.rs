@@ -1,7 +1,7 @@
 //! Charts of the benchmark studies (time and success against a size), drawn with
 //! the project's [`aerial_chain::picture`] figures so they look like the other pictures.
 
-use aerial_chain::picture::{stroke, Axis, Colour, Figure, Mark, Panel};
+use aerial_chain::picture::{palette, stroke, Axis, Colour, Figure, Mark, Panel};
 
 use super::{Spread, Summary};
 
@@ -87,6 +87,46 @@ pub fn svg(charts: &[Chart], rows: usize, cols: usize, size: (u32, u32)) -> Stri
     for (cell, chart) in fig.cells(rows, cols, 0.0, h).into_iter().zip(charts) {
         fig.add(panel(cell, chart));
     }
+    fig.to_svg()
+}
+
+/// Dots of a time chart: the points, their colour and their key.
+pub type Dots<'a> = (&'a [(f64, f64)], Colour, &'a str);
+
+/// A chart of one time (s) against another, both from 0 (labels and largest values
+/// `x`, `y`), as an SVG document: the dashed line `y = x` keyed `same`, the dashed
+/// target `y = target.0 x` keyed `target.1`, and the points of every one of `dots`.
+pub fn times_svg(
+    title: &str,
+    x: (&str, f64),
+    y: (&str, f64),
+    same: &str,
+    target: (f64, &str),
+    dots: &[Dots],
+) -> String {
+    let mut fig = Figure::new(900.0, 600.0, "");
+    let cell = fig.cells(1, 1, 0.0, 600.0)[0];
+    let (x_axis, y_axis) = (Axis::linear(x.0, (0.0, x.1)), Axis::linear(y.0, (0.0, y.1)));
+    let mut p = Panel::chart(cell, x_axis, y_axis, title);
+    let xmax = x.1;
+    p.polyline(
+        &[(0.0, 0.0), (xmax, xmax)],
+        palette::INK,
+        stroke::HAIR,
+        true,
+    );
+    p.key_mark(Mark::Dashed, palette::INK, same);
+    let (slope, target_key) = target;
+    let target_line = [(0.0, 0.0), (xmax, slope * xmax)];
+    p.polyline(&target_line, palette::GOAL, stroke::DATA, true);
+    p.key_mark(Mark::Dashed, palette::GOAL, target_key);
+    for &(points, colour, key) in dots {
+        for &q in points {
+            p.marker(q, MARKER, colour);
+        }
+        p.key_mark(Mark::Dot, colour, key);
+    }
+    fig.add(p);
     fig.to_svg()
 }
 
