@@ -11,6 +11,7 @@ use super::verify::check_edge_exact;
 use super::*;
 use crate::map::distance::DistanceField;
 use crate::map::grid::{Cell, Grid};
+use crate::map::random_grids::write_cycled;
 
 /// A free 4 x 4 x 2 m box at 0.1 m with the given occupied boxes.
 fn map(boxes: &[([f64; 3], [f64; 3])], unknown_occ: bool) -> Arc<DistanceField> {
@@ -332,7 +333,7 @@ fn small_grid() -> impl Strategy<Value = Grid> {
         .prop_map(|(dims, origin, draws, (occ, unk), (unknown_occ, fill))| {
             // Per mille of occupied and of unknown voxels.
             let (occ, unk) = ([0, 5, 100][occ], [0, 5, 100][unk]);
-            let states: Vec<u8> = draws
+            let states: Vec<usize> = draws
                 .iter()
                 .map(|&d| match d {
                     d if d < occ => 0,
@@ -344,20 +345,9 @@ fn small_grid() -> impl Strategy<Value = Grid> {
             // (and keeps the summary's counts through every change).
             let fill = [Cell::Free, Cell::Unknown, Cell::Occupied][fill];
             let mut g = Grid::new(0.1, origin, dims, fill, unknown_occ).unwrap();
-            let mut k = 0;
-            for z in 0..dims[2] as i32 {
-                for y in 0..dims[1] as i32 {
-                    for x in 0..dims[0] as i32 {
-                        let state = match states[k % states.len()] {
-                            0 => Cell::Occupied,
-                            1 => Cell::Unknown,
-                            _ => Cell::Free,
-                        };
-                        g.set([origin[0] + x, origin[1] + y, origin[2] + z], state);
-                        k += 1;
-                    }
-                }
-            }
+            write_cycled(&mut g, &states, |s| {
+                [Cell::Occupied, Cell::Unknown, Cell::Free][s]
+            });
             g
         })
 }

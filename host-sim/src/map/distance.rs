@@ -323,6 +323,7 @@ impl DistanceField {
 #[cfg(test)]
 mod tests {
     use super::super::grid::{Cell, Grid};
+    use super::super::random_grids::grids;
     use super::*;
     use proptest::prelude::*;
 
@@ -385,24 +386,13 @@ mod tests {
         out
     }
 
-    fn random_grid(dims: [usize; 3], cells: &[u8], unknown_occ: bool) -> Grid {
-        let mut g = Grid::new(0.1, [-3, 2, -1], dims, Cell::Free, unknown_occ).unwrap();
-        let o = g.origin();
-        let mut k = 0;
-        for z in 0..dims[2] {
-            for y in 0..dims[1] {
-                for x in 0..dims[0] {
-                    let s = match cells[k % cells.len()] % 10 {
-                        0 => Cell::Occupied,
-                        1 => Cell::Unknown,
-                        _ => Cell::Free,
-                    };
-                    g.set([o[0] + x as i32, o[1] + y as i32, o[2] + z as i32], s);
-                    k += 1;
-                }
-            }
+    /// A tenth of the voxels occupied, a tenth unknown.
+    fn sparse(v: u8) -> Cell {
+        match v % 10 {
+            0 => Cell::Occupied,
+            1 => Cell::Unknown,
+            _ => Cell::Free,
         }
-        g
     }
 
     #[test]
@@ -425,24 +415,17 @@ mod tests {
 
         /// The FH transform equals brute force on random small grids.
         #[test]
-        fn edt_matches_brute_force(
-            dims in proptest::array::uniform3(1usize..9),
-            cells in proptest::collection::vec(any::<u8>(), 1..200),
-            unknown_occ in any::<bool>(),
-        ) {
-            let g = random_grid(dims, &cells, unknown_occ);
+        fn edt_matches_brute_force(g in grids(1..9, sparse)) {
             prop_assert_eq!(squared_edt(&g), brute_edt(&g));
         }
 
         /// The clearance query never exceeds the true distance to the nearest obstacle cube.
         #[test]
         fn lower_bound_holds_against_brute_force(
-            dims in proptest::array::uniform3(1usize..8),
-            cells in proptest::collection::vec(any::<u8>(), 1..200),
-            unknown_occ in any::<bool>(),
+            g in grids(1..8, sparse),
             pts in proptest::collection::vec(proptest::array::uniform3(-0.5f64..1.2), 1..40),
         ) {
-            let g = random_grid(dims, &cells, unknown_occ);
+            let dims = g.dims();
             let f = DistanceField::new(g.clone());
             let o = g.origin();
             let r = g.resolution();

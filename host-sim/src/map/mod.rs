@@ -4,6 +4,8 @@ pub(crate) mod distance;
 pub(crate) mod edt;
 pub(crate) mod grid;
 pub(crate) mod octomap;
+#[cfg(test)]
+pub(crate) mod random_grids;
 pub(crate) mod row_gaps;
 
 pub use distance::{DistanceField, UpdateError, UpdateStats};

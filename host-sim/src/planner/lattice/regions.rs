@@ -549,6 +549,7 @@ mod tests {
 
     use super::*;
     use crate::map::grid::{Cell, Grid};
+    use crate::map::random_grids::scatter;
 
     /// Edges between coarse nodes, both ways.
     type Edges = BTreeSet<(u32, u32)>;
@@ -612,19 +613,10 @@ mod tests {
             density in 0.0f64..0.7,
             radius in prop::sample::select(vec![0.0f64, 0.08, 0.15]),
         ) {
-            use rand::{Rng, SeedableRng};
+            use rand::SeedableRng;
             let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-            let dims = [23, 13, 10];
-            let mut g = Grid::new(0.1, [0; 3], dims, Cell::Free, true).unwrap();
-            for z in 0..dims[2] as i32 {
-                for y in 0..dims[1] as i32 {
-                    for x in 0..dims[0] as i32 {
-                        if rng.gen_bool(density) {
-                            g.set([x, y, z], Cell::Occupied);
-                        }
-                    }
-                }
-            }
+            let mut g = Grid::new(0.1, [0; 3], [23, 13, 10], Cell::Free, true).unwrap();
+            scatter(&mut g, [0; 3], [23, 13, 10], density, &mut rng);
             let (graph, brute) = coarse_and_brute_force(g, radius);
             // A dense map can leave no gap wide enough for the sphere: nothing to
             // compare; proptest draws another (and fails if it must draw too often).

@@ -12,6 +12,7 @@ use super::search::offsets26;
 use super::*;
 use crate::map::distance::DistanceField;
 use crate::map::grid::{Cell, Grid};
+use crate::map::random_grids::scatter;
 
 /// A closed box of `dims` voxels at `res`, free inside a one-voxel shell.
 fn boxed(res: f64, dims: [usize; 3]) -> Grid {
@@ -263,17 +264,8 @@ proptest! {
     ) {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-        let dims = [14, 10, 8];
-        let mut g = boxed(res, dims);
-        for z in 1..dims[2] as i32 - 1 {
-            for y in 1..dims[1] as i32 - 1 {
-                for x in 1..dims[0] as i32 - 1 {
-                    if rng.gen_bool(density) {
-                        g.set([x, y, z], Cell::Occupied);
-                    }
-                }
-            }
-        }
+        let mut g = boxed(res, [14, 10, 8]);
+        scatter(&mut g, [1; 3], [13, 9, 7], density, &mut rng);
         let c = ctx(g, 0.0);
         let lat = HeadLattice::new(&c, 0.0, 2.0);
         let (lo, hi) = c.field().grid().bounds();

@@ -2,27 +2,11 @@
 
 use proptest::prelude::*;
 
+use super::super::super::random_grids::grids;
 use super::super::super::row_gaps::FAR;
 use super::*;
 
-/// A grid of `dims` at origin `(-3, 2, -1)` whose voxels take their states from
-/// `cells` (cycled): a tenth occupied, a tenth unknown.
-fn random_grid(dims: [usize; 3], cells: &[u8], unknown_occ: bool) -> Grid {
-    let mut g = Grid::new(0.1, [-3, 2, -1], dims, Cell::Free, unknown_occ).unwrap();
-    let o = g.origin();
-    let mut k = 0;
-    for z in 0..dims[2] {
-        for y in 0..dims[1] {
-            for x in 0..dims[0] {
-                let i = [o[0] + x as i32, o[1] + y as i32, o[2] + z as i32];
-                g.set(i, state(cells[k % cells.len()]));
-                k += 1;
-            }
-        }
-    }
-    g
-}
-
+/// Three tenths of the voxels occupied, two unknown.
 fn state(v: u8) -> Cell {
     match v % 10 {
         0..=2 => Cell::Occupied,
@@ -95,16 +79,14 @@ proptest! {
     #[test]
     fn updates_equal_a_recomputation(
         // Up to 12 a side: y columns wider than `WIDE_WINDOW` take the other path.
-        dims in proptest::array::uniform3(1usize..13),
-        cells in proptest::collection::vec(any::<u8>(), 1..200),
-        unknown_occ in any::<bool>(),
+        grid in grids(1..13, state),
         prepared in any::<bool>(),
         batches in proptest::collection::vec(
             proptest::collection::vec((0u8..3, any::<[u8; 3]>(), any::<u8>()), 1..12),
             1..5,
         ),
     ) {
-        let grid = random_grid(dims, &cells, unknown_occ);
+        let dims = grid.dims();
         let mut f = DistanceField::new(grid);
         if prepared {
             f.prepare_updates();
