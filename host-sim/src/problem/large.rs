@@ -16,9 +16,9 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use super::scenarios::{fill, points, shell_box, Scenario};
+use super::scenarios::{along, fill, shell_box, Scenario};
 use super::ProblemError;
-use crate::map::grid::{Cell, Grid};
+use crate::map::grid::Cell;
 
 /// Allowed resolutions of `campus:RES` (m).
 pub const CAMPUS_RESOLUTIONS: std::ops::RangeInclusive<f64> = 0.1..=0.4;
@@ -61,22 +61,6 @@ pub fn build(name: &str) -> Option<Result<Scenario, ProblemError>> {
     } else {
         hall(res)
     }))
-}
-
-/// A scenario for the default chain (5 units) that starts at the first point of
-/// `route`, trailing along -y (yaw 90 degrees), and ends at its last.
-fn along(name: String, description: &str, grid: Grid, route: &[[f64; 3]]) -> Scenario {
-    let route = points(route);
-    Scenario {
-        name,
-        description: description.into(),
-        grid,
-        start: route[0],
-        start_yaw: FRAC_PI_2,
-        goal: route[route.len() - 1],
-        default_units: 5,
-        route,
-    }
 }
 
 /// Campus block pitch (m): a 12 m building and an 8 m street.
@@ -125,12 +109,9 @@ pub fn campus(res: f64) -> Scenario {
                       through the building in its way, around it by the streets; an open-air hop \
                       is --start 40,20,10 --goal 45,20,10 (4 m from every building).",
         g,
-        &[
-            [2.0, 50.0, 2.0],
-            [2.0, 60.0, 2.0],
-            [98.0, 60.0, 2.0],
-            [98.0, 50.0, 2.0],
-        ],
+        FRAC_PI_2,
+        2.0,
+        &[[2.0, 50.0], [2.0, 60.0], [98.0, 60.0], [98.0, 50.0]],
     )
 }
 
@@ -209,11 +190,8 @@ pub fn hall(res: f64) -> Scenario {
                       first room on one side to the last on the other; a hop in the corridor is \
                       --start 20,20,1.3 --start-yaw-deg 0 --goal 25,20,1.3.",
         g,
-        &[
-            [3.0, 10.0, 1.3],
-            [3.0, 20.0, 1.3],
-            [57.0, 20.0, 1.3],
-            [57.0, 30.0, 1.3],
-        ],
+        FRAC_PI_2,
+        1.3,
+        &[[3.0, 10.0], [3.0, 20.0], [57.0, 20.0], [57.0, 30.0]],
     )
 }

@@ -73,6 +73,30 @@ pub(crate) fn points(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
     v.iter().map(|&p| p.into()).collect()
 }
 
+/// A scenario for the default chain (5 units) whose head starts at the first point of
+/// `route` at `start_yaw` and ends at its last; the route runs at the height `z`, so its
+/// points are given as `[x, y]`.
+pub(super) fn along(
+    name: impl Into<String>,
+    description: impl Into<String>,
+    grid: Grid,
+    start_yaw: f64,
+    z: f64,
+    route: &[[f64; 2]],
+) -> Scenario {
+    let route: Vec<Point3<f64>> = route.iter().map(|&[x, y]| Point3::new(x, y, z)).collect();
+    Scenario {
+        name: name.into(),
+        description: description.into(),
+        grid,
+        start: route[0],
+        start_yaw,
+        goal: route[route.len() - 1],
+        default_units: 5,
+        route,
+    }
+}
+
 /// A scenario by name: `window`, `maze`, `silos`, `corridor` (20 m) or `corridor:L`
 /// (`L` metres, 10 to 100).
 pub fn build(name: &str) -> Result<Scenario, ProblemError> {
@@ -144,29 +168,26 @@ pub fn window() -> Scenario {
     // centred at y = 3.0, z = 1.5 (faces on the voxel lattice).
     solid(&mut g, [4.0, 0.0, 0.0], [4.2, sy, sz]);
     open(&mut g, [4.0, 2.6, 1.1], [4.2, 3.4, 1.9]);
-    Scenario {
-        name: "window".into(),
-        description: "Env 1: two rooms (3.8 m and 3.6 m deep, 5.6 m wide, 2.6 m high) joined by a \
-                      0.8 m x 0.8 m window in the 0.2 m dividing wall. The chain starts across the \
-                      room, perpendicular to the window, and must turn to pass it end first."
-            .into(),
-        grid: g,
-        start: Point3::new(2.0, 4.5, 1.5),
-        start_yaw: FRAC_PI_2,
-        goal: Point3::new(6.6, 3.0, 1.5),
-        default_units: 5,
-        route: points(&[
-            [2.0, 4.5, 1.5],
-            [2.0, 5.0, 1.5],
-            [2.4, 5.3, 1.5],
-            [3.0, 5.2, 1.5],
-            [3.3, 4.6, 1.5],
-            [3.4, 3.6, 1.5],
-            [3.55, 3.1, 1.5],
-            [3.8, 3.0, 1.5],
-            [6.6, 3.0, 1.5],
-        ]),
-    }
+    along(
+        "window",
+        "Env 1: two rooms (3.8 m and 3.6 m deep, 5.6 m wide, 2.6 m high) joined by a \
+         0.8 m x 0.8 m window in the 0.2 m dividing wall. The chain starts across the \
+         room, perpendicular to the window, and must turn to pass it end first.",
+        g,
+        FRAC_PI_2,
+        1.5,
+        &[
+            [2.0, 4.5],
+            [2.0, 5.0],
+            [2.4, 5.3],
+            [3.0, 5.2],
+            [3.3, 4.6],
+            [3.4, 3.6],
+            [3.55, 3.1],
+            [3.8, 3.0],
+            [6.6, 3.0],
+        ],
+    )
 }
 
 /// Env 2 of the paper: a zig-zag room.
@@ -178,41 +199,38 @@ pub fn maze() -> Scenario {
     solid(&mut g, [5.2, 1.4, 0.0], [5.4, sy, sz]);
     solid(&mut g, [7.7, 0.0, 0.0], [7.9, 5.0, sz]);
     let z = 1.4;
-    Scenario {
-        name: "maze".into(),
-        description: "Env 2: a 10 m x 6 m room split by three walls into four bays (2.3-2.5 m wide) \
+    along(
+        "maze",
+        "Env 2: a 10 m x 6 m room split by three walls into four bays (2.3-2.5 m wide) \
                       joined by 1.2 m gaps at alternating ends, so the way zig-zags. A straight chain \
                       of 5 units (2 m plus its spheres) fits in no bay across and through no gap \
-                      sideways: it must bend around every wall end."
-            .into(),
-        grid: g,
-        start: Point3::new(1.45, 4.0, z),
-        start_yaw: FRAC_PI_2,
-        goal: Point3::new(9.05, 3.5, z),
-        default_units: 5,
-        route: points(&[
-            [1.45, 4.0, z],
-            [1.45, 5.0, z],
-            [1.75, 5.45, z],
-            [2.3, 5.6, z],
-            [3.3, 5.6, z],
-            [3.85, 5.45, z],
-            [4.05, 5.0, z],
-            [4.05, 1.4, z],
-            [4.25, 0.95, z],
-            [4.8, 0.8, z],
-            [5.8, 0.8, z],
-            [6.35, 0.95, z],
-            [6.55, 1.4, z],
-            [6.55, 5.0, z],
-            [6.75, 5.45, z],
-            [7.3, 5.6, z],
-            [8.3, 5.6, z],
-            [8.85, 5.45, z],
-            [9.05, 5.0, z],
-            [9.05, 3.5, z],
-        ]),
-    }
+                      sideways: it must bend around every wall end.",
+        g,
+        FRAC_PI_2,
+        z,
+        &[
+            [1.45, 4.0],
+            [1.45, 5.0],
+            [1.75, 5.45],
+            [2.3, 5.6],
+            [3.3, 5.6],
+            [3.85, 5.45],
+            [4.05, 5.0],
+            [4.05, 1.4],
+            [4.25, 0.95],
+            [4.8, 0.8],
+            [5.8, 0.8],
+            [6.35, 0.95],
+            [6.55, 1.4],
+            [6.55, 5.0],
+            [6.75, 5.45],
+            [7.3, 5.6],
+            [8.3, 5.6],
+            [8.85, 5.45],
+            [9.05, 5.0],
+            [9.05, 3.5],
+        ],
+    )
 }
 
 /// The application demo: two silos with a narrow gap between them.
@@ -230,30 +248,27 @@ pub fn silos() -> Scenario {
         let db = (c[0] - xc).hypot(c[1] - yb);
         da <= r || db <= r
     });
-    Scenario {
-        name: "silos".into(),
-        description: "The application demo: two silos (radius 2.5 m, 5 m high) stand side by side \
+    along(
+        "silos",
+        "The application demo: two silos (radius 2.5 m, 5 m high) stand side by side \
                       across a 14 m x 10.4 m yard, touching its sides, with a 0.8 m gap between \
                       them. There is room to inspect around each silo on both sides; the only way \
-                      from west to east is end first through the gap."
-            .into(),
-        grid: g,
-        start: Point3::new(3.0, 5.2, 2.0),
-        start_yaw: FRAC_PI_2,
-        goal: Point3::new(11.0, 5.2, 2.0),
-        default_units: 5,
-        route: points(&[
-            [3.0, 5.2, 2.0],
-            [3.0, 6.0, 2.0],
-            [3.4, 6.6, 2.0],
-            [4.0, 6.7, 2.0],
-            [4.5, 6.3, 2.0],
-            [4.6, 5.6, 2.0],
-            [4.8, 5.25, 2.0],
-            [5.3, 5.2, 2.0],
-            [11.0, 5.2, 2.0],
-        ]),
-    }
+                      from west to east is end first through the gap.",
+        g,
+        FRAC_PI_2,
+        2.0,
+        &[
+            [3.0, 5.2],
+            [3.0, 6.0],
+            [3.4, 6.6],
+            [4.0, 6.7],
+            [4.5, 6.3],
+            [4.6, 5.6],
+            [4.8, 5.25],
+            [5.3, 5.2],
+            [11.0, 5.2],
+        ],
+    )
 }
 
 /// A long corridor with doors at alternating sides, `length` metres (10 to 100).
@@ -286,37 +301,28 @@ pub fn corridor(length: f64) -> Result<Scenario, ProblemError> {
     // Route: straight from the start, then a sine through every door's centre
     // (y = yc + amp sin(pi (x - s0) / 2), extreme at each door), then straight on.
     let s0 = FIRST - 0.9;
-    let start = [s0 - 0.1, yc, z];
     let last = doors.last().copied().unwrap_or(s0) + 0.1;
     let end_s = last + 1.0;
-    let goal = [sx - 1.0, yc, z];
-    let mut route = vec![start, [s0, yc, z]];
+    let mut route = vec![[s0 - 0.1, yc], [s0, yc]];
     let mut x = s0 + 0.1;
     while x < end_s - 1e-9 {
-        route.push([x, yc + amp * (PI * (x - s0) / 2.0).sin(), z]);
+        route.push([x, yc + amp * (PI * (x - s0) / 2.0).sin()]);
         x += 0.1;
     }
-    route.push([end_s, yc, z]);
-    route.push(goal);
-    Ok(Scenario {
-        name: if length == DEFAULT_CORRIDOR_LENGTH {
-            "corridor".into()
-        } else {
-            format!("corridor:{length}")
-        },
-        description: format!(
-            "A {sx:.1} m corridor (2 m x 2 m inside) with {} doors 2 m apart, each 0.8 m wide, \
-             alternately 0.45 m left and right of the axis. A straight chain of 5 units is longer \
-             than the space between two doors, so it cannot shift sideways: it must snake.",
-            doors.len()
-        ),
-        grid: g,
-        start: start.into(),
-        start_yaw: 0.0,
-        goal: goal.into(),
-        default_units: 5,
-        route: points(&route),
-    })
+    route.push([end_s, yc]);
+    route.push([sx - 1.0, yc]);
+    let name = if length == DEFAULT_CORRIDOR_LENGTH {
+        "corridor".into()
+    } else {
+        format!("corridor:{length}")
+    };
+    let description = format!(
+        "A {sx:.1} m corridor (2 m x 2 m inside) with {} doors 2 m apart, each 0.8 m wide, \
+         alternately 0.45 m left and right of the axis. A straight chain of 5 units is longer \
+         than the space between two doors, so it cannot shift sideways: it must snake.",
+        doors.len()
+    );
+    Ok(along(name, description, g, 0.0, z, &route))
 }
 
 /// The poses of a witness plan ([`Scenario::route_poses`]) and the chain they are for.
