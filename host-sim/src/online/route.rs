@@ -35,6 +35,17 @@ pub struct Route {
 }
 
 impl Route {
+    /// The route through `points` on `field`, its radius the smallest bound of its
+    /// points after the first, at most the route radius.
+    fn on(field: &DistanceField, points: Vec<Point3<f64>>, radii: Radii) -> Self {
+        let radius = points
+            .iter()
+            .skip(1)
+            .map(|p| field.voxel_clearance(field.grid().lattice_index(*p)))
+            .fold(radii.route, f64::min);
+        Route { points, radius }
+    }
+
     /// Its length (m).
     pub fn length(&self) -> f64 {
         self.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
@@ -144,9 +155,11 @@ fn narrow_cost(voxels: usize) -> f64 {
     voxels as f64 * 3f64.sqrt()
 }
 
-/// Searches `field` from `from` to within `tol` of `goal` through the voxels at the
-/// proof radius, a metre below the route radius costing more than any route that keeps
-/// it (`narrow_cost`).
+/// Searches `field` from `from` to within `tol` of `goal`: an A* over the 26-connected
+/// voxels whose bound is at least the proof radius (the start voxel always), Euclidean
+/// costs, [`narrow_cost`] times that below the route radius. Goal voxels: centres
+/// within `tol` plus half a voxel diagonal of `goal`, so that every head position
+/// within `tol` has its voxel among them.
 pub fn search(
     scratch: &mut Scratch,
     field: &DistanceField,
@@ -155,40 +168,12 @@ pub fn search(
     tol: f64,
     radii: Radii,
 ) -> Found {
-    match astar(scratch, field, from, goal, tol, radii) {
-        Ok(points) => {
-            let radius = points
-                .iter()
-                .skip(1)
-                .map(|p| field.voxel_clearance(field.grid().lattice_index(*p)))
-                .fold(radii.route, f64::min);
-            Found::Route(Route { points, radius })
-        }
-        Err(reached) => Found::Sealed { reached },
-    }
-}
-
-/// A* over the 26-connected voxels whose bound is at least the proof radius (the start
-/// voxel always), Euclidean costs ([`narrow_cost`] times that below the route radius).
-/// Goal voxels: centres within `tol` plus half a voxel diagonal of `goal`, so that every
-/// head position within `tol` has its voxel among them. `Err` holds the number of
-/// voxels reached.
-fn astar(
-    scratch: &mut Scratch,
-    field: &DistanceField,
-    from: Point3<f64>,
-    goal: Point3<f64>,
-    tol: f64,
-    radii: Radii,
-) -> Result<Vec<Point3<f64>>, usize> {
     let grid = field.grid();
-    let dims = grid.dims();
-    let r_v = grid.resolution();
-    let reach = tol + 3f64.sqrt() / 2.0 * r_v;
     let Some(start) = grid.local(grid.lattice_index(from)) else {
-        return Err(0);
+        return Found::Sealed { reached: 0 };
     };
-    let o = grid.origin();
+    let (dims, o, r_v) = (grid.dims(), grid.origin(), grid.resolution());
+    let reach = tol + 3f64.sqrt() / 2.0 * r_v;
     let unlinear = |k: usize| {
         [
             k % dims[0],
@@ -214,7 +199,8 @@ fn astar(
             continue; // a stale entry: the voxel was reached more cheaply since
         }
         if (centre(l) - goal).norm() <= reach {
-            return Ok(walk_back(scratch, k, |k| centre(unlinear(k))));
+            let points = walk_back(scratch, k, |k| centre(unlinear(k)));
+            return Found::Route(Route::on(field, points, radii));
         }
         for d in NEIGHBOURS {
             let Some(m) = step(l, d, dims) else { continue };
@@ -240,7 +226,7 @@ fn astar(
             heap.push(Reverse((key(gm + h(m)), km)));
         }
     }
-    Err(reached)
+    Found::Sealed { reached }
 }
 
 /// A non-negative cost as an ordered integer (IEEE order of non-negative floats).
@@ -315,19 +301,37 @@ mod tests {
         DistanceField::new(g)
     }
 
+    /// The search across the room of [`walled`] with a hole of `hole` m, from a metre
+    /// and a half before the wall to within 0.3 m of a metre and a half behind it, for a
+    /// head sphere of 0.2 m.
+    fn across(hole: f64) -> Found {
+        let from = Point3::new(0.5, 1.0, 1.0);
+        search(
+            &mut Scratch::default(),
+            &walled(hole),
+            from,
+            GOAL,
+            0.3,
+            radii(),
+        )
+    }
+
+    /// The goal of [`across`].
+    const GOAL: Point3<f64> = Point3::new(3.5, 1.0, 1.0);
+
+    /// The radii of [`across`]: a head sphere of 0.2 m on a map of 0.1 m.
+    fn radii() -> Radii {
+        Radii::new(0.2, 0.1)
+    }
+
     #[test]
     fn a_route_goes_through_the_hole_and_keeps_its_radius() {
-        let field = walled(0.8);
-        let radii = Radii::new(0.2, 0.1);
-        let from = Point3::new(0.5, 1.0, 1.0);
-        let goal = Point3::new(3.5, 1.0, 1.0);
-        let Found::Route(route) = search(&mut Scratch::default(), &field, from, goal, 0.3, radii)
-        else {
+        let Found::Route(route) = across(0.8) else {
             panic!("no route");
         };
-        assert_eq!(route.radius, radii.route);
-        assert!(route.holds(&field));
-        assert!((route.points.last().unwrap() - goal).norm() <= 0.3 + 0.09);
+        assert_eq!(route.radius, radii().route);
+        assert!(route.holds(&walled(0.8)));
+        assert!((route.points.last().unwrap() - GOAL).norm() <= 0.3 + 0.09);
         assert!(
             route.length() >= 2.6 && route.length() < 3.6,
             "{}",
@@ -337,47 +341,23 @@ mod tests {
 
     #[test]
     fn a_sealed_wall_and_a_small_hole_are_proven_sealed_and_a_larger_one_is_left_to_the_planner() {
-        let radii = Radii::new(0.2, 0.1);
-        let from = Point3::new(0.5, 1.0, 1.0);
-        let goal = Point3::new(3.5, 1.0, 1.0);
-        let found = search(
-            &mut Scratch::default(),
-            &walled(0.0),
-            from,
-            goal,
-            0.3,
-            radii,
-        );
+        let found = across(0.0);
         assert!(
             matches!(found, Found::Sealed { reached } if reached > 1000),
             "{found:?}"
         );
         // A hole of two voxels a side is too narrow for the head (0.2 m against a
         // sphere of 0.2 m radius), and the proof says so.
-        let two = search(
-            &mut Scratch::default(),
-            &walled(0.2),
-            from,
-            goal,
-            0.3,
-            radii,
-        );
+        let two = across(0.2);
         assert!(matches!(two, Found::Sealed { .. }), "{two:?}");
         // Four voxels a side is still too narrow, but the proof radius is conservative
         // by up to `(sqrt(3) - 1/2) r_v`: the route goes through at that radius and the
         // piece planner, exact, finds no way.
-        let Found::Route(r) = search(
-            &mut Scratch::default(),
-            &walled(0.4),
-            from,
-            goal,
-            0.3,
-            radii,
-        ) else {
+        let Found::Route(r) = across(0.4) else {
             panic!("the proof cannot seal a hole of four voxels");
         };
         assert!(
-            r.radius < radii.route && r.radius >= radii.proof,
+            r.radius < radii().route && r.radius >= radii().proof,
             "{}",
             r.radius
         );
