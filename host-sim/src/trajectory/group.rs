@@ -409,19 +409,28 @@ fn segment(edges: &[Segment], start: f64, end: f64) -> Segment {
 mod tests {
     use super::*;
 
-    /// The edges of waypoints `(head, yaw of a straight chain of 4 units)`.
-    fn edges(points: &[([f64; 3], f64)]) -> Vec<Segment> {
-        let w: Vec<Vec<f64>> = points
-            .iter()
-            .map(|(h, yaw)| {
-                let mut z = h.to_vec();
-                z.push(*yaw);
-                for _ in 0..3 {
-                    z.extend([0.0, *yaw]);
-                }
-                z
-            })
-            .collect();
+    /// A step of a straight chain of 4 units: its head along x or y (m), or a turn of
+    /// the chain about its head (rad).
+    #[derive(Clone, Copy, Debug)]
+    enum Step {
+        X(f64),
+        Y(f64),
+        Turn(f64),
+    }
+    use Step::{Turn, X, Y};
+
+    /// The edges of the waypoints `steps` reach from the head at `(0, 0, 1)`, yaw 0.
+    fn walk(steps: &[Step]) -> Vec<Segment> {
+        let (mut h, mut yaw) = ([0.0, 0.0, 1.0], 0.0);
+        let mut w = vec![zeta(h, yaw)];
+        for step in steps {
+            match *step {
+                X(d) => h[0] += d,
+                Y(d) => h[1] += d,
+                Turn(d) => yaw += d,
+            }
+            w.push(zeta(h, yaw));
+        }
         let lim = ReferenceLimits {
             start_hold: 0.0,
             ..Default::default()
@@ -430,6 +439,21 @@ mod tests {
             .unwrap()
             .segments()
             .to_vec()
+    }
+
+    /// `zeta` of the straight chain of 4 units with its head at `h` and yaw `yaw`.
+    fn zeta(h: [f64; 3], yaw: f64) -> Vec<f64> {
+        let mut z = h.to_vec();
+        z.push(yaw);
+        for _ in 0..3 {
+            z.extend([0.0, yaw]);
+        }
+        z
+    }
+
+    /// The edges of a chain of links of 0.5 m grouped, merging on.
+    fn grouped(e: &[Segment]) -> Grouping {
+        Grouping::new(e, 0.5, true, &Settings::default())
     }
 
     fn places(g: &Grouping) -> Vec<(f64, f64, bool)> {
@@ -452,14 +476,8 @@ mod tests {
     #[test]
     fn runs_join_what_lies_on_a_line_and_stop_at_corners() {
         // Three translations along x, then one along y: the first three are one run.
-        let e = edges(&[
-            ([0.0, 0.0, 1.0], 0.0),
-            ([0.1, 0.0, 1.0], 0.0),
-            ([0.2, 0.0, 1.0], 0.0),
-            ([0.3, 0.0, 1.0], 0.0),
-            ([0.3, 0.1, 1.0], 0.0),
-        ]);
-        let g = Grouping::new(&e, 0.5, true, &Settings::default());
+        let e = walk(&[X(0.1), X(0.1), X(0.1), Y(0.1)]);
+        let g = grouped(&e);
         assert_eq!(places(&g), [(0.0, 3.0, true), (3.0, 4.0, false)]);
         let off = Grouping::new(&e, 0.5, false, &Settings::default());
         assert_eq!(off.merged_corners(), 0);
@@ -479,26 +497,16 @@ mod tests {
         // straight move would swing the tail 1.5 * 0.1 rad off at the waypoint between,
         // past even a short step's tolerance, so only the pair (translation, turn) is
         // merged.
-        let e = edges(&[
-            ([0.0, 0.0, 1.0], 0.0),
-            ([0.1, 0.0, 1.0], 0.0),
-            ([0.1, 0.0, 1.0], 0.1),
-            ([0.2, 0.0, 1.0], 0.1),
-        ]);
-        let g = Grouping::new(&e, 0.5, true, &Settings::default());
+        let e = walk(&[X(0.1), Turn(0.1), X(0.1)]);
+        let g = grouped(&e);
         assert_eq!(places(&g), [(0.0, 2.0, true), (2.0, 3.0, false)]);
     }
 
     #[test]
     fn a_pair_flies_less_of_its_translation_then_the_other_one_then_comes_apart() {
         // 2 m along x, a turn of the chain by 0.4 rad, 2 m along x again.
-        let e = edges(&[
-            ([0.0, 0.0, 1.0], 0.0),
-            ([2.0, 0.0, 1.0], 0.0),
-            ([2.0, 0.0, 1.0], 0.4),
-            ([4.0, 0.0, 1.0], 0.4),
-        ]);
-        let mut g = Grouping::new(&e, 0.5, true, &Settings::default());
+        let e = walk(&[X(2.0), Turn(0.4), X(2.0)]);
+        let mut g = grouped(&e);
         covers(&g, 3);
         assert_eq!(places(&g), [(0.0, 2.0, true), (2.0, 3.0, false)]);
         assert_eq!(g.merged_corners(), 1);
@@ -542,12 +550,8 @@ mod tests {
     fn no_pair_is_shrunk_to_a_sliver() {
         // 0.3 m, then a turn: the pair flies 0.15 m, then comes apart (0.075 m would be
         // under the shortest piece); nothing after the turn to pair with.
-        let e = edges(&[
-            ([0.0, 0.0, 1.0], 0.0),
-            ([0.3, 0.0, 1.0], 0.0),
-            ([0.3, 0.0, 1.0], 0.4),
-        ]);
-        let mut g = Grouping::new(&e, 0.5, true, &Settings::default());
+        let e = walk(&[X(0.3), Turn(0.4)]);
+        let mut g = grouped(&e);
         assert_eq!(places(&g), [(0.0, 2.0, true)]);
         assert!(g.undo(0, &e));
         assert_eq!(places(&g), [(0.0, 0.5, false), (0.5, 2.0, true)]);
@@ -558,14 +562,8 @@ mod tests {
     #[test]
     fn a_short_translation_is_taken_whole_and_blocks_nothing_else() {
         // 0.2 m, a turn, 0.2 m, a turn back: each turn takes the translation before it.
-        let e = edges(&[
-            ([0.0, 0.0, 1.0], 0.0),
-            ([0.2, 0.0, 1.0], 0.0),
-            ([0.2, 0.0, 1.0], 0.4),
-            ([0.4, 0.0, 1.0], 0.4),
-            ([0.4, 0.0, 1.0], 0.0),
-        ]);
-        let g = Grouping::new(&e, 0.5, true, &Settings::default());
+        let e = walk(&[X(0.2), Turn(0.4), X(0.2), Turn(-0.4)]);
+        let g = grouped(&e);
         covers(&g, 4);
         assert_eq!(places(&g), [(0.0, 2.0, true), (2.0, 4.0, true)]);
         assert_eq!(g.merged_corners(), 2);
@@ -580,18 +578,16 @@ mod tests {
             kinds in proptest::collection::vec((0u8..3, 0.05f64..3.0), 1..24),
             picks in proptest::collection::vec(0usize..1000, 0..400),
         ) {
-            let mut points = vec![([0.0, 0.0, 1.0], 0.0)];
-            for (kind, size) in &kinds {
-                let (mut h, mut yaw) = *points.last().unwrap();
-                match kind {
-                    0 => h[0] += size,
-                    1 => yaw += size / 4.0,
-                    _ => h[1] += size,
-                }
-                points.push((h, yaw));
-            }
-            let e = edges(&points);
-            let mut g = Grouping::new(&e, 0.5, true, &Settings::default());
+            let steps: Vec<Step> = kinds
+                .iter()
+                .map(|&(kind, size)| match kind {
+                    0 => X(size),
+                    1 => Turn(size / 4.0),
+                    _ => Y(size),
+                })
+                .collect();
+            let e = walk(&steps);
+            let mut g = grouped(&e);
             covers(&g, e.len());
             let corners = e.len() - 1;
             let mut undone = 0;
