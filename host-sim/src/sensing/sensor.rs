@@ -288,78 +288,29 @@ mod tests {
 
     #[test]
     fn bad_settings_name_the_field_and_value() {
-        let cases: Vec<(DepthSensor, &str)> = vec![
+        let cases: [(fn(&mut DepthSensor), &str); 9] = [
+            (|s| s.fov_h_deg = 180.0, "fov_h_deg = 180.0"),
+            (|s| s.fov_v_deg = 0.0, "fov_v_deg = 0.0"),
+            (|s| s.fov_v_deg = f64::NAN, "fov_v_deg = NaN"),
+            (|s| s.min_range = -0.1, "min_range = -0.1"),
+            (|s| s.max_range = 0.2, "max_range = 0.2"),
+            (|s| s.resolution_deg = 0.0, "resolution_deg = 0.0"),
             (
-                DepthSensor {
-                    fov_h_deg: 180.0,
-                    ..Default::default()
-                },
-                "fov_h_deg = 180.0",
-            ),
-            (
-                DepthSensor {
-                    fov_v_deg: 0.0,
-                    ..Default::default()
-                },
-                "fov_v_deg = 0.0",
-            ),
-            (
-                DepthSensor {
-                    fov_v_deg: f64::NAN,
-                    ..Default::default()
-                },
-                "fov_v_deg = NaN",
-            ),
-            (
-                DepthSensor {
-                    min_range: -0.1,
-                    ..Default::default()
-                },
-                "min_range = -0.1",
-            ),
-            (
-                DepthSensor {
-                    max_range: 0.2,
-                    ..Default::default()
-                },
-                "max_range = 0.2",
-            ),
-            (
-                DepthSensor {
-                    resolution_deg: 0.0,
-                    ..Default::default()
-                },
-                "resolution_deg = 0.0",
-            ),
-            (
-                DepthSensor {
-                    resolution_deg: 0.1,
-                    ..Default::default()
-                },
+                |s| s.resolution_deg = 0.1,
                 "resolution_deg = 0.1: gives 506051 rays per scan, more than 100000",
             ),
             (
-                DepthSensor {
-                    mount: Mount {
-                        rotation: [1.0, 1.0, 0.0, 0.0],
-                        ..Default::default()
-                    },
-                    ..Default::default()
-                },
+                |s| s.mount.rotation = [1.0, 1.0, 0.0, 0.0],
                 "mount.rotation = [1.0, 1.0, 0.0, 0.0]",
             ),
             (
-                DepthSensor {
-                    mount: Mount {
-                        offset: [0.0, f64::INFINITY, 0.0],
-                        ..Default::default()
-                    },
-                    ..Default::default()
-                },
+                |s| s.mount.offset = [0.0, f64::INFINITY, 0.0],
                 "mount.offset = [0.0, inf, 0.0]",
             ),
         ];
-        for (s, expected) in cases {
+        for (change, expected) in cases {
+            let mut s = DepthSensor::default();
+            change(&mut s);
             let e = s.validate().expect_err(expected).to_string();
             assert!(e.contains(expected), "{e:?} should say {expected:?}");
             assert!(s.body_rays().is_empty());
