@@ -208,6 +208,18 @@ pub(crate) struct Draft {
     pub(crate) notes: Notes,
 }
 
+impl Draft {
+    /// The search's plan of `cx` as the stages first take it, in the search's context.
+    pub(crate) fn of(cx: &Context) -> Self {
+        Draft {
+            steps: cx.raw.to_vec(),
+            ctx: cx.ctx.clone(),
+            checks: 0,
+            notes: Notes::default(),
+        }
+    }
+}
+
 /// What the stages record on a draft.
 #[derive(Clone, Default)]
 pub(crate) struct Notes {
@@ -250,13 +262,7 @@ pub(crate) trait Select: Sync + Send {
 /// Post-processes `cx.raw` through the declared list: the plan, and what was done.
 pub(crate) fn post_process(cx: &Context) -> (Vec<Step>, Refinement) {
     let began = Instant::now();
-    let draft = Draft {
-        steps: cx.raw.to_vec(),
-        ctx: cx.ctx.clone(),
-        checks: 0,
-        notes: Notes::default(),
-    };
-    let (out, stages) = driver::run(&post_processing(), draft, cx);
+    let (out, stages) = driver::run(&post_processing(), Draft::of(cx), cx);
     let n = out.notes;
     let first = n.first_widening.map(|f| f.1).unwrap_or_default();
     let last = n.widening;

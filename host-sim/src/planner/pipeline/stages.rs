@@ -113,12 +113,18 @@ fn measurements(cx: &Context, w: &Widening) -> Budget {
     }
 }
 
-/// Widens `draft`'s plan in its context (`super::super::widen`): what that did.
-fn widened(draft: &mut Draft, cx: &Context) -> Widening {
+/// Widens `draft`'s plan in its context (`super::super::widen`), notes what that did
+/// on it by `note`, and gives it with the budget spent.
+fn widened(
+    mut draft: Draft,
+    cx: &Context,
+    note: impl FnOnce(&mut Draft, Widening),
+) -> (Draft, Budget) {
     let steps = std::mem::take(&mut draft.steps);
     let (steps, w) = widen(&draft.ctx, cx.ctx_min, steps, cx.deadline, &cx.s.widen);
     draft.steps = steps;
-    w
+    note(&mut draft, w);
+    (draft, measurements(cx, &w))
 }
 
 /// The search's plan widened (`super::super::widen`), where it has the most stations
@@ -130,10 +136,10 @@ impl Stage for WidenFirst {
         "widen"
     }
 
-    fn run(&self, mut draft: Draft, cx: &Context) -> (Draft, Budget) {
-        let w = widened(&mut draft, cx);
-        draft.notes.first_widening = Some(Arc::new((draft.steps.clone(), w)));
-        (draft, measurements(cx, &w))
+    fn run(&self, draft: Draft, cx: &Context) -> (Draft, Budget) {
+        widened(draft, cx, |d, w| {
+            d.notes.first_widening = Some(Arc::new((d.steps.clone(), w)));
+        })
     }
 }
 
@@ -223,9 +229,7 @@ impl Stage for WidenAgain {
                 return (draft, used);
             }
         }
-        let w = widened(&mut draft, cx);
-        draft.notes.widening = w;
-        (draft, measurements(cx, &w))
+        widened(draft, cx, |d, w| d.notes.widening = w)
     }
 }
 

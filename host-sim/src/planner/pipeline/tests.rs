@@ -46,15 +46,6 @@ fn verified(grid: &Grid, params: &ChainParams, steps: &[Step]) -> Result<(), Str
     }
 }
 
-fn draft(cx: &Context) -> Draft {
-    Draft {
-        steps: cx.raw.to_vec(),
-        ctx: cx.ctx.clone(),
-        checks: 0,
-        notes: Notes::default(),
-    }
-}
-
 /// Runs `list` one stage after the other from the search's plan, holding every
 /// plan a stage gives to the exact verifier, its start to the search's start and its
 /// head's end to the search's; the last draft (where a stage gives its lane up, as
@@ -62,7 +53,7 @@ fn draft(cx: &Context) -> Draft {
 fn each_verified(planner: &ArcPlanner, raw: &[Step], grid: &Grid, list: &[&dyn Stage]) -> Draft {
     let cx = planner.post_context(raw, None);
     let params = *cx.ctx.params();
-    let mut d = draft(&cx);
+    let mut d = Draft::of(&cx);
     for s in list {
         let (out, _) = s.run(d, &cx);
         d = out;
@@ -78,21 +69,32 @@ fn each_verified(planner: &ArcPlanner, raw: &[Step], grid: &Grid, list: &[&dyn S
     d
 }
 
-/// The stages of the main lane, in the plain lane's order, on the maze (where the
-/// search's plan bends round every wall end and carrying takes over).
+/// The stages of the main lane, in the plain lane's order.
+const MAIN_LANE: [&dyn Stage; 7] = [
+    &stages::Shortcut,
+    &stages::ShrinkChanges,
+    &stages::HoldYaw,
+    &stages::ReplaceRuns,
+    &stages::Straighten,
+    &stages::Carry,
+    &stages::WidenAgain,
+];
+
+/// The widened lane's own stages (widening, the margin it won) and the shortcuts
+/// that keep to that margin.
+const WIDENED_LANE: [&dyn Stage; 4] = [
+    &stages::WidenFirst,
+    &stages::KeepMargin,
+    &stages::Shortcut,
+    &stages::ReplaceRuns,
+];
+
+/// The main lane on the maze (where the search's plan bends round every wall end and
+/// carrying takes over).
 #[test]
 fn every_main_lane_stage_gives_a_plan_the_exact_verifier_passes() {
     let (planner, raw, grid) = solved("maze", 4);
-    let list: [&dyn Stage; 7] = [
-        &stages::Shortcut,
-        &stages::ShrinkChanges,
-        &stages::HoldYaw,
-        &stages::ReplaceRuns,
-        &stages::Straighten,
-        &stages::Carry,
-        &stages::WidenAgain,
-    ];
-    let out = each_verified(&planner, &raw, &grid, &list);
+    let out = each_verified(&planner, &raw, &grid, &MAIN_LANE);
     assert!(
         !out.notes.withdrawn && out.notes.carried.is_some(),
         "the maze is carried"
@@ -106,13 +108,7 @@ fn every_main_lane_stage_gives_a_plan_the_exact_verifier_passes() {
 #[test]
 fn widening_keeping_its_margin_and_threading_give_plans_the_exact_verifier_passes() {
     let (planner, raw, grid) = solved("window", 3);
-    let widened: [&dyn Stage; 4] = [
-        &stages::WidenFirst,
-        &stages::KeepMargin,
-        &stages::Shortcut,
-        &stages::ReplaceRuns,
-    ];
-    let out = each_verified(&planner, &raw, &grid, &widened);
+    let out = each_verified(&planner, &raw, &grid, &WIDENED_LANE);
     assert!(
         !out.notes.withdrawn,
         "the window keeps the margin widening won"
