@@ -12,11 +12,19 @@ fn window() -> (Grid, CollisionContext) {
     let mut g = Grid::new(0.05, [-20, -10, 0], [100, 60, 40], Cell::Free, false).unwrap();
     g.fill_box([2.01, -0.5, 0.0], [2.14, 2.5, 2.0], Cell::Occupied);
     g.fill_box([2.01, 0.76, 0.76], [2.14, 1.24, 1.24], Cell::Free);
-    let field = Arc::new(DistanceField::new(g.clone()));
-    (
-        g,
-        CollisionContext::new(field, ChainParams::new(4), 0.05).unwrap(),
-    )
+    (g.clone(), context(g))
+}
+
+/// The context of a chain of 4 units at 0.05 m of clearance on `g`.
+fn context(g: Grid) -> CollisionContext {
+    CollisionContext::new(Arc::new(DistanceField::new(g)), ChainParams::new(4), 0.05).unwrap()
+}
+
+/// The head `route` with its pinches' axes put in, and the pinches.
+fn straightened(ctx: &CollisionContext, route: &[[f64; 3]]) -> (Vec<Point3<f64>>, Vec<Pinch>) {
+    let route: Vec<Point3<f64>> = route.iter().map(|&p| p.into()).collect();
+    let s = ThreadSettings::default();
+    Router { ctx, s: &s }.straightened(&route)
 }
 
 #[test]
@@ -87,18 +95,8 @@ fn a_tunnel_axis_runs_through_the_middles_of_its_ends() {
     let mut g = Grid::new(0.05, [-20, -10, 0], [120, 60, 40], Cell::Free, false).unwrap();
     g.fill_box([2.01, -0.5, 0.0], [2.99, 2.5, 2.0], Cell::Occupied);
     g.fill_box([2.01, 0.71, 0.76], [2.99, 1.24, 1.29], Cell::Free);
-    let field = Arc::new(DistanceField::new(g));
-    let ctx = CollisionContext::new(field, ChainParams::new(4), 0.05).unwrap();
-    let route = [
-        Point3::new(0.6, 0.2, 1.0),
-        Point3::new(2.5, 1.05, 1.04),
-        Point3::new(4.4, 1.9, 1.0),
-    ];
-    let (_, pinches) = Router {
-        ctx: &ctx,
-        s: &ThreadSettings::default(),
-    }
-    .straightened(&route);
+    let route = [[0.6, 0.2, 1.0], [2.5, 1.05, 1.04], [4.4, 1.9, 1.0]];
+    let (_, pinches) = straightened(&context(g), &route);
     assert_eq!(pinches.len(), 1);
     let p = pinches[0];
     // Both ends on the tunnel's axis, outside its mouths: a degree off over the
@@ -114,19 +112,12 @@ fn a_tunnel_axis_runs_through_the_middles_of_its_ends() {
 #[test]
 fn a_pinch_becomes_its_axis_through_the_middle() {
     let (_, ctx) = window();
-    let route = [
-        Point3::new(0.6, 0.4, 1.0),
-        Point3::new(2.07, 1.04, 1.02),
-        Point3::new(3.6, 1.8, 1.0),
-    ];
-    let (out, pinches) = Router {
-        ctx: &ctx,
-        s: &ThreadSettings::default(),
-    }
-    .straightened(&route);
+    let route = [[0.6, 0.4, 1.0], [2.07, 1.04, 1.02], [3.6, 1.8, 1.0]];
+    let (out, pinches) = straightened(&ctx, &route);
     assert_eq!(pinches.len(), 1);
     assert!((pinches[0].middle - 0.1).abs() < 0.01, "{pinches:?}");
-    assert_eq!((out[0], out[out.len() - 1]), (route[0], route[2]));
+    let ends = (out[0], out[out.len() - 1]);
+    assert_eq!(ends, (route[0].into(), route[2].into()));
     // Two points on the window's axis (y = z = 1), one on each side of the wall.
     let on_axis: Vec<_> = out
         .iter()
