@@ -25,6 +25,13 @@ fn room(wall: bool) -> CollisionContext {
     CollisionContext::new(field, ChainParams::new(4), 0.05).unwrap()
 }
 
+/// `steps` carried in `ctx` with the library of its chain and the default tuning.
+fn carry_in(ctx: &CollisionContext, steps: &[Step]) -> Option<(Vec<Step>, Carried)> {
+    let lsc = library(ctx.params()).entries;
+    let mut checker = Checker::new(ctx.clone(), None);
+    carried(&mut checker, &lsc, steps, &d(), &mut 0)
+}
+
 fn step(x: f64, shape: Shape, shape_change: bool) -> Step {
     Step {
         xi: Point3::new(x, 2.0, 1.5),
@@ -59,13 +66,9 @@ fn restless_plan() -> Vec<Step> {
 
 #[test]
 fn a_restless_plan_in_open_space_is_flown_in_its_start_shape() {
-    let ctx = room(false);
-    let lsc = library(ctx.params()).entries;
-    let mut checker = Checker::new(ctx.clone(), None);
     let steps = restless_plan();
     assert!(Quality::of(&steps).shape_changes >= d().min_changes);
-    let (out, carried) =
-        carried(&mut checker, &lsc, &steps, &d(), &mut 0).expect("the line flies it all");
+    let (out, carried) = carry_in(&room(false), &steps).expect("the line flies it all");
     assert_eq!(carried.kind, LscKind::Li);
     // No change at all: the line is the start shape, and the goal needs none.
     assert_eq!(Quality::of(&out).shape_changes, 0);
@@ -79,11 +82,8 @@ fn a_restless_plan_in_open_space_is_flown_in_its_start_shape() {
 #[test]
 fn a_carried_plan_passes_the_checks_through_a_window() {
     let ctx = room(true);
-    let lsc = library(ctx.params()).entries;
-    let mut checker = Checker::new(ctx.clone(), None);
     let steps = restless_plan();
-    let (out, _) =
-        carried(&mut checker, &lsc, &steps, &d(), &mut 0).expect("a line passes the window");
+    let (out, _) = carry_in(&ctx, &steps).expect("a line passes the window");
     assert_carried_plan_holds(&ctx, &steps, &out);
 }
 
@@ -164,9 +164,7 @@ proptest::proptest! {
         let steps = bent_plan(y, &before, &after);
         let valid = steps.windows(2).all(|w| edge_passes(&ctx, w));
         proptest::prop_assume!(valid);
-        let lsc = library(ctx.params()).entries;
-        let mut checker = Checker::new(ctx.clone(), None);
-        if let Some((out, carried)) = carried(&mut checker, &lsc, &steps, &d(), &mut 0) {
+        if let Some((out, carried)) = carry_in(&ctx, &steps) {
             assert_carried_plan_holds(&ctx, &steps, &out);
             proptest::prop_assert!(carried.head_path_m > 0.0);
         }
@@ -175,9 +173,6 @@ proptest::proptest! {
 
 #[test]
 fn plans_with_few_changes_are_left_alone() {
-    let ctx = room(false);
-    let lsc = library(ctx.params()).entries;
-    let mut checker = Checker::new(ctx, None);
     let line = Shape::line(4, 0.0);
     let steps = vec![
         step(2.0, line, false),
@@ -186,7 +181,7 @@ fn plans_with_few_changes_are_left_alone() {
         step(3.0, line, true),
         step(4.0, line, false),
     ];
-    assert!(carried(&mut checker, &lsc, &steps, &d(), &mut 0).is_none());
+    assert!(carry_in(&room(false), &steps).is_none());
 }
 
 #[test]
