@@ -56,15 +56,16 @@ fn units(l: f64, z: &[f64]) -> Vec<[f64; 3]> {
     p
 }
 
-/// Every limit at every sample by differences, and every sample valid by the exact
-/// test: the test's own reading of docs/model.md, independent of the generator.
-fn assert_respects_limits(
-    grid: &Grid,
-    params: &ChainParams,
-    lim: &Limits,
-    t: &[f64],
-    z: &[Vec<f64>],
-) {
+/// The trajectory of `plan` on `grid` with the default settings.
+fn built(plan: &Plan, grid: &Grid) -> Trajectory {
+    build(plan, grid, &Settings::default()).unwrap()
+}
+
+/// Every limit `tr` was made within at every sample by differences, and every sample
+/// valid by the exact test: the test's own reading of docs/model.md, independent of the generator.
+fn assert_respects_limits(grid: &Grid, tr: &Trajectory) {
+    let (params, lim) = (tr.params(), &tr.settings().limits);
+    let (t, z) = (tr.times(), tr.zetas());
     let l = params.link_length as f64;
     let slack = 1.0 + 1e-6;
     let angle = |a: f64| {
@@ -112,7 +113,7 @@ fn blended_tour_keeps_every_limit_and_is_faster() {
     let params = ChainParams::new(3);
     let (grid, plan) = (room(), tour(&params));
     let s = Settings::default();
-    let tr = build(&plan, &grid, &s).unwrap();
+    let tr = built(&plan, &grid);
     assert_eq!(tr.corners(), 3);
     assert_eq!(
         tr.merged(),
@@ -126,7 +127,7 @@ fn blended_tour_keeps_every_limit_and_is_faster() {
         tr.duration(),
         tr.stop_go_duration()
     );
-    assert_respects_limits(&grid, &params, &s.limits, tr.times(), tr.zetas());
+    assert_respects_limits(&grid, &tr);
     let rep = check_samples(&grid, &params, &s.limits, tr.times(), tr.zetas(), 0.5);
     assert!(rep.ok, "{:?}", rep.violation);
     // Starts at the plan's start, ends at rest at its end.
@@ -155,7 +156,7 @@ fn blended_tour_keeps_every_limit_and_is_faster() {
     let plain = build(&plan, &grid, &Settings { blend: false, ..s }).unwrap();
     assert_eq!((plain.blended(), plain.merged()), (0, 0));
     assert!((plain.duration() - plain.stop_go_duration()).abs() <= 4.0 * s.dt);
-    assert_respects_limits(&grid, &params, &s.limits, plain.times(), plain.zetas());
+    assert_respects_limits(&grid, &plain);
 }
 
 /// Head along +x, then up: the chain's tail rounds the corner below a voxel that the
@@ -176,17 +177,17 @@ fn corner(params: &ChainParams) -> Plan {
 fn a_blend_that_would_touch_the_map_is_not_flown() {
     let params = ChainParams::new(3);
     let s = Settings::default();
-    let free = build(&corner(&params), &room(), &s).unwrap();
+    let free = built(&corner(&params), &room());
     assert_eq!(free.blended(), 1);
     let mut grid = room();
     grid.fill_box([1.71, 0.51, 1.21], [1.79, 1.49, 1.29], Cell::Occupied);
-    let blocked = build(&corner(&params), &grid, &s).unwrap();
+    let blocked = built(&corner(&params), &grid);
     assert_eq!(
         blocked.blended(),
         0,
         "the rounded corner brings the tail onto the voxel"
     );
-    assert_respects_limits(&grid, &params, &s.limits, blocked.times(), blocked.zetas());
+    assert_respects_limits(&grid, &blocked);
     // The blended one does touch it: the check says where.
     let rep = check_samples(&grid, &params, &s.limits, free.times(), free.zetas(), 0.0);
     let v = rep.violation.expect("the blend touches the voxel");
@@ -225,7 +226,7 @@ fn the_check_names_what_is_wrong() {
     let params = ChainParams::new(3);
     let grid = room();
     let lim = Limits::default();
-    let tr = build(&tour(&params), &grid, &Settings::default()).unwrap();
+    let tr = built(&tour(&params), &grid);
     let (t, z) = (tr.times().to_vec(), tr.zetas().to_vec());
     let check = |t: &[f64], z: &[Vec<f64>]| {
         check_samples(&grid, &params, &lim, t, z, 0.0)
@@ -270,7 +271,7 @@ fn the_check_names_what_is_wrong() {
 fn file_round_trips_and_refuses_bad_records() {
     let params = ChainParams::new(3);
     let plan = tour(&params);
-    let tr = build(&plan, &room(), &Settings::default()).unwrap();
+    let tr = built(&plan, &room());
     let file = TrajectoryFile::new(&tr, &plan);
     let text = serde_json::to_string(&file).unwrap();
     let back = TrajectoryFile::parse(&text, "t.json").unwrap();
@@ -306,7 +307,7 @@ fn file_round_trips_and_refuses_bad_records() {
 #[test]
 fn blended_reference_is_smooth_and_within_limits_between_samples() {
     let params = ChainParams::new(3);
-    let tr = build(&tour(&params), &room(), &Settings::default()).unwrap();
+    let tr = built(&tour(&params), &room());
     let r = tr.reference();
     let lim = Limits::default();
     let (h, mut t) = (1e-5, 0.01);
@@ -361,10 +362,11 @@ fn bad_settings_and_plans_are_refused() {
     ));
 }
 
-/// Follow-the-leader along an arc of radius `radius` about (2, 2, 1), as threading
-/// makes it: the body laid on the circle, then a translation of `step` along the
-/// chord; `steps` of them from the head at angle 0.
-fn arc_follow(params: &ChainParams, radius: f64, step: f64, steps: usize) -> Plan {
+/// Follow-the-leader of a chain of 4 units along an arc of radius `radius` about
+/// (2, 2, 1), as threading makes it: the body laid on the circle, then a translation
+/// of `step` along the chord; `steps` of them from the head at angle 0.
+fn arc_follow(radius: f64, step: f64, steps: usize) -> Plan {
+    let params = &ChainParams::new(4);
     let l = params.link_length as f64;
     let spacing = 2.0 * (l / (2.0 * radius)).asin();
     let at = |phi: f64| [2.0 + radius * phi.cos(), 2.0 + radius * phi.sin(), 1.0];
@@ -392,12 +394,11 @@ fn arc_follow(params: &ChainParams, radius: f64, step: f64, steps: usize) -> Pla
 
 #[test]
 fn follow_the_leader_steps_fly_as_runs() {
-    let params = ChainParams::new(4);
     let s = Settings::default();
     // A quarter turn of radius 1.2 m in 2 cm steps: 2 x 94 edges.
-    let plan = arc_follow(&params, 1.2, 0.02, 94);
+    let plan = arc_follow(1.2, 0.02, 94);
     let grid = room();
-    let tr = build(&plan, &grid, &s).unwrap();
+    let tr = built(&plan, &grid);
     let motions = tr.corners() + 1 - tr.merged();
     assert!(
         motions * 8 <= tr.corners() + 1,
@@ -412,9 +413,9 @@ fn follow_the_leader_steps_fly_as_runs() {
         "{} s for {path} s",
         tr.duration()
     );
-    assert_respects_limits(&grid, &params, &s.limits, tr.times(), tr.zetas());
+    assert_respects_limits(&grid, &tr);
     // A tighter arc bends the links faster: shorter runs.
-    let tight = build(&arc_follow(&params, 0.6, 0.02, 47), &grid, &s).unwrap();
+    let tight = built(&arc_follow(0.6, 0.02, 47), &grid);
     let tight_motions = tight.corners() + 1 - tight.merged();
     assert!(
         tight_motions * 94 > motions * 47,
@@ -424,24 +425,22 @@ fn follow_the_leader_steps_fly_as_runs() {
 
 #[test]
 fn a_run_that_would_touch_the_map_is_halved() {
-    let params = ChainParams::new(4);
-    let s = Settings::default();
-    let plan = arc_follow(&params, 1.2, 0.02, 94);
-    let free = build(&plan, &room(), &s).unwrap();
+    let plan = arc_follow(1.2, 0.02, 94);
+    let free = built(&plan, &room());
     // On a 2 cm grid, a voxel just inside the arc: its far corner is 1.016 m from the
     // centre, so the plan's own edges pass it at 2-3 cm (a translation carries the
     // units behind the head inwards, off the circle), under the margin that every
     // merged motion must keep there.
     let mut grid = Grid::new(0.02, [0, 0, 0], [200, 200, 100], Cell::Free, true).unwrap();
     grid.fill_box([2.801, 2.581, 0.99], [2.819, 2.599, 1.01], Cell::Occupied);
-    let near = build(&plan, &grid, &s).unwrap();
+    let near = built(&plan, &grid);
     assert!(
         near.merged() < free.merged(),
         "{} vs {}",
         near.merged(),
         free.merged()
     );
-    assert_respects_limits(&grid, &params, &s.limits, near.times(), near.zetas());
+    assert_respects_limits(&grid, &near);
 }
 
 #[test]
@@ -451,7 +450,6 @@ fn a_pair_that_would_touch_the_map_flies_less_of_its_translation() {
     // the start and pass a box beside the first metre of the head's track; merged with
     // the last metre or half metre only, it swings clear of it.
     let params = ChainParams::new(4);
-    let s = Settings::default();
     let line = Shape::line(4, 0.0);
     let plan = plan(
         &params,
@@ -462,11 +460,19 @@ fn a_pair_that_would_touch_the_map_flies_less_of_its_translation() {
         ],
     );
     let mut grid = Grid::new(0.1, [0, 0, 0], [60, 40, 20], Cell::Free, true).unwrap();
-    let free = build(&plan, &grid, &s).unwrap();
+    let free = built(&plan, &grid);
     assert_eq!((free.corners(), free.merged()), (1, 1));
     grid.fill_box([1.0, 1.2, 0.8], [1.4, 1.45, 1.2], Cell::Occupied);
-    let near = build(&plan, &grid, &s).unwrap();
-    let apart = build(&plan, &grid, &Settings { blend: false, ..s }).unwrap();
+    let near = built(&plan, &grid);
+    let apart = build(
+        &plan,
+        &grid,
+        &Settings {
+            blend: false,
+            ..Settings::default()
+        },
+    )
+    .unwrap();
     assert_eq!(
         near.merged(),
         1,
@@ -479,7 +485,7 @@ fn a_pair_that_would_touch_the_map_flies_less_of_its_translation() {
         free.duration(),
         apart.duration()
     );
-    assert_respects_limits(&grid, &params, &s.limits, near.times(), near.zetas());
+    assert_respects_limits(&grid, &near);
 }
 
 #[test]
@@ -487,15 +493,13 @@ fn runs_of_short_steps_may_cut_their_corners_by_more() {
     // A quarter turn of radius 0.6 m in 2 cm steps: the straight move through many of
     // them passes their waypoints 2-6 cm off, which short steps allow and long edges
     // do not (with 2 cm for these too, the turn took 5 motions).
-    let params = ChainParams::new(4);
-    let s = Settings::default();
     let grid = room();
-    let tight = build(&arc_follow(&params, 0.6, 0.02, 47), &grid, &s).unwrap();
+    let tight = built(&arc_follow(0.6, 0.02, 47), &grid);
     let motions = tight.corners() + 1 - tight.merged();
     assert!(motions <= 2, "{motions} motions");
-    assert_respects_limits(&grid, &params, &s.limits, tight.times(), tight.zetas());
+    assert_respects_limits(&grid, &tight);
     // The same turn in 3 steps of 0.3 m: no run joins two of them (each step's shape
     // change and translation fly as a pair).
-    let long = build(&arc_follow(&params, 0.6, 0.3, 3), &grid, &s).unwrap();
+    let long = built(&arc_follow(0.6, 0.3, 3), &grid);
     assert_eq!(long.corners() + 1 - long.merged(), 3);
 }
