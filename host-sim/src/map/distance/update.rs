@@ -175,9 +175,7 @@ impl DistanceField {
                 flipped.push(self.grid.linear(l));
             }
         }
-        flipped.sort_unstable();
-        flipped.dedup();
-        flipped
+        sorted_once(flipped)
     }
 
     /// The x pass and the row gaps of the rows holding `flipped` voxels; the cells whose
@@ -249,9 +247,7 @@ impl DistanceField {
             stats.y_columns += 1;
             stats.voxels_visited += hi + 1 - lo;
         }
-        next.sort_unstable();
-        next.dedup();
-        next
+        sorted_once(next)
     }
 
     /// The z pass of columns `cols` (`x + nx y`), into the stored bounds.
@@ -279,6 +275,13 @@ impl DistanceField {
         stats.z_columns = cols.len();
         stats.voxels_visited += cols.len() * nz;
     }
+}
+
+/// `keys` sorted, each once.
+fn sorted_once(mut keys: Vec<usize>) -> Vec<usize> {
+    keys.sort_unstable();
+    keys.dedup();
+    keys
 }
 
 mod line;
