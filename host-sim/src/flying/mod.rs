@@ -13,7 +13,7 @@ use crate::map::Grid;
 use crate::plan_file::{FormatError, Plan};
 use crate::sim::{
     simulate_reference, simulate_with_progress, Flight, MapClearance, Progress, Reference,
-    ReferenceError, SettingsError, SimConfig, SimError,
+    SimConfig, SimError,
 };
 use crate::trajectory::{self, Trajectory, TrajectoryError, Violation};
 
@@ -70,17 +70,12 @@ pub enum FlyError {
     /// The plan breaks its format.
     #[error("plan: {0}")]
     Plan(#[from] FormatError),
-    /// The simulation settings are outside their limits.
-    #[error("simulation settings: {0}")]
-    Settings(#[from] SettingsError),
     /// The trajectory cannot be made (limits, sample spacing, length), other than
     /// for being inadmissible (then the chain stops at every waypoint).
     #[error(transparent)]
     Trajectory(TrajectoryError),
-    /// The plan cannot be timed stopping at every waypoint.
-    #[error("plan: {0}")]
-    Timing(#[from] ReferenceError),
-    /// The simulation cannot fly it (its budget, the dynamics).
+    /// The simulation cannot fly it: settings outside their limits, a plan it cannot
+    /// time stopping at every waypoint, its budget, the dynamics.
     #[error(transparent)]
     Sim(#[from] SimError),
 }
@@ -89,7 +84,7 @@ pub enum FlyError {
 pub fn time(plan: &Plan, grid: &Grid, options: &FlyOptions) -> Result<Timed, FlyError> {
     let params = plan.check()?;
     let cfg = options.sim_config();
-    cfg.validate()?;
+    cfg.validate().map_err(SimError::from)?;
     if options.timing.blend {
         match trajectory::build(plan, grid, &options.timing) {
             Ok(tr) => return Ok(Timed::along(tr, options)),
@@ -110,7 +105,8 @@ fn stop_at_waypoints(
     why: Option<Box<Violation>>,
 ) -> Result<Timed, FlyError> {
     let l = params.link_length as f64;
-    let reference = Reference::new(params.n(), l, &waypoints(plan), &cfg.limits)?;
+    let reference =
+        Reference::new(params.n(), l, &waypoints(plan), &cfg.limits).map_err(SimError::from)?;
     Ok(Timed {
         timing: Timing::StopAtWaypoints(why),
         reference,
@@ -142,7 +138,7 @@ pub fn fly_timed(
             simulate_reference(&params, tr.reference(), &cfg, Some(&obstacles), progress)
         }
         Timing::StopAtWaypoints(_) => {
-            cfg.validate()?;
+            cfg.validate().map_err(SimError::from)?;
             let w = waypoints(plan);
             simulate_with_progress(&params, &w, &cfg, Some(&obstacles), progress)
         }

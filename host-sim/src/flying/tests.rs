@@ -75,6 +75,6 @@ fn settings_outside_their_limits_are_refused_before_any_flight() {
     let mut options = FlyOptions::default();
     options.sim.rate = 10.0;
     let e = fly(&plan, &grid, &options, &Progress::default()).unwrap_err();
-    assert!(matches!(e, FlyError::Settings(_)), "{e}");
+    assert!(matches!(e, FlyError::Sim(SimError::Config(_))), "{e}");
     assert!(e.to_string().contains("rate"), "{e}");
 }
