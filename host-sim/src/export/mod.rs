@@ -122,16 +122,29 @@ pub struct ExportOptions {
 /// What an export wrote.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Written {
-    /// The format.
-    pub format: Format,
     /// Bytes written.
     pub bytes: usize,
-    /// Messages written.
-    pub messages: usize,
-    /// What the bag holds, for `.mcap`.
-    pub bag: Option<BagSummary>,
-    /// What the log holds, for `.tlog`.
-    pub tlog: Option<TlogSummary>,
+    /// What the file holds, in its format.
+    pub holds: Holds,
+}
+
+/// What an exported file holds, by its format.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Holds {
+    /// A ROS 2 bag, `.mcap`.
+    Bag(BagSummary),
+    /// A MAVLink 2 telemetry log, `.tlog`.
+    Tlog(TlogSummary),
+}
+
+impl Holds {
+    /// The messages it holds.
+    pub fn messages(&self) -> usize {
+        match self {
+            Holds::Bag(b) => b.topics.iter().map(|(_, n)| n).sum(),
+            Holds::Tlog(s) => s.heartbeats + s.position_targets + s.attitude_targets + s.commands,
+        }
+    }
 }
 
 /// The map as an OctoMap binary stream (`writeBinaryData`, what `octomap_msgs`
@@ -152,30 +165,23 @@ pub fn export(
     path: &Path,
     options: &ExportOptions,
 ) -> Result<Written, ExportError> {
-    let format = Format::of_path(path)?;
-    let (bytes, written) = match format {
+    let (bytes, holds) = match Format::of_path(path)? {
         Format::Mcap => {
             let stream = map.map(map_stream).transpose()?;
             let (bytes, summary) = bag::bag(motion, stream.as_ref().map(|(s, r)| (&s[..], *r)))?;
-            let messages = summary.topics.iter().map(|(_, n)| n).sum();
-            (bytes, (messages, Some(summary), None))
+            (bytes, Holds::Bag(summary))
         }
         Format::Tlog => {
-            let (bytes, s) = tlog::tlog(motion, &options.tlog)?;
-            let messages = s.heartbeats + s.position_targets + s.attitude_targets + s.commands;
-            (bytes, (messages, None, Some(s)))
+            let (bytes, summary) = tlog::tlog(motion, &options.tlog)?;
+            (bytes, Holds::Tlog(summary))
         }
     };
     crate::fsutil::write_atomic(path, &bytes).map_err(|source| ExportError::Io {
         path: path.display().to_string(),
         source,
     })?;
-    let (messages, bag, tlog) = written;
     Ok(Written {
-        format,
         bytes: bytes.len(),
-        messages,
-        bag,
-        tlog,
+        holds,
     })
 }

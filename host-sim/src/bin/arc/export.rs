@@ -11,8 +11,8 @@ use super::common::{read_plan, MapArgs, Report};
 use super::trajectory::{make, read_trajectory, TimingArgs};
 use super::{CliError, CliResult};
 use aerial_chain::export::{
-    export, Autopilot, ExportOptions, Format, Motion, TlogOptions, DEFAULT_RATE_HZ, MAX_HOLD_S,
-    MAX_RATE_HZ, MIN_RATE_HZ, PX4_MIN_HOLD_S, SENDER_SYSTEM,
+    export, Autopilot, ExportOptions, Format, Holds, Motion, TlogOptions, DEFAULT_RATE_HZ,
+    MAX_HOLD_S, MAX_RATE_HZ, MIN_RATE_HZ, PX4_MIN_HOLD_S, SENDER_SYSTEM,
 };
 use aerial_chain::sim::FlightFile;
 use aerial_chain::trajectory::TrajectoryFile;
@@ -185,11 +185,11 @@ pub fn run(a: ExportArgs) -> CliResult {
         motion.units(),
         motion.duration() - motion.ticks[0].t,
         a.rate,
-        written.messages,
+        written.holds.messages(),
         written.bytes,
         began.elapsed().as_secs_f64() * 1e3
     ));
-    if let Some(bag) = &written.bag {
+    if let Holds::Bag(bag) = &written.holds {
         let topics: Vec<String> = bag
             .topics
             .iter()
@@ -197,7 +197,7 @@ pub fn run(a: ExportArgs) -> CliResult {
             .collect();
         report.line(format_args!("  topics: {}", topics.join(", ")));
     }
-    if let Some(s) = &written.tlog {
+    if let Holds::Tlog(s) = &written.holds {
         report.line(format_args!(
             "  {} heartbeats, {} position setpoints, {} attitude setpoints, {} commands; units are systems {}..={}",
             s.heartbeats,
