@@ -201,7 +201,7 @@ fn a_deadline_that_has_passed_keeps_the_plan_stop_and_go() {
     let mut grid = room();
     grid.fill_box([1.71, 0.51, 1.21], [1.79, 1.49, 1.29], Cell::Occupied);
     for (plan, grid) in [(tour(&params), room()), (corner(&params), grid)] {
-        let full = build(&plan, &grid, &s).unwrap();
+        let full = built(&plan, &grid);
         let later = std::time::Instant::now() + std::time::Duration::from_secs(600);
         let within = build_until(&plan, &grid, &s, Some(later)).unwrap();
         assert!(!within.cut_short());
@@ -217,7 +217,7 @@ fn a_deadline_that_has_passed_keeps_the_plan_stop_and_go() {
         assert_eq!(cut.stages().reports()[0].rounds, 1, "one round, the last");
         let rep = check_samples(&grid, &params, &s.limits, cut.times(), cut.zetas(), 0.0);
         assert!(rep.ok, "{:?}", rep.violation);
-        assert_respects_limits(&grid, &params, &s.limits, cut.times(), cut.zetas());
+        assert_respects_limits(&grid, &cut);
     }
 }
 
