@@ -18,6 +18,8 @@ use aerial_chain::problem::scenarios;
 use aerial_chain::tables::{ShapeTables, TableSettings};
 use aerial_chain_core::ChainParams;
 
+use super::report::{csv_table, markdown_table, Column};
+use super::statistics::nearest_rank;
 use super::StudyError;
 
 /// The built-in scenarios, each at its default chain size.
@@ -136,16 +138,6 @@ pub fn timed(request: &Request, tables: &ShapeTables, options: &PlanOptions) -> 
     }
 }
 
-/// The `q`-quantile (nearest rank) of `v`, 0 when empty.
-fn quantile(v: &[f64], q: f64) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    s[((q * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1]
-}
-
 /// The markdown summary: per limit, the runs, their outcomes and the time after setup
 /// against the bound; then every run that broke the promise.
 pub fn markdown(runs: &[LimitRun]) -> String {
@@ -159,7 +151,7 @@ pub fn markdown(runs: &[LimitRun]) -> String {
         let at: Vec<&LimitRun> = runs.iter().filter(|r| r.limit_s == t).collect();
         let times: Vec<f64> = at.iter().map(|r| r.after_setup_s).collect();
         let count = |f: &dyn Fn(&LimitRun) -> bool| at.iter().filter(|r| f(r)).count();
-        let max = quantile(&times, 1.0);
+        let max = nearest_rank(&times, 1.0);
         s += &format!(
             "| {:.0} | {:.1} | {} | {} | {} | {} | {:.1} / {:.1} / {:.1} | {:.2} | {} |\n",
             t * 1e3,
@@ -168,8 +160,8 @@ pub fn markdown(runs: &[LimitRun]) -> String {
             count(&|r| r.outcome == "plan"),
             count(&|r| r.outcome == "no plan"),
             count(&|r| r.cut_short),
-            quantile(&times, 0.5) * 1e3,
-            quantile(&times, 0.95) * 1e3,
+            nearest_rank(&times, 0.5) * 1e3,
+            nearest_rank(&times, 0.95) * 1e3,
             max * 1e3,
             max / bound(t),
             count(&|r| !r.kept()),
@@ -177,39 +169,40 @@ pub fn markdown(runs: &[LimitRun]) -> String {
     }
     let over: Vec<&LimitRun> = runs.iter().filter(|r| !r.kept()).collect();
     if !over.is_empty() {
-        s += "\nOver the bound:\n\n| scenario | N | limit (ms) | after setup (ms) | outcome |\n|---|---|---|---|---|\n";
-        for r in over {
-            s += &format!(
-                "| `{}` | {} | {:.0} | {:.1} | {} |\n",
-                r.scenario,
-                r.units,
-                r.limit_s * 1e3,
-                r.after_setup_s * 1e3,
-                r.outcome
-            );
-        }
+        s += "\nOver the bound:\n\n";
+        s += &markdown_table(&OVER_COLUMNS, &over);
     }
     s
 }
 
+/// The columns of the runs over the bound.
+const OVER_COLUMNS: [Column<LimitRun>; 5] = [
+    ("scenario", |r| format!("`{}`", r.scenario)),
+    ("N", |r| r.units.to_string()),
+    ("limit (ms)", |r| format!("{:.0}", r.limit_s * 1e3)),
+    ("after setup (ms)", |r| {
+        format!("{:.1}", r.after_setup_s * 1e3)
+    }),
+    ("outcome", |r| r.outcome.clone()),
+];
+
+/// The CSV's columns.
+const CSV_COLUMNS: [Column<LimitRun>; 8] = [
+    ("scenario", |r| format!("\"{}\"", r.scenario)),
+    ("units", |r| r.units.to_string()),
+    ("limit_s", |r| r.limit_s.to_string()),
+    ("after_setup_s", |r| format!("{:.6}", r.after_setup_s)),
+    ("bound_s", |r| format!("{:.6}", bound(r.limit_s))),
+    ("kept", |r| r.kept().to_string()),
+    ("outcome", |r| {
+        format!("\"{}\"", r.outcome.replace('"', "'"))
+    }),
+    ("cut_short", |r| r.cut_short.to_string()),
+];
+
 /// Every run as CSV.
 pub fn csv(runs: &[LimitRun]) -> String {
-    let mut s =
-        String::from("scenario,units,limit_s,after_setup_s,bound_s,kept,outcome,cut_short\n");
-    for r in runs {
-        s += &format!(
-            "\"{}\",{},{},{:.6},{:.6},{},\"{}\",{}\n",
-            r.scenario,
-            r.units,
-            r.limit_s,
-            r.after_setup_s,
-            bound(r.limit_s),
-            r.kept(),
-            r.outcome.replace('"', "'"),
-            r.cut_short
-        );
-    }
-    s
+    csv_table(&CSV_COLUMNS, runs)
 }
 
 #[cfg(test)]

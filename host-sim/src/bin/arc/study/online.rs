@@ -16,7 +16,7 @@ use aerial_chain::tables::ShapeTables;
 use aerial_chain_core::ChainParams;
 use std::sync::atomic::AtomicUsize;
 
-use super::report::csv_field;
+use super::report::{csv_field, csv_table, Column};
 
 /// One run: an exploration and the finished-map flight of the same query.
 #[derive(Clone, Debug, Default)]
@@ -138,8 +138,8 @@ fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
     Ok(())
 }
 
-/// The CSV's columns: each one's name and its cell for a run.
-const CSV_COLUMNS: [(&str, fn(&OnlineRun) -> String); 19] = [
+/// The CSV's columns.
+const CSV_COLUMNS: [Column<OnlineRun>; 19] = [
     ("scenario", |r| csv_field(&r.scenario)),
     ("units", |r| r.units.to_string()),
     ("end", |r| csv_field(&r.end)),
@@ -167,14 +167,7 @@ const CSV_COLUMNS: [(&str, fn(&OnlineRun) -> String); 19] = [
 
 /// One line per run, under a line of the column names.
 pub fn csv(runs: &[OnlineRun]) -> String {
-    let names: Vec<&str> = CSV_COLUMNS.iter().map(|(name, _)| *name).collect();
-    let mut out = names.join(",") + "\n";
-    for r in runs {
-        let cells: Vec<String> = CSV_COLUMNS.iter().map(|(_, cell)| cell(r)).collect();
-        out += &cells.join(",");
-        out.push('\n');
-    }
-    out
+    csv_table(&CSV_COLUMNS, runs)
 }
 
 /// The summary table: success, ratios and latencies over all runs.
@@ -250,3 +243,4 @@ pub fn figure(runs: &[OnlineRun]) -> String {
         &[(&pts, palette::series(0), "a run that reached the goal")],
     )
 }
+

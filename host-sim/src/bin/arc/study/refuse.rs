@@ -18,6 +18,8 @@ use aerial_chain::tables::{ShapeTables, TableSettings};
 use aerial_chain_core::ChainParams;
 
 use super::limit::timed;
+use super::report::{csv_table, markdown_table, Column};
+use super::statistics::nearest_rank;
 use super::StudyError;
 
 /// Chain sizes every query is asked at.
@@ -142,16 +144,6 @@ fn reason(why: &str) -> &'static str {
     }
 }
 
-/// The `q`-quantile (nearest rank) of `v`, 0 when empty.
-fn quantile(v: &[f64], q: f64) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    s[((q * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1]
-}
-
 /// Whether a scenario's name is of a group of the summary.
 type Kind = fn(&str) -> bool;
 
@@ -182,42 +174,44 @@ pub fn markdown(runs: &[Refusal]) -> String {
             at.len(),
             at.iter().filter(|r| r.kept()).count(),
             listed.join(", "),
-            quantile(&times, 0.5) * 1e3,
-            quantile(&times, 1.0) * 1e3,
+            nearest_rank(&times, 0.5) * 1e3,
+            nearest_rank(&times, 1.0) * 1e3,
         );
     }
     let missed: Vec<&Refusal> = runs.iter().filter(|r| !r.kept()).collect();
     if !missed.is_empty() {
-        s += "\nMissed:\n\n| scenario | N | after setup (ms) | outcome | reason |\n|---|---|---|---|---|\n";
-        for r in missed {
-            s += &format!(
-                "| `{}` | {} | {:.1} | {} | {} |\n",
-                r.scenario,
-                r.units,
-                r.after_setup_s * 1e3,
-                r.outcome,
-                r.reason
-            );
-        }
+        s += "\nMissed:\n\n";
+        s += &markdown_table(&MISSED_COLUMNS, &missed);
     }
     s
 }
 
+/// The columns of the runs that missed the target.
+const MISSED_COLUMNS: [Column<Refusal>; 5] = [
+    ("scenario", |r| format!("`{}`", r.scenario)),
+    ("N", |r| r.units.to_string()),
+    ("after setup (ms)", |r| {
+        format!("{:.1}", r.after_setup_s * 1e3)
+    }),
+    ("outcome", |r| r.outcome.clone()),
+    ("reason", |r| r.reason.to_string()),
+];
+
+/// The CSV's columns.
+const CSV_COLUMNS: [Column<Refusal>; 6] = [
+    ("scenario", |r| format!("\"{}\"", r.scenario)),
+    ("units", |r| r.units.to_string()),
+    ("after_setup_s", |r| format!("{:.6}", r.after_setup_s)),
+    ("outcome", |r| {
+        format!("\"{}\"", r.outcome.replace('"', "'"))
+    }),
+    ("reason", |r| format!("\"{}\"", r.reason)),
+    ("kept", |r| r.kept().to_string()),
+];
+
 /// Every run as CSV.
 pub fn csv(runs: &[Refusal]) -> String {
-    let mut s = String::from("scenario,units,after_setup_s,outcome,reason,kept\n");
-    for r in runs {
-        s += &format!(
-            "\"{}\",{},{:.6},\"{}\",\"{}\",{}\n",
-            r.scenario,
-            r.units,
-            r.after_setup_s,
-            r.outcome.replace('"', "'"),
-            r.reason,
-            r.kept()
-        );
-    }
-    s
+    csv_table(&CSV_COLUMNS, runs)
 }
 
 #[cfg(test)]

@@ -13,6 +13,32 @@ pub(super) fn csv_field(s: &str) -> String {
     }
 }
 
+/// A column of a table of `T`s: its name and a row's cell.
+pub(super) type Column<T> = (&'static str, fn(&T) -> String);
+
+/// `rows` as CSV, under a line of the column names.
+pub(super) fn csv_table<T>(columns: &[Column<T>], rows: &[T]) -> String {
+    let names: Vec<&str> = columns.iter().map(|(name, _)| *name).collect();
+    let mut out = names.join(",") + "\n";
+    for r in rows {
+        let cells: Vec<String> = columns.iter().map(|(_, cell)| cell(r)).collect();
+        out += &cells.join(",");
+        out.push('\n');
+    }
+    out
+}
+
+/// `rows` as a markdown table: the column names, the separator line, a line a row.
+pub(super) fn markdown_table<T>(columns: &[Column<T>], rows: &[&T]) -> String {
+    let line = |cells: Vec<String>| format!("| {} |\n", cells.join(" | "));
+    let mut out = line(columns.iter().map(|(name, _)| name.to_string()).collect());
+    out += &format!("|{}\n", "---|".repeat(columns.len()));
+    for r in rows {
+        out += &line(columns.iter().map(|(_, cell)| cell(r)).collect());
+    }
+    out
+}
+
 fn opt<T: ToString>(v: Option<T>) -> String {
     v.map(|x| x.to_string()).unwrap_or_default()
 }

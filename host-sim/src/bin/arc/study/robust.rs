@@ -9,6 +9,7 @@
 
 use rand::{Rng, SeedableRng};
 
+use super::statistics::nearest_rank;
 use super::{plot, run_all, ArcMode, Envs, Method, RunKey, RunResult, RunSpec, Spread, StudyError};
 use aerial_chain::problem::passages::PassageSpec;
 use aerial_chain::witness::witness;
@@ -133,16 +134,6 @@ pub fn run(
     Ok(out)
 }
 
-/// The `q`-quantile of `v` (nearest rank), 0 when empty.
-fn quantile(v: &[f64], q: f64) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    s[((q * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1]
-}
-
 /// The markdown summary.
 pub fn markdown(results: &[RunResult], family: Family, redrawn: usize, meta: &str) -> String {
     let n = results.len();
@@ -167,12 +158,12 @@ pub fn markdown(results: &[RunResult], family: Family, redrawn: usize, meta: &st
         "| {n} | {} ({:.1} %) | {verified} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} / {:.1} |\n\n",
         solved.len(),
         100.0 * solved.len() as f64 / n.max(1) as f64,
-        quantile(&road, 0.5),
-        quantile(&road, 0.95),
-        quantile(&plan, 0.5),
-        quantile(&plan, 0.95),
-        quantile(&total, 0.5),
-        quantile(&total, 0.95),
+        nearest_rank(&road, 0.5),
+        nearest_rank(&road, 0.95),
+        nearest_rank(&plan, 0.5),
+        nearest_rank(&plan, 0.95),
+        nearest_rank(&total, 0.5),
+        nearest_rank(&total, 0.95),
     );
     s += "| N | instances | solved | planning median (ms) |\n|---|---|---|---|\n";
     for u in 4..=8u8 {
@@ -231,8 +222,8 @@ fn openings_markdown(solved: &[&RunResult]) -> String {
          the worst opening of each instance counts. Post-processed as `arc plan` does: median {:.1} ms, \
          p95 {:.1} ms; {verified} of {} post-processed plans verified.\n\n\
          | plan | at or above the target | worst ratio | median ratio |\n|---|---|---|---|\n",
-        quantile(&post_ms, 0.5),
-        quantile(&post_ms, 0.95),
+        nearest_rank(&post_ms, 0.5),
+        nearest_rank(&post_ms, 0.95),
         with.len()
     );
     for (name, post) in [("raw", false), ("post-processed", true)] {
@@ -242,7 +233,7 @@ fn openings_markdown(solved: &[&RunResult]) -> String {
             "| {name} | {ok} of {} | {:.2} | {:.2} |\n",
             v.len(),
             v.iter().copied().fold(f64::INFINITY, f64::min),
-            quantile(&v, 0.5)
+            nearest_rank(&v, 0.5)
         );
     }
     s

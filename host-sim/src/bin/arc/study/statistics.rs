@@ -33,6 +33,14 @@ pub(super) fn quantile(sorted: &[f64], q: f64) -> f64 {
     sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
 }
 
+/// Quantile `q` (0..=1) of `values` in any order, the nearest rank (0 when empty), as
+/// the tables of `arc bench robust`, `limit` and `refuse` give it.
+pub(super) fn nearest_rank(values: &[f64], q: f64) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    aerial_chain::online::quantile(&sorted, q)
+}
+
 impl Spread {
     /// The spread of `values` (NaN fields when empty).
     pub fn of(values: impl IntoIterator<Item = f64>) -> Self {
