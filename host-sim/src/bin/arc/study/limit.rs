@@ -18,7 +18,7 @@ use aerial_chain::problem::scenarios;
 use aerial_chain::tables::{ShapeTables, TableSettings};
 use aerial_chain_core::ChainParams;
 
-use super::report::{csv_table, markdown_table, Column};
+use super::report::{csv_table, missed, Column};
 use super::statistics::nearest_rank;
 use super::StudyError;
 
@@ -167,11 +167,7 @@ pub fn markdown(runs: &[LimitRun]) -> String {
             count(&|r| !r.kept()),
         );
     }
-    let over: Vec<&LimitRun> = runs.iter().filter(|r| !r.kept()).collect();
-    if !over.is_empty() {
-        s += "\nOver the bound:\n\n";
-        s += &markdown_table(&OVER_COLUMNS, &over);
-    }
+    s += &missed("Over the bound", &OVER_COLUMNS, runs, LimitRun::kept);
     s
 }
 

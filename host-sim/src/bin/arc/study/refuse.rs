@@ -18,7 +18,7 @@ use aerial_chain::tables::{ShapeTables, TableSettings};
 use aerial_chain_core::ChainParams;
 
 use super::limit::timed;
-use super::report::{csv_table, markdown_table, Column};
+use super::report::{csv_table, missed, Column};
 use super::statistics::nearest_rank;
 use super::StudyError;
 
@@ -178,11 +178,7 @@ pub fn markdown(runs: &[Refusal]) -> String {
             nearest_rank(&times, 1.0) * 1e3,
         );
     }
-    let missed: Vec<&Refusal> = runs.iter().filter(|r| !r.kept()).collect();
-    if !missed.is_empty() {
-        s += "\nMissed:\n\n";
-        s += &markdown_table(&MISSED_COLUMNS, &missed);
-    }
+    s += &missed("Missed", &MISSED_COLUMNS, runs, Refusal::kept);
     s
 }
 

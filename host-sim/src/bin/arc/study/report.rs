@@ -39,6 +39,21 @@ pub(super) fn markdown_table<T>(columns: &[Column<T>], rows: &[&T]) -> String {
     out
 }
 
+/// The table of the `rows` that `kept` does not keep under the line `title`, or
+/// nothing where it keeps every one.
+pub(super) fn missed<T>(
+    title: &str,
+    columns: &[Column<T>],
+    rows: &[T],
+    kept: fn(&T) -> bool,
+) -> String {
+    let missed: Vec<&T> = rows.iter().filter(|r| !kept(r)).collect();
+    match missed.is_empty() {
+        true => String::new(),
+        false => format!("\n{title}:\n\n{}", markdown_table(columns, &missed)),
+    }
+}
+
 fn opt<T: ToString>(v: Option<T>) -> String {
     v.map(|x| x.to_string()).unwrap_or_default()
 }
