@@ -288,7 +288,9 @@ mod tests {
 
     #[test]
     fn bad_settings_name_the_field_and_value() {
-        let cases: [(fn(&mut DepthSensor), &str); 9] = [
+        /// A change to the default sensor.
+        type Change = fn(&mut DepthSensor);
+        let cases: [(Change, &str); 9] = [
             (|s| s.fov_h_deg = 180.0, "fov_h_deg = 180.0"),
             (|s| s.fov_v_deg = 0.0, "fov_v_deg = 0.0"),
             (|s| s.fov_v_deg = f64::NAN, "fov_v_deg = NaN"),

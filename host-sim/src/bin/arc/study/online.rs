@@ -243,4 +243,3 @@ pub fn figure(runs: &[OnlineRun]) -> String {
         &[(&pts, palette::series(0), "a run that reached the goal")],
     )
 }
-
