@@ -157,7 +157,7 @@ fn narrow_cost(voxels: usize) -> f64 {
 
 /// Searches `field` from `from` to within `tol` of `goal`: an A* over the 26-connected
 /// voxels whose bound is at least the proof radius (the start voxel always), Euclidean
-/// costs, [`narrow_cost`] times that below the route radius. Goal voxels: centres
+/// costs, `narrow_cost` times that below the route radius. Goal voxels: centres
 /// within `tol` plus half a voxel diagonal of `goal`, so that every head position
 /// within `tol` has its voxel among them.
 pub fn search(
