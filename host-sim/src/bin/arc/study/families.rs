@@ -8,8 +8,6 @@
 //! 0.05 m; slots tilted 15-60 degrees, approached 0-45 degrees off the normal either way,
 //! at 0.05 m.
 
-use std::sync::atomic::AtomicUsize;
-
 use rand::{Rng, SeedableRng};
 
 use aerial_chain::collision::verify_plan;
@@ -17,9 +15,10 @@ use aerial_chain::planner::Query;
 use aerial_chain::planning::{self, PlanOptions, Request};
 use aerial_chain::problem::families::{ForestSpec, SlotSpec};
 use aerial_chain::problem::scenarios;
-use aerial_chain::tables::{ShapeTables, TableSettings};
+use aerial_chain::tables::ShapeTables;
 use aerial_chain_core::ChainParams;
 
+use super::limit::default_tables;
 use super::StudyError;
 
 /// One query of a family.
@@ -73,16 +72,7 @@ pub fn run(count: usize, seed: u64) -> Result<Vec<FamilyRun>, StudyError> {
         let sc = scenarios::build(&name)?;
         for n in units {
             if !tables.iter().any(|(m, _)| *m == n) {
-                let t = ShapeTables::build(
-                    ChainParams::new(n),
-                    &TableSettings::default(),
-                    &AtomicUsize::new(0),
-                )
-                .map_err(|e| StudyError::Tables {
-                    units: n,
-                    why: e.to_string(),
-                })?;
-                tables.push((n, t));
+                tables.push((n, default_tables(n)?));
             }
             let t = &tables.iter().find(|(m, _)| *m == n).expect("built above").1;
             let query = Query::new(sc.start, sc.start_shape(n)?, sc.goal);

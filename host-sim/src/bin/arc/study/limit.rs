@@ -74,16 +74,23 @@ pub fn run(jobs: &[(String, u8)], limits_s: &[f64]) -> Result<Vec<LimitRun>, Stu
         let shape = sc.start_shape(*units)?;
         let query = Query::new(sc.start, shape, sc.goal);
         let request = Request::new(sc.grid.clone(), params, query);
-        let tables = ShapeTables::build(params, &TableSettings::default(), &AtomicUsize::new(0))
-            .map_err(|e| StudyError::Tables {
-                units: *units,
-                why: e.to_string(),
-            })?;
+        let tables = default_tables(*units)?;
         for &limit_s in limits_s {
             out.push(one(name, &request, &tables, limit_s));
         }
     }
     Ok(out)
+}
+
+/// The shape tables `arc plan` builds by default for a chain of `units`.
+pub(super) fn default_tables(units: u8) -> Result<ShapeTables, StudyError> {
+    let params = ChainParams::new(units);
+    ShapeTables::build(params, &TableSettings::default(), &AtomicUsize::new(0)).map_err(|e| {
+        StudyError::Tables {
+            units,
+            why: e.to_string(),
+        }
+    })
 }
 
 /// `request` planned as `arc plan --trajectory --time-limit limit_s` plans it.

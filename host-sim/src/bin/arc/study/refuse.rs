@@ -8,16 +8,14 @@
 //! into a box (0.2 m walls, 1 m clear inside). Each is planned through the library's
 //! facade at N = 4, 6 and 8.
 
-use std::sync::atomic::AtomicUsize;
-
 use aerial_chain::map::Cell;
 use aerial_chain::planner::Query;
 use aerial_chain::planning::{PlanOptions, Request};
 use aerial_chain::problem::scenarios::{self, Scenario};
-use aerial_chain::tables::{ShapeTables, TableSettings};
+use aerial_chain::tables::ShapeTables;
 use aerial_chain_core::ChainParams;
 
-use super::limit::timed;
+use super::limit::{default_tables, timed};
 use super::report::{csv_table, missed, Column};
 use super::statistics::nearest_rank;
 use super::StudyError;
@@ -94,17 +92,7 @@ pub fn walled_goal(mut sc: Scenario) -> Scenario {
 pub fn run() -> Result<Vec<Refusal>, StudyError> {
     let tables: Vec<ShapeTables> = UNITS
         .iter()
-        .map(|&n| {
-            ShapeTables::build(
-                ChainParams::new(n),
-                &TableSettings::default(),
-                &AtomicUsize::new(0),
-            )
-            .map_err(|e| StudyError::Tables {
-                units: n,
-                why: e.to_string(),
-            })
-        })
+        .map(|&n| default_tables(n))
         .collect::<Result<_, _>>()?;
     let mut out = Vec::new();
     for name in names() {
