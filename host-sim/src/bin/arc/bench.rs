@@ -669,19 +669,12 @@ fn run_families(a: FamiliesArgs) -> CliResult {
         std::env::var("RAYON_NUM_THREADS").unwrap_or_else(|_| "every core's".into()),
         began.elapsed().as_secs_f64()
     );
-    let files = [
-        study::write_out(
-            &a.out_dir,
-            "families_runs.csv",
-            study::families::csv(&runs).as_bytes(),
-        )?,
-        study::write_out(&a.out_dir, "families.md", md.as_bytes())?,
+    let runs_csv = study::families::csv(&runs);
+    let files: [(&str, &[u8]); 2] = [
+        ("families_runs.csv", runs_csv.as_bytes()),
+        ("families.md", md.as_bytes()),
     ];
-    println!("{md}");
-    for f in files {
-        println!("wrote {}", f.display());
-    }
-    Ok(())
+    publish(&a.out_dir, &md, &files)
 }
 
 fn run_refuse(a: RefuseArgs) -> CliResult {
@@ -694,19 +687,12 @@ fn run_refuse(a: RefuseArgs) -> CliResult {
         if cfg!(debug_assertions) { "debug" } else { "release" },
         began.elapsed().as_secs_f64()
     );
-    let files = [
-        study::write_out(
-            &a.out_dir,
-            "refuse_runs.csv",
-            study::refuse::csv(&runs).as_bytes(),
-        )?,
-        study::write_out(&a.out_dir, "refuse.md", md.as_bytes())?,
+    let runs_csv = study::refuse::csv(&runs);
+    let files: [(&str, &[u8]); 2] = [
+        ("refuse_runs.csv", runs_csv.as_bytes()),
+        ("refuse.md", md.as_bytes()),
     ];
-    println!("{md}");
-    for f in files {
-        println!("wrote {}", f.display());
-    }
-    Ok(())
+    publish(&a.out_dir, &md, &files)
 }
 
 fn run_limit(a: LimitArgs) -> CliResult {
@@ -751,19 +737,12 @@ fn run_limit(a: LimitArgs) -> CliResult {
         if cfg!(debug_assertions) { "debug" } else { "release" },
         began.elapsed().as_secs_f64()
     );
-    let files = [
-        study::write_out(
-            &a.out_dir,
-            "limit_runs.csv",
-            study::limit::csv(&runs).as_bytes(),
-        )?,
-        study::write_out(&a.out_dir, "limit.md", md.as_bytes())?,
+    let runs_csv = study::limit::csv(&runs);
+    let files: [(&str, &[u8]); 2] = [
+        ("limit_runs.csv", runs_csv.as_bytes()),
+        ("limit.md", md.as_bytes()),
     ];
-    println!("{md}");
-    for f in files {
-        println!("wrote {}", f.display());
-    }
-    Ok(())
+    publish(&a.out_dir, &md, &files)
 }
 
 fn run_online(a: OnlineArgs) -> CliResult {
