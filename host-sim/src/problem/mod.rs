@@ -1,5 +1,5 @@
 //! Problems to plan for: the built-in scenarios (the paper's rooms and more) and the
-//! parametric families (hard cases `passage:`, `forest:` and `slot:`), each a map with a start, a goal and a
+//! parametric families (hard cases `passage:`, `forest:`, `slot:` and `pipe:`), each a map with a start, a goal and a
 //! hand-made route that shows the problem can be solved.
 //!
 //! This layer sits above the map and collision layers (a scenario is a grid; the
@@ -9,6 +9,7 @@
 pub mod families;
 pub mod large;
 pub mod passages;
+pub mod pipes;
 pub mod scenarios;
 
 use crate::collision::verify::PlanViolation;
@@ -18,7 +19,7 @@ use crate::collision::verify::PlanViolation;
 pub enum ProblemError {
     /// A name that is no built-in scenario.
     #[error(
-        "unknown scenario {0:?}; known: {known}, corridor:LENGTH, passage:KEY=VALUE,..., forest:KEY=VALUE,..., slot:KEY=VALUE,..., campus[:RES], hall[:RES]",
+        "unknown scenario {0:?}; known: {known}, corridor:LENGTH, passage:KEY=VALUE,..., forest:KEY=VALUE,..., slot:KEY=VALUE,..., pipe:KEY=VALUE,..., campus[:RES], hall[:RES]",
         known = scenarios::NAMES.join(", ")
     )]
     UnknownScenario(String),
@@ -40,7 +41,7 @@ pub enum ProblemError {
         value: String,
     },
     /// A key that the family does not have.
-    #[error("unknown key {0:?}; known: w, angle, offset, wall, door, door_offset, res, sealed, slit, slits (passage:), spacing, seed, res (forest:), tilt, angle, res (slot:)")]
+    #[error("unknown key {0:?}; known: w, angle, offset, wall, door, door_offset, res, sealed, slit, slits (passage:), spacing, seed, res (forest:), tilt, angle, res (slot:), d, square, bends, radius, res (pipe:)")]
     UnknownKey(String),
     /// A parameter outside its range.
     #[error("{name} = {value} is outside {lo}..={hi}")]
