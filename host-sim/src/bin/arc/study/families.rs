@@ -162,12 +162,8 @@ fn run_on(jobs: Vec<(&'static str, String, Vec<u8>)>) -> Result<Vec<FamilyRun>, 
 }
 
 /// The median of `v`, 0 when empty.
-fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+fn median(v: Vec<f64>) -> f64 {
+    super::statistics::nearest_rank(&v, 0.5)
 }
 
 /// The markdown summary: per family and N.

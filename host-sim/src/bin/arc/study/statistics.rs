@@ -34,7 +34,7 @@ pub(super) fn quantile(sorted: &[f64], q: f64) -> f64 {
 }
 
 /// Quantile `q` (0..=1) of `values` in any order, the nearest rank (0 when empty), as
-/// the tables of `arc bench robust`, `limit` and `refuse` give it.
+/// the tables of `arc bench robust`, `limit`, `refuse` and `families` give it.
 pub(super) fn nearest_rank(values: &[f64], q: f64) -> f64 {
     let mut sorted = values.to_vec();
     sorted.sort_by(f64::total_cmp);
