@@ -61,6 +61,15 @@ pub(super) fn within(name: &'static str, value: f64, lo: f64, hi: f64) -> Result
     }
 }
 
+/// `value` as a whole number within `lo..=hi`.
+pub(super) fn whole(name: &'static str, value: f64, lo: f64, hi: f64) -> Result<u64, ProblemError> {
+    within(name, value, lo, hi)?;
+    if value.fract() != 0.0 {
+        return Err(ProblemError::NotWhole { name, value });
+    }
+    Ok(value as u64)
+}
+
 /// Parameters of one forest.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ForestSpec {
@@ -98,16 +107,7 @@ impl ForestSpec {
         for (k, v) in key_values(text)? {
             match k.as_str() {
                 "spacing" => s.spacing = v,
-                "seed" => {
-                    within("seed", v, 0.0, 1e9)?;
-                    if v.fract() != 0.0 {
-                        return Err(ProblemError::NotANumber {
-                            part: format!("seed={v}"),
-                            value: v.to_string(),
-                        });
-                    }
-                    s.seed = v as u64;
-                }
+                "seed" => s.seed = whole("seed", v, 0.0, 1e9)?,
                 "res" => s.res = v,
                 _ => return Err(ProblemError::UnknownKey(k)),
             }

@@ -43,6 +43,14 @@ pub enum ProblemError {
     /// A key that the family does not have.
     #[error("unknown key {0:?}; known: w, angle, offset, wall, door, door_offset, res, sealed, slit, slits (passage:), spacing, seed, res (forest:), tilt, angle, res (slot:), d, square, bends, radius, res (pipe:)")]
     UnknownKey(String),
+    /// A count or seed that is not a whole number.
+    #[error("{name} = {value} must be a whole number")]
+    NotWhole {
+        /// The parameter.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
     /// A parameter outside its range.
     #[error("{name} = {value} is outside {lo}..={hi}")]
     OutOfRange {

@@ -28,7 +28,7 @@
 //! follow-the-leader fashion, and the exact verifier checks the result: an instance
 //! with a witness is solvable, whatever the planner does.
 
-use super::families::{key_values, within};
+use super::families::{key_values, whole, within};
 use super::scenarios::fill;
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
@@ -114,14 +114,7 @@ impl PassageSpec {
         }
         s.door = door.map(|d| (d, door_offset));
         if let Some(w) = slit {
-            within("slits", slits, 1.0, 5.0)?;
-            if slits.fract() != 0.0 {
-                return Err(ProblemError::NotANumber {
-                    part: format!("slits={slits}"),
-                    value: slits.to_string(),
-                });
-            }
-            s.slits = Some((w, slits as u32));
+            s.slits = Some((w, whole("slits", slits, 1.0, 5.0)? as u32));
         }
         s.check()?;
         Ok(s)

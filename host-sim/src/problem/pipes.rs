@@ -21,7 +21,7 @@ use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::{Point3, Vector2};
 
-use super::families::{key_values, within};
+use super::families::{key_values, whole, within};
 use super::scenarios::Scenario;
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
@@ -70,16 +70,7 @@ impl PipeSpec {
             match k.as_str() {
                 "d" => s.d = v,
                 "square" => s.square = v != 0.0,
-                "bends" => {
-                    within("bends", v, 0.0, 2.0)?;
-                    if v.fract() != 0.0 {
-                        return Err(ProblemError::NotANumber {
-                            part: format!("bends={v}"),
-                            value: v.to_string(),
-                        });
-                    }
-                    s.bends = v as u8;
-                }
+                "bends" => s.bends = whole("bends", v, 0.0, 2.0)? as u8,
                 "radius" => s.radius = v,
                 "res" => s.res = v,
                 _ => return Err(ProblemError::UnknownKey(k)),

@@ -660,39 +660,41 @@ fn run_families(a: FamiliesArgs) -> CliResult {
     }
     let began = Instant::now();
     let runs = study::families::run(a.instances, a.seed)?;
-    let md = format!(
-        "{}\n`arc plan`'s defaults through the library's facade, {} instances of each family (seed {}); {} build, {} worker threads; whole study {:.0} s.\n",
-        study::families::markdown(&runs),
-        a.instances,
-        a.seed,
-        if cfg!(debug_assertions) { "debug" } else { "release" },
+    let what = format!(
+        "`arc plan`'s defaults through the library's facade, {} instances of each family (seed {})",
+        a.instances, a.seed
+    );
+    let md = study_page(&study::families::markdown(&runs), &what, began);
+    publish_table(&a.out_dir, "families", &md, &study::families::csv(&runs))
+}
+
+/// A study's markdown page: its table, then what ran, the build, the worker threads
+/// and how long the whole study took.
+fn study_page(table: &str, what: &str, began: Instant) -> String {
+    format!(
+        "{table}\n{what}; {} build, {} worker threads; whole study {:.0} s.\n",
+        if cfg!(debug_assertions) {
+            "debug"
+        } else {
+            "release"
+        },
         std::env::var("RAYON_NUM_THREADS").unwrap_or_else(|_| "every core's".into()),
         began.elapsed().as_secs_f64()
-    );
-    let runs_csv = study::families::csv(&runs);
-    let files: [(&str, &[u8]); 2] = [
-        ("families_runs.csv", runs_csv.as_bytes()),
-        ("families.md", md.as_bytes()),
-    ];
-    publish(&a.out_dir, &md, &files)
+    )
+}
+
+/// Writes a study's page `STEM.md` and its runs `STEM_runs.csv` under `dir`.
+fn publish_table(dir: &Path, stem: &str, md: &str, csv: &str) -> CliResult {
+    let (runs, page) = (format!("{stem}_runs.csv"), format!("{stem}.md"));
+    publish(dir, md, &[(&runs, csv.as_bytes()), (&page, md.as_bytes())])
 }
 
 fn run_refuse(a: RefuseArgs) -> CliResult {
     let began = Instant::now();
     let runs = study::refuse::run()?;
-    let md =
-        format!(
-        "{}\n`arc plan`'s defaults through the library's facade; {} build; whole study {:.0} s.\n",
-        study::refuse::markdown(&runs),
-        if cfg!(debug_assertions) { "debug" } else { "release" },
-        began.elapsed().as_secs_f64()
-    );
-    let runs_csv = study::refuse::csv(&runs);
-    let files: [(&str, &[u8]); 2] = [
-        ("refuse_runs.csv", runs_csv.as_bytes()),
-        ("refuse.md", md.as_bytes()),
-    ];
-    publish(&a.out_dir, &md, &files)
+    let what = "`arc plan`'s defaults through the library's facade";
+    let md = study_page(&study::refuse::markdown(&runs), what, began);
+    publish_table(&a.out_dir, "refuse", &md, &study::refuse::csv(&runs))
 }
 
 fn run_limit(a: LimitArgs) -> CliResult {
@@ -730,19 +732,12 @@ fn run_limit(a: LimitArgs) -> CliResult {
     );
     let limits: Vec<f64> = a.limits_ms.iter().map(|t| t / 1e3).collect();
     let runs = study::limit::run(&jobs, &limits)?;
-    let md = format!(
-        "{}\n`arc plan --trajectory --time-limit T`'s defaults through the library's facade, {} queries a limit; {} build; whole study {:.0} s.\n",
-        study::limit::markdown(&runs),
-        jobs.len(),
-        if cfg!(debug_assertions) { "debug" } else { "release" },
-        began.elapsed().as_secs_f64()
+    let what = format!(
+        "`arc plan --trajectory --time-limit T`'s defaults through the library's facade, {} queries a limit",
+        jobs.len()
     );
-    let runs_csv = study::limit::csv(&runs);
-    let files: [(&str, &[u8]); 2] = [
-        ("limit_runs.csv", runs_csv.as_bytes()),
-        ("limit.md", md.as_bytes()),
-    ];
-    publish(&a.out_dir, &md, &files)
+    let md = study_page(&study::limit::markdown(&runs), &what, began);
+    publish_table(&a.out_dir, "limit", &md, &study::limit::csv(&runs))
 }
 
 fn run_online(a: OnlineArgs) -> CliResult {
