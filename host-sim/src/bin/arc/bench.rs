@@ -504,7 +504,7 @@ fn run_scale(a: ScaleArgs) -> CliResult {
     }
     let (specs, starts) = scale::specs(&o)?;
     let (results, sums, header) = run_study(&a.study, &specs, "arc bench scale")?;
-    let md = scale::markdown(&sums, &o, &starts, &header);
+    let md = scale::markdown(&sums, &results, &o, &starts, &header);
     let svg = scale::figure(&sums, o.corridor_units);
     let png =
         aerial_chain::picture::rasterise(&svg).map_err(|e| CliError::failed(e.to_string()))?;

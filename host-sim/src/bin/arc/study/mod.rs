@@ -111,6 +111,33 @@ pub struct RunResult {
     /// For an instance of the hard-case family (`passage:`), what post-processing
     /// made of the plan and the clearance it keeps through the openings.
     pub passage: Option<PassageResult>,
+    /// Where an ARCplanner query's time went, for a successful run.
+    pub phases: Option<Phases>,
+}
+
+/// Where an ARCplanner query's time went (s), phase by phase, as `arc plan` prints it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Phases {
+    /// Labelling the map's free regions.
+    pub regions_s: f64,
+    /// Building the uniform head roadmap.
+    pub roadmap_s: f64,
+    /// The head route over the lattice.
+    pub lattice_s: f64,
+    /// The shape search along the route or roadmap (the rest of the query).
+    pub shapes_s: f64,
+}
+
+impl Phases {
+    /// The phases of a query from its stats.
+    fn of(s: &aerial_chain::planner::Stats) -> Self {
+        Self {
+            regions_s: s.regions_s,
+            roadmap_s: (s.timings.roadmap_s - s.regions_s).max(0.0),
+            lattice_s: s.lattice_s,
+            shapes_s: (s.timings.planning_s - s.lattice_s).max(0.0),
+        }
+    }
 }
 
 /// The plan of a `passage:` instance after `arc plan`'s post-processing, and the
@@ -162,6 +189,7 @@ impl RunResult {
             waypoints: None,
             verified: None,
             passage: None,
+            phases: None,
         }
     }
 
@@ -476,6 +504,7 @@ fn run_arc(
     let (mut r, res) = run_planner(env, spec, &mut planner, &q, stops);
     r.tables_s = tables_s;
     r.roadmap_vertices = spec.key.vertices;
+    r.phases = res.as_ref().ok().map(|sol| Phases::of(&sol.stats));
     if let Ok(sol) = res {
         if let Some(p) = spec.key.scenario.strip_prefix("passage:") {
             r.passage = passage_result(env, &planner, &sol, p);

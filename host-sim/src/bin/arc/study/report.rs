@@ -73,14 +73,15 @@ pub fn runs_csv(results: &[RunResult]) -> String {
     let mut s = String::from(
         "study,scenario,units,method,vertices,srs,seed,time_limit_s,start_x,start_y,start_z,success,outcome,\
          tables_s,roadmap_s,planning_s,roadmap_cpu_s,planning_cpu_s,collision_s,search_s,shape_changes,edges,replans,srs_connects,\
-         iterations,collision_checks,roadmap_vertices,build_capped,waypoints,verified,post_s,openings,message\n",
+         iterations,collision_checks,roadmap_vertices,build_capped,waypoints,verified,post_s,openings,\
+         regions_s,head_roadmap_s,lattice_s,shape_search_s,message\n",
     );
     for r in results {
         let p = &r.spec;
         let start = p.query.map(|q| q.start);
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             key_cells(&p.key),
             p.seed,
             opt(p.time_limit),
@@ -108,6 +109,10 @@ pub fn runs_csv(results: &[RunResult]) -> String {
             opt(r.verified),
             opt(r.passage.as_ref().map(|p| format!("{:.6}", p.post_s))),
             r.passage.as_ref().map_or(String::new(), openings_cell),
+            r.phases.map_or(",,,".into(), |p| format!(
+                "{:.6},{:.6},{:.6},{:.6}",
+                p.regions_s, p.roadmap_s, p.lattice_s, p.shapes_s
+            )),
             csv_field(&r.message)
         );
     }

@@ -17,8 +17,10 @@ use aerial_chain::picture::{palette, Colour};
 use aerial_chain_core::lsc::library;
 
 use super::plot::{self, Chart, Curve};
+use super::statistics::nearest_rank;
 use super::{
-    fitting_query, ArcMode, Budgets, Envs, Method, Query, RunKey, RunSpec, StudyError, Summary,
+    fitting_query, ArcMode, Budgets, Envs, Method, Phases, Query, RunKey, RunResult, RunSpec,
+    StudyError, Summary,
 };
 
 /// What to run.
@@ -125,7 +127,13 @@ fn corridor_length(s: &Summary) -> f64 {
 }
 
 /// The markdown report.
-pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta: &str) -> String {
+pub fn markdown(
+    sums: &[Summary],
+    results: &[RunResult],
+    o: &ScaleOptions,
+    starts: &[StartChoice],
+    meta: &str,
+) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# ARC benchmark: scaling\n\n{meta}\n");
     let _ = writeln!(
@@ -194,7 +202,53 @@ pub fn markdown(sums: &[Summary], o: &ScaleOptions, starts: &[StartChoice], meta
             g.time_limited
         );
     }
+    s += &phases_table(results);
     s
+}
+
+/// Where the queries' time went, per row of both studies: the median over successful
+/// runs of each phase `arc plan` reports (ms).
+fn phases_table(results: &[RunResult]) -> String {
+    let mut s = String::from(
+        "\n## Where the query's time goes\n\nMedians over successful runs (ms), the phases `arc plan` prints.\n\n\
+         | study | row | free regions | head roadmap | head route (lattice) | shape search |\n|---|---|---|---|---|---|\n",
+    );
+    // Rows in the order their first run comes.
+    let mut rows: Vec<(String, String)> = Vec::new();
+    for r in results {
+        let row = (r.spec.key.study.clone(), row_name(r));
+        if !rows.contains(&row) {
+            rows.push(row);
+        }
+    }
+    for (study, row) in rows {
+        let at: Vec<Phases> = results
+            .iter()
+            .filter(|r| r.spec.key.study == study && row_name(r) == row)
+            .filter_map(|r| r.phases)
+            .collect();
+        let med = |f: fn(&Phases) -> f64| {
+            let v: Vec<f64> = at.iter().map(f).collect();
+            nearest_rank(&v, 0.5) * 1e3
+        };
+        let _ = writeln!(
+            s,
+            "| {study} | {row} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            med(|p| p.regions_s),
+            med(|p| p.roadmap_s),
+            med(|p| p.lattice_s),
+            med(|p| p.shapes_s)
+        );
+    }
+    s
+}
+
+/// A row of the phases table: `N = n` for the units study, the corridor otherwise.
+fn row_name(r: &RunResult) -> String {
+    match r.spec.key.study.as_str() {
+        "scale-units" => format!("N = {}", r.spec.key.units),
+        _ => r.spec.key.scenario.clone(),
+    }
 }
 
 const BLUE: Colour = palette::PATH;
