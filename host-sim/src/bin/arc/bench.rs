@@ -51,9 +51,10 @@ pub enum BenchCommand {
     /// after setup against 1 s; CSV and markdown.
     #[command(after_help = "Example:\n  arc bench refuse --out-dir docs/bench")]
     Refuse(RefuseArgs),
-    /// The forest and tilted-slot families (`forest:`, `slot:`): random instances,
-    /// forests at N = 5..8, slots at N = 4..6, `arc plan`'s defaults; plans verified,
-    /// query time after setup; CSV and markdown.
+    /// The forest, tilted-slot and pipe families (`forest:`, `slot:`, `pipe:`): random
+    /// forests at N = 5..8 and slots at N = 4..6, 24 pipes at N = 4, 6, 8, `arc plan`'s
+    /// defaults; plans verified, query time after setup, pipe clearance against the
+    /// witness's; CSV and markdown.
     #[command(after_help = "Example:\n  arc bench families --instances 12 --out-dir docs/bench")]
     Families(FamiliesArgs),
     /// One plan by the full-state lazy PRM baseline (arc-plan/1, verified exactly).
@@ -213,7 +214,7 @@ pub struct OnlineArgs {
 /// `arc bench families`
 #[derive(Args, Debug)]
 pub struct FamiliesArgs {
-    /// Instances of each family, 1 to 1000.
+    /// Forests and slots drawn, 1 to 1000 (the 24 pipes are fixed).
     #[arg(long, default_value_t = 12)]
     instances: usize,
     /// Seed of the instance generator.
@@ -661,8 +662,8 @@ fn run_families(a: FamiliesArgs) -> CliResult {
     let began = Instant::now();
     let runs = study::families::run(a.instances, a.seed)?;
     let what = format!(
-        "`arc plan`'s defaults through the library's facade, {} instances of each family (seed {})",
-        a.instances, a.seed
+        "`arc plan`'s defaults through the library's facade, {} forests and {} slots (seed {}) and the 24 pipes",
+        a.instances, a.instances, a.seed
     );
     let md = study_page(&study::families::markdown(&runs), &what, began);
     publish_table(&a.out_dir, "families", &md, &study::families::csv(&runs))
