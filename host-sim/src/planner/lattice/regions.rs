@@ -474,9 +474,10 @@ fn row_runs(field: &DistanceField, [y, z]: [usize; 2], radius: f64) -> Vec<[u32;
     let mut open: Option<u32> = None;
     let row = g.obstacle_row(y, z).zip(field.row_bounds(y, z));
     for (x, (obstacle, &lb)) in row.enumerate() {
-        let at = [x, y, z].map(|v| v as i32);
-        let at = [0, 1, 2].map(|a| origin[a] + at[a]);
-        let free = !obstacle && lb > bar && (lb >= sure || !too_narrow(g, at, need));
+        // The gap test (and its lattice index) only where the bound leaves doubt.
+        let free = !obstacle
+            && lb > bar
+            && (lb >= sure || !too_narrow(g, lattice(origin, [x, y, z]), need));
         match (free, open) {
             (true, None) => open = Some(x as u32),
             (false, Some(x0)) => {
@@ -490,6 +491,12 @@ fn row_runs(field: &DistanceField, [y, z]: [usize; 2], radius: f64) -> Vec<[u32;
         runs.push([x0, g.dims()[0] as u32 - 1]);
     }
     runs
+}
+
+/// The lattice index of the voxel at grid-local `local`, the grid's lowest voxel at
+/// `origin`.
+fn lattice(origin: [i32; 3], local: [usize; 3]) -> [i32; 3] {
+    [0, 1, 2].map(|a| origin[a] + local[a] as i32)
 }
 
 /// The fewest voxels in a row, between two obstacle voxels, that can hold a centre

@@ -16,16 +16,14 @@ use rand::{Rng, SeedableRng};
 
 use aerial_chain::collision::verify_plan;
 use aerial_chain::collision::DEFAULT_CLEARANCE;
-use aerial_chain::planner::Query;
-use aerial_chain::planning::{self, PlanOptions, Request};
+use aerial_chain::planning::{self, PlanOptions};
 use aerial_chain::problem::families::{ForestSpec, SlotSpec};
 use aerial_chain::problem::pipes::PipeSpec;
 use aerial_chain::problem::scenarios::{self, Scenario};
-use aerial_chain::tables::ShapeTables;
 use aerial_chain::witness::witness;
 use aerial_chain_core::ChainParams;
 
-use super::limit::default_tables;
+use super::limit::{field_of, request, tables_for};
 use super::StudyError;
 
 /// One query of a family.
@@ -113,18 +111,15 @@ pub fn run(count: usize, seed: u64) -> Result<Vec<FamilyRun>, StudyError> {
 
 /// Plans every `(family, name, chain sizes)` at each of its chain sizes.
 fn run_on(jobs: Vec<(&'static str, String, Vec<u8>)>) -> Result<Vec<FamilyRun>, StudyError> {
-    let mut tables: Vec<(u8, ShapeTables)> = Vec::new();
+    let tables = tables_for(jobs.iter().flat_map(|(_, _, units)| units.iter().copied()))?;
     let mut out = Vec::new();
     for (family, name, units) in jobs {
         let sc = scenarios::build(&name)?;
+        let field = field_of(&sc);
         for n in units {
-            if !tables.iter().any(|(m, _)| *m == n) {
-                tables.push((n, default_tables(n)?));
-            }
-            let t = &tables.iter().find(|(m, _)| *m == n).expect("built above").1;
-            let query = Query::new(sc.start, sc.start_shape(n)?, sc.goal);
-            let request = Request::new(sc.grid.clone(), ChainParams::new(n), query);
-            let result = planning::plan(&request, Some(t.clone()), &PlanOptions::default());
+            let request = request(&sc, &field, n)?;
+            let result =
+                planning::plan(&request, Some(tables[&n].clone()), &PlanOptions::default());
             let mut run = FamilyRun {
                 family,
                 scenario: name.clone(),

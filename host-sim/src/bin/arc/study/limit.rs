@@ -9,12 +9,18 @@
 //! and the shape tables are built once per scenario and chain before the clock starts,
 //! as `arc plan` times them apart.
 
+use std::collections::btree_map::Entry;
+use std::collections::BTreeMap;
 use std::sync::atomic::AtomicUsize;
+use std::sync::Arc;
 use std::time::Instant;
 
+use aerial_chain::goal::GoalPose;
+use aerial_chain::map::DistanceField;
+use aerial_chain::plan_file::MapSection;
 use aerial_chain::planner::Query;
 use aerial_chain::planning::{self, PlanOptions, PlanningError, Request};
-use aerial_chain::problem::scenarios;
+use aerial_chain::problem::scenarios::{self, Scenario};
 use aerial_chain::tables::{ShapeTables, TableSettings};
 use aerial_chain_core::ChainParams;
 
@@ -67,19 +73,50 @@ impl LimitRun {
 
 /// Runs every `(scenario, units)` job at every limit in `limits_s` (s).
 pub fn run(jobs: &[(String, u8)], limits_s: &[f64]) -> Result<Vec<LimitRun>, StudyError> {
+    let tables = tables_for(jobs.iter().map(|(_, n)| *n))?;
     let mut out = Vec::with_capacity(jobs.len() * limits_s.len());
     for (name, units) in jobs {
         let sc = scenarios::build(name)?;
-        let params = ChainParams::new(*units);
-        let shape = sc.start_shape(*units)?;
-        let query = Query::new(sc.start, shape, sc.goal);
-        let request = Request::new(sc.grid.clone(), params, query);
-        let tables = default_tables(*units)?;
+        let request = request(&sc, &field_of(&sc), *units)?;
         for &limit_s in limits_s {
-            out.push(one(name, &request, &tables, limit_s));
+            out.push(one(name, &request, &tables[units], limit_s));
         }
     }
     Ok(out)
+}
+
+/// Every chain size of `units` once, with its default shape tables.
+pub(super) fn tables_for(
+    units: impl IntoIterator<Item = u8>,
+) -> Result<BTreeMap<u8, ShapeTables>, StudyError> {
+    let mut out = BTreeMap::new();
+    for n in units {
+        if let Entry::Vacant(e) = out.entry(n) {
+            e.insert(default_tables(n)?);
+        }
+    }
+    Ok(out)
+}
+
+/// `sc`'s distance field, built once for every chain size that plans on it.
+pub(super) fn field_of(sc: &Scenario) -> Arc<DistanceField> {
+    Arc::new(DistanceField::new(sc.grid.clone()))
+}
+
+/// `sc`'s query for a chain of `units` on `field`, as `Request::new` makes it.
+pub(super) fn request(
+    sc: &Scenario,
+    field: &Arc<DistanceField>,
+    units: u8,
+) -> Result<Request, StudyError> {
+    let query = Query::new(sc.start, sc.start_shape(units)?, sc.goal);
+    Ok(Request {
+        field: field.clone(),
+        params: ChainParams::new(units),
+        query,
+        pose: GoalPose::default(),
+        map: MapSection::of(&sc.grid),
+    })
 }
 
 /// The shape tables `arc plan` builds by default for a chain of `units`.

@@ -9,13 +9,10 @@
 //! facade at N = 4, 6 and 8.
 
 use aerial_chain::map::Cell;
-use aerial_chain::planner::Query;
-use aerial_chain::planning::{PlanOptions, Request};
+use aerial_chain::planning::PlanOptions;
 use aerial_chain::problem::scenarios::{self, Scenario};
-use aerial_chain::tables::ShapeTables;
-use aerial_chain_core::ChainParams;
 
-use super::limit::{default_tables, timed};
+use super::limit::{field_of, request, tables_for, timed};
 use super::report::{csv_table, missed, Column};
 use super::statistics::nearest_rank;
 use super::StudyError;
@@ -90,21 +87,17 @@ pub fn walled_goal(mut sc: Scenario) -> Scenario {
 /// Plans every scenario of [`names`] at every N of [`UNITS`] with `arc plan`'s
 /// defaults.
 pub fn run() -> Result<Vec<Refusal>, StudyError> {
-    let tables: Vec<ShapeTables> = UNITS
-        .iter()
-        .map(|&n| default_tables(n))
-        .collect::<Result<_, _>>()?;
+    let tables = tables_for(UNITS)?;
     let mut out = Vec::new();
     for name in names() {
         let mut sc = scenarios::build(&name)?;
         if !name.starts_with("passage:") {
             sc = walled_goal(sc);
         }
-        for (&n, tables) in UNITS.iter().zip(&tables) {
-            let shape = sc.start_shape(n)?;
-            let query = Query::new(sc.start, shape, sc.goal);
-            let request = Request::new(sc.grid.clone(), ChainParams::new(n), query);
-            let t = timed(&request, tables, &PlanOptions::default());
+        let field = field_of(&sc);
+        for n in UNITS {
+            let request = request(&sc, &field, n)?;
+            let t = timed(&request, &tables[&n], &PlanOptions::default());
             out.push(Refusal {
                 scenario: sc.name.clone(),
                 units: n,
