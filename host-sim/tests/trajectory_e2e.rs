@@ -37,6 +37,35 @@ fn maze_plan_and_trajectory_verify() {
     assert!(f("duration_s") < f("stop_go_s"), "{st}");
 }
 
+/// A 100 m corridor of doors at N = 6: no one library shape passes every door the way
+/// the search's plan does, so carrying flies it stretch by stretch, and the timed
+/// trajectory (verified exactly) lasts at most twice head path / speed (issue 38).
+#[test]
+fn a_long_corridor_is_carried_stretch_by_stretch_and_flies_within_twice_its_path() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let plan = dir.path().join("plan.json");
+    let tr = dir.path().join("t.json");
+    let scenario = "corridor:100";
+    plan_scenario(scenario, 6, &["--trajectory", s(&tr)], &plan).expect("a plan");
+    arc_ok(&["verify", "--scenario", scenario, "--trajectory", s(&tr)])
+        .unwrap_or_else(|e| panic!("trajectory not verified: {e}"));
+    let read = |p: &std::path::Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).expect("file")).expect("JSON")
+    };
+    let carried = read(&plan)["stats"]["refinement"]["carried"].clone();
+    let stretches = carried.as_array().expect("a list of stretches");
+    assert!(stretches.len() >= 2, "{carried}");
+    let st = &read(&tr)["stats"];
+    let f = |k: &str| st[k].as_f64().unwrap_or_else(|| panic!("stats.{k}"));
+    let speed = 0.5;
+    let ratio = f("duration_s") / (f("head_path_m") / speed);
+    eprintln!(
+        "corridor:100 N=6: {} stretches carried, flight {ratio:.2}x head path / speed",
+        stretches.len()
+    );
+    assert!(ratio <= 2.0, "{st}");
+}
+
 #[test]
 fn trajectory_command_csv_and_refusals() {
     let dir = tempfile::tempdir().expect("temporary directory");

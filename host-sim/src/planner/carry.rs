@@ -19,15 +19,18 @@
 //!    does there.
 //! 2. **Fit.** Along the plan's head route from `i` to `j` (every 0.3 m, tightest
 //!    first), the chain in that shape must fit with some unit within a map resolution
-//!    of the route: a carried body passes every passage the head passed. Most
-//!    candidates are turned away here, before any search.
+//!    of the route: a carried body passes every passage the head passed. Where it
+//!    does not fit along an edge, the plan is split there and each side gets its own
+//!    span (1 and 2 again, within that side). Most candidates are turned away here,
+//!    before any search.
 //!
 //! Then, largest saving first, within fixed budgets of placements:
 //!
 //! 3. **Search.** An A* over head positions on a lattice (spacing: twice the map's
 //!    resolution) from `i`'s head to `j`'s, through positions where the chain in that
-//!    shape is clear, and clear half way along the step to them (a step past a corner
-//!    can clip it between two clear positions). It is guided by the plan's route,
+//!    shape is clear, and the step to them passes the translation check (a step past a
+//!    corner can clip it between two clear positions, and the taut path below is made
+//!    of the search's own checks). It is guided by the plan's route,
 //!    shifted so that the shape's middle follows it, and keeps within 1 m of it.
 //!    Candidates whose search found no way at all on that lattice are searched again
 //!    at the map's resolution, once no candidate got through on the coarse one.
@@ -36,8 +39,10 @@
 //!    more than 25 % (plus 1 m) longer than the route it replaces is refused: a long
 //!    detour costs more flight than the changes it saves.
 //!
-//! The first candidate that passes is taken. Every check counts towards fixed
-//! budgets, not time, so the result is deterministic.
+//! The first candidate that passes is taken, and the next stretch is looked for on the
+//! plan it made, until none passes: a long route is carried stretch by stretch. Every
+//! check counts towards fixed budgets (one per stretch looked for), not time, so the
+//! result is deterministic.
 
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
@@ -50,7 +55,7 @@ use nalgebra::{Point3, Vector3};
 
 use super::candidates::{headings, Source};
 use super::lattice::{offsets26, KeyHasher};
-use super::numeric::SAME_HEADING;
+use super::numeric::{SAME_HEADING, TIE};
 use super::plan_ops::{differs, farthest, head_route, shape_motion, Quality};
 use super::{CarrySettings, Checker, Step};
 
@@ -83,10 +88,32 @@ struct Takeover {
     kind: LscKind,
 }
 
-/// The plan `steps` with a stretch of it flown in one library shape, if that moves
-/// the angles less (see the module docs); checks by `checker`. The placements its
-/// searches make (its budget, `CarrySettings::total_points`) are added to `spent`.
+/// The plan `steps` with stretches of it flown in one library shape each, where that
+/// moves the angles less (see the module docs), and those stretches in the order they
+/// were taken; checks by `checker`. The placements its searches make are added to
+/// `spent`: at most `CarrySettings::total_points` for each stretch looked for, so the
+/// work grows with the number of stretches a long route has, not with its length.
 pub(super) fn carried(
+    checker: &mut Checker,
+    library: &[LscEntry],
+    steps: &[Step],
+    s: &CarrySettings,
+    spent: &mut usize,
+) -> Option<(Vec<Step>, Vec<Carried>)> {
+    let mut plan = steps.to_vec();
+    let mut stretches = Vec::new();
+    // Each stretch taken saves at least `s.saving` of the plan's shape motion, so this
+    // ends; it ends sooner where too few changes are left to carry.
+    while let Some((next, c)) = carried_once(checker, library, &plan, s, spent) {
+        plan = next;
+        stretches.push(c);
+    }
+    (!stretches.is_empty()).then_some((plan, stretches))
+}
+
+/// One stretch of `steps` flown in one library shape: the candidate with the largest
+/// saving whose search gets through, within `total_points` placements.
+fn carried_once(
     checker: &mut Checker,
     library: &[LscEntry],
     steps: &[Step],
@@ -142,7 +169,10 @@ pub(super) fn carried(
 }
 
 /// Every library shape that could take over somewhere in the plan and fits along the
-/// route there, the largest saving first.
+/// route there, the largest saving first. Where a shape does not fit along some edge
+/// of its span (a passage only other shapes pass), the plan is split at that edge and
+/// each side gets a span of its own: on a long route a shape may carry every stretch
+/// between the passages it cannot take.
 fn takeovers(
     checker: &mut Checker,
     library: &[LscEntry],
@@ -156,17 +186,27 @@ fn takeovers(
     }
     let mut out = Vec::new();
     for (x, kind) in shapes(library, &steps[0].shape, s.headings) {
-        let Some((i, j, saving)) = span(checker, steps, &upto, &x, s.saving) else {
-            continue;
-        };
-        if fits_along(checker, &head_route(&steps[i..=j]), &x, s.fit_spacing) {
-            out.push(Takeover {
-                saving,
-                i,
-                j,
-                x,
-                kind,
-            });
+        // Ranges of waypoints still to look at, the plan's start first.
+        let mut ranges = vec![(0, steps.len() - 1)];
+        while let Some((from, to)) = ranges.pop() {
+            let Some((i, j, saving)) = span(checker, steps, &upto, &x, s.saving, from, to) else {
+                continue;
+            };
+            match misfit(checker, &steps[i..=j], &x, s.fit_spacing) {
+                None => out.push(Takeover {
+                    saving,
+                    i,
+                    j,
+                    x,
+                    kind,
+                }),
+                // Edge `k` of the span is where it does not fit: what lies after it,
+                // then what lies before it (popped first).
+                Some(k) => {
+                    ranges.push((i + k + 1, j));
+                    ranges.push((i, i + k));
+                }
+            }
         }
     }
     // Stable: equal savings keep the order of `shapes`.
@@ -176,13 +216,16 @@ fn takeovers(
 
 /// Where shape `x` can take over from the plan: the first waypoint `i` at which the
 /// chain can change into it, and the last `j` after it at which it can change back
-/// to the plan's shape (or the goal), if flying `x` from `i` to `j` would save motion.
+/// to the plan's shape (or the goal), if flying `x` from `i` to `j` would save motion;
+/// both within waypoints `from..=to`.
 fn span(
     checker: &mut Checker,
     steps: &[Step],
     upto: &[f64],
     x: &Shape,
     saving: f64,
+    from: usize,
+    to: usize,
 ) -> Option<(usize, usize, f64)> {
     let last = steps.len() - 1;
     let into = |k: usize| shape_motion(&steps[k].shape, x);
@@ -194,12 +237,12 @@ fn span(
         }
     };
     // A change at `i` can only pay where the rest of the plan moves more than it.
-    let i = (0..last).find(|&i| {
+    let i = (from..to).find(|&i| {
         into(i) + saving < upto[last] - upto[i]
             && checker.placement(steps[i].xi, x)
             && checker.shape_change(steps[i].xi, &steps[i].shape, x)
     })?;
-    let j = (i + 1..=last).rev().find(|&j| {
+    let j = (i + 1..=to).rev().find(|&j| {
         into(i) + back(j) + saving < upto[j] - upto[i]
             && checker.placement(steps[j].xi, x)
             && (j == last || checker.shape_change(steps[j].xi, x, &steps[j].shape))
@@ -274,25 +317,32 @@ fn middle(checker: &Checker, x: &Shape) -> Vector3<f64> {
     (lo + hi) / 2.0
 }
 
-/// Whether the chain in shape `x` can be at every point of the route, `fit_spacing`
-/// (m) apart (the tightest, where the head is nearest the map, first): some unit at the
-/// point or one map resolution from it along or across the axes, the rest of the body
-/// clear. A carried chain takes its body through every passage the route takes its
-/// head through; this turns away, before any search, a shape that is too wide for one.
-fn fits_along(checker: &mut Checker, route: &[Point3<f64>], x: &Shape, fit_spacing: f64) -> bool {
+/// Where the chain in shape `x` cannot be along the head route of `steps`, tested at
+/// points `fit_spacing` (m) apart (the tightest, where the head is nearest the map,
+/// first): the edge `k` (from `steps[k]` to `steps[k + 1]`) of the first point at which
+/// no unit can be at the point or one map resolution from it along or across the axes
+/// with the rest of the body clear; `None` where it fits everywhere. A carried chain
+/// takes its body through every passage the route takes its head through; this turns
+/// away, before any search, a shape that is too wide for one.
+fn misfit(checker: &mut Checker, steps: &[Step], x: &Shape, fit_spacing: f64) -> Option<usize> {
     let r_v = checker.ctx.field().grid().resolution();
-    let mut samples: Vec<(f64, Point3<f64>)> = Vec::new();
-    for w in route.windows(2) {
-        let n = ((w[1] - w[0]).norm() / r_v).ceil().max(1.0) as usize;
-        for k in 0..n {
-            let p = w[0] + (w[1] - w[0]) * (k as f64 / n as f64);
-            samples.push((checker.ctx.clearance(p), p));
+    // (clearance, point, edge)
+    let mut samples: Vec<(f64, Point3<f64>, usize)> = Vec::new();
+    for (k, w) in steps.windows(2).enumerate() {
+        let (a, b) = (w[0].xi, w[1].xi);
+        if (b - a).norm() <= TIE {
+            continue;
+        }
+        let n = ((b - a).norm() / r_v).ceil().max(1.0) as usize;
+        for m in 0..n {
+            let p = a + (b - a) * (m as f64 / n as f64);
+            samples.push((checker.ctx.clearance(p), p, k));
         }
     }
     samples.sort_by(|a, b| a.0.total_cmp(&b.0));
     let units = offsets(checker.ctx.params(), x);
     let mut tested: Vec<Point3<f64>> = Vec::new();
-    for &(_, p) in &samples {
+    for &(_, p, k) in &samples {
         if tested.iter().any(|t| (t - p).norm() < fit_spacing) {
             continue;
         }
@@ -305,10 +355,10 @@ fn fits_along(checker: &mut Checker, route: &[Point3<f64>], x: &Shape, fit_spaci
                 .any(|d| checker.placement(head + d, x))
         });
         if !fits {
-            return false;
+            return Some(k);
         }
     }
-    true
+    None
 }
 
 /// The plan's head route with the shape's middle on it: the start and the goal stay
@@ -443,9 +493,9 @@ fn search(
         }
         if k != [0; 3] {
             // A step past an obstacle's corner can clip it between two clear points:
-            // half way along it must be clear too (another step may reach the point).
+            // the step itself must pass (another step may reach the point).
             checked += 1;
-            if !checker.placement(nalgebra::center(&at(from), &p), x) {
+            if !checker.translation(at(from), p, x) {
                 pt.g = u64::MAX;
                 continue;
             }

@@ -26,7 +26,7 @@ fn room(wall: bool) -> CollisionContext {
 }
 
 /// `steps` carried in `ctx` with the library of its chain and the default tuning.
-fn carry_in(ctx: &CollisionContext, steps: &[Step]) -> Option<(Vec<Step>, Carried)> {
+fn carry_in(ctx: &CollisionContext, steps: &[Step]) -> Option<(Vec<Step>, Vec<Carried>)> {
     let lsc = library(ctx.params()).entries;
     let mut checker = Checker::new(ctx.clone(), None);
     carried(&mut checker, &lsc, steps, &d(), &mut 0)
@@ -69,6 +69,8 @@ fn a_restless_plan_in_open_space_is_flown_in_its_start_shape() {
     let steps = restless_plan();
     assert!(Quality::of(&steps).shape_changes >= d().min_changes);
     let (out, carried) = carry_in(&room(false), &steps).expect("the line flies it all");
+    assert_eq!(carried.len(), 1, "one stretch: {carried:?}");
+    let carried = carried[0];
     assert_eq!(carried.kind, LscKind::Li);
     // No change at all: the line is the start shape, and the goal needs none.
     assert_eq!(Quality::of(&out).shape_changes, 0);
@@ -166,7 +168,7 @@ proptest::proptest! {
         proptest::prop_assume!(valid);
         if let Some((out, carried)) = carry_in(&ctx, &steps) {
             assert_carried_plan_holds(&ctx, &steps, &out);
-            proptest::prop_assert!(carried.head_path_m > 0.0);
+            proptest::prop_assert!(carried.iter().all(|c| c.head_path_m > 0.0));
         }
     }
 }
@@ -185,19 +187,52 @@ fn plans_with_few_changes_are_left_alone() {
 }
 
 #[test]
-fn a_shape_across_the_window_does_not_fit_and_one_along_it_does() {
+fn a_shape_across_the_window_does_not_fit_there_and_one_along_it_does() {
     let ctx = room(true);
     let mut checker = Checker::new(ctx, None);
-    let route = [Point3::new(2.0, 2.0, 1.5), Point3::new(4.5, 2.0, 1.5)];
-    // Trailing along -x passes end first; trailing along -y lies across the window.
-    assert!(fits_along(
-        &mut checker,
-        &route,
-        &Shape::line(4, 0.0),
-        d().fit_spacing
-    ));
+    let line = Shape::line(4, 0.0);
+    let steps = [
+        step(2.0, line, false),
+        step(2.5, line, false),
+        step(3.5, line, false),
+        step(4.5, line, false),
+    ];
+    // Trailing along -x passes end first; trailing along -y lies across the window,
+    // whose wall (x = 3.0..3.2) the second edge crosses.
+    assert_eq!(misfit(&mut checker, &steps, &line, d().fit_spacing), None);
     let across = Shape::line(4, std::f32::consts::FRAC_PI_2);
-    assert!(!fits_along(&mut checker, &route, &across, d().fit_spacing));
+    assert_eq!(
+        misfit(&mut checker, &steps, &across, d().fit_spacing),
+        Some(1)
+    );
+    // Away from the wall it fits.
+    assert_eq!(
+        misfit(&mut checker, &steps[..2], &across, d().fit_spacing),
+        None
+    );
+}
+
+#[test]
+fn a_shape_that_cannot_take_the_window_still_takes_over_on_either_side_of_it() {
+    let ctx = room(true);
+    let bends =
+        |x0: f64| [0.0, 0.1, 0.2, 0.3, 0.4].map(|dx| (x0 + dx, 0.5 - (dx * 10.0 % 2.0) as f32));
+    let steps = bent_plan(2.0, &bends(2.0)[..4], &bends(5.0));
+    let valid = steps.windows(2).all(|w| edge_passes(&ctx, w));
+    assert!(valid, "the plan passes the checks");
+    let crossing = steps
+        .windows(2)
+        .position(|w| w[0].xi.x < 3.0 && w[1].xi.x > 3.2)
+        .expect("an edge through the window");
+    let mut checker = Checker::new(ctx, None);
+    let lsc = library(checker.ctx.params()).entries;
+    let all = takeovers(&mut checker, &lsc, &steps, &d());
+    let split: Vec<&Takeover> = all
+        .iter()
+        .filter(|t| misfit(&mut checker, &steps, &t.x, d().fit_spacing).is_some())
+        .collect();
+    assert!(split.iter().any(|t| t.j <= crossing), "before the window");
+    assert!(split.iter().any(|t| t.i > crossing), "after it");
 }
 
 #[test]

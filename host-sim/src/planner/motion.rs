@@ -70,13 +70,11 @@ pub fn annotate_quality(plan: &mut Plan, quality: &Quality, refinement: Option<&
         }),
     );
     m.insert("threaded".into(), r.threaded.into());
-    m.insert(
-        "carried".into(),
-        r.carried.map_or(
-            Value::Null,
-            |c| serde_json::json!({ "shape": c.kind.name(), "head_path_m": c.head_path_m }),
-        ),
-    );
+    let carried = r
+        .carried
+        .iter()
+        .map(|c| serde_json::json!({ "shape": c.kind.name(), "head_path_m": c.head_path_m }));
+    m.insert("carried".into(), Value::Array(carried.collect()));
     plan.stats.insert("refinement".into(), Value::Object(m));
     if let Some(Value::Object(t)) = plan.stats.get_mut("timing") {
         t.insert("refine_s".into(), r.time_s.into());

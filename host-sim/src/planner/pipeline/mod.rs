@@ -86,9 +86,9 @@ pub struct Refinement {
     pub widening: Widening,
     /// Whether the plan is the search's head route threaded (`super::thread`).
     pub threaded: bool,
-    /// The stretch of the plan flown in one library shape (`super::carry`), if any
-    /// (a threaded plan has none).
-    pub carried: Option<Carried>,
+    /// The stretches of the plan flown in one library shape each (`super::carry`), in
+    /// the order they were found (a threaded plan has none).
+    pub carried: Vec<Carried>,
     /// Time spent (s).
     pub time_s: f64,
     /// Every stage that ran, in the order of the declared list (a fork's first lane,
@@ -230,8 +230,8 @@ pub(crate) struct Notes {
     pub(crate) first_widening: Option<Arc<(Vec<Step>, Widening)>>,
     /// The first widening's moves, where its lane was kept (`KeepMotion`).
     pub(crate) kept_moves: Option<usize>,
-    /// The stretch flown in one library shape (`Carry`).
-    pub(crate) carried: Option<Carried>,
+    /// The stretches flown in one library shape each (`Carry`).
+    pub(crate) carried: Vec<Carried>,
     /// What the last widening did (`WidenAgain`; for a threaded plan, how it passes).
     pub(crate) widening: Widening,
     /// The route the threaded plan follows and how that passes its pinches

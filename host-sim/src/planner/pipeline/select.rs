@@ -82,7 +82,7 @@ impl Select for ThreadedIfBetter {
             measured: 0,
         };
         main.notes.threaded = true;
-        main.notes.carried = None;
+        main.notes.carried.clear();
         main.steps = threaded.steps;
         (main, 1)
     }

@@ -573,11 +573,15 @@ fn print_quality(report: &Report, q: &Quality, refinement: Option<&Refinement>) 
                 "  threaded: the chain follows its head along the route, straightened through the middle of each passage"
             ));
         }
-        if let Some(c) = r.carried {
+        if !r.carried.is_empty() {
+            let stretches: Vec<String> = r
+                .carried
+                .iter()
+                .map(|c| format!("{:.2} m in {}", c.head_path_m, c.kind.name()))
+                .collect();
             report.line(format_args!(
-                "  carried: the chain flies {:.2} m of head path in one shape ({}), on a route of its own",
-                c.head_path_m,
-                c.kind.name()
+                "  carried: the chain flies {} of head path, each stretch in one shape on a route of its own",
+                stretches.join(", ")
             ));
         }
         print_stages(report, &r.stages);
