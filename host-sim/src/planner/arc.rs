@@ -359,25 +359,28 @@ impl ArcPlanner {
     /// in its middle (a window or a door, not a wide passage where a follower would
     /// turn through every corner of the route): at an oblique window
     /// the chain lines up with the opening and threads it, where the roadmap would
-    /// sample the room for another way in. `None` where the route has no such opening
-    /// or a step fails the checks.
+    /// sample the room for another way in. A route that has no pinch to straighten
+    /// because the chain starts or ends inside the passage (a bent pipe) is followed
+    /// as it is, where its head keeps less than that reach. `None` where the route has
+    /// no such opening or a step fails the checks.
     fn threaded_on_route(
         &self,
         query: &Query,
         built: &Built,
         deadline: Option<Instant>,
     ) -> Option<(Vec<Step>, Stats)> {
-        let points: Vec<Point3<f64>> = built
-            .route
-            .as_ref()?
-            .points
-            .iter()
-            .map(|&p| p.into())
-            .collect();
-        let threading = super::thread::Threading::along(&self.ctx, &points, &self.refine.thread)?;
-        if threading.narrowest_middle() >= self.refine.thread.opening * super::widen::CAP {
-            return None;
-        }
+        let route = built.route.as_ref()?;
+        let points: Vec<Point3<f64>> = route.points.iter().map(|&p| p.into()).collect();
+        let reach = self.refine.thread.opening * super::widen::CAP;
+        let threading =
+            match super::thread::Threading::along(&self.ctx, &points, &self.refine.thread) {
+                Some(t) if t.narrowest_middle() < reach => t,
+                Some(_) => return None,
+                None if route.narrowest_margin < reach => {
+                    super::thread::Threading::as_is(&points, &self.refine.thread)?
+                }
+                None => return None,
+            };
         let (steps, checks) = threading
             .follow(
                 &self.ctx,

@@ -81,6 +81,17 @@ impl Threading {
         })
     }
 
+    /// The head route `route` (start first) as it is, with no pinch straightened: for a
+    /// chain that starts or ends inside a passage (a pipe), whose route has no pinch
+    /// with room on both sides to straighten.
+    pub(super) fn as_is(route: &[Point3<f64>], s: &ThreadSettings) -> Option<Self> {
+        (route.len() >= 2).then(|| Self {
+            route: route.to_vec(),
+            pinches: Vec::new(),
+            s: *s,
+        })
+    }
+
     /// The least clearance a unit keeps in the middle of any of the route's pinches
     /// (m; at most [`PINCH`]).
     pub(super) fn narrowest_middle(&self) -> f64 {
