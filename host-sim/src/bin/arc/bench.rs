@@ -635,24 +635,14 @@ fn run_flight(a: FlightArgs) -> CliResult {
         if cfg!(debug_assertions) { "debug" } else { "release" },
         t.elapsed().as_secs_f64()
     );
-    let files = [
-        study::write_out(
-            &a.out_dir,
-            "flight_runs.csv",
-            study::flight::csv(&runs, speed).as_bytes(),
-        )?,
-        study::write_out(&a.out_dir, "flight.md", md.as_bytes())?,
-        study::write_out(
-            &a.out_dir,
-            "flight.svg",
-            study::flight::figure(&runs, speed).as_bytes(),
-        )?,
+    let csv = study::flight::csv(&runs, speed);
+    let svg = study::flight::figure(&runs, speed);
+    let files: [(&str, &[u8]); 3] = [
+        ("flight_runs.csv", csv.as_bytes()),
+        ("flight.md", md.as_bytes()),
+        ("flight.svg", svg.as_bytes()),
     ];
-    println!("{md}");
-    for f in files {
-        println!("wrote {}", f.display());
-    }
-    Ok(())
+    publish(&a.out_dir, &md, &files)
 }
 
 fn run_families(a: FamiliesArgs) -> CliResult {
@@ -781,24 +771,14 @@ fn run_online(a: OnlineArgs) -> CliResult {
         std::env::var("RAYON_NUM_THREADS").unwrap_or_else(|_| "every core's".into()),
         t.elapsed().as_secs_f64()
     );
-    let files = [
-        study::write_out(
-            &a.out_dir,
-            "online_runs.csv",
-            study::online::csv(&runs).as_bytes(),
-        )?,
-        study::write_out(&a.out_dir, "online.md", md.as_bytes())?,
-        study::write_out(
-            &a.out_dir,
-            "online.svg",
-            study::online::figure(&runs).as_bytes(),
-        )?,
+    let csv = study::online::csv(&runs);
+    let svg = study::online::figure(&runs);
+    let files: [(&str, &[u8]); 3] = [
+        ("online_runs.csv", csv.as_bytes()),
+        ("online.md", md.as_bytes()),
+        ("online.svg", svg.as_bytes()),
     ];
-    println!("{md}");
-    for f in files {
-        println!("wrote {}", f.display());
-    }
-    Ok(())
+    publish(&a.out_dir, &md, &files)
 }
 
 fn run_prm(a: PrmArgs) -> CliResult {
