@@ -30,7 +30,7 @@ use rand::{Rng, SeedableRng};
 use super::scenarios::{fill, points, shell_box, Scenario};
 use super::spec::{
     Family, Key,
-    Values::{Flag, Real, Whole},
+    Values::{Real, Whole},
 };
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};

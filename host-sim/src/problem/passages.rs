@@ -31,7 +31,7 @@
 use super::scenarios::fill;
 use super::spec::{
     self, key_values, whole, within, Key,
-    Values::{Flag, Real, Whole},
+    Values::{Flag, Real},
 };
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
