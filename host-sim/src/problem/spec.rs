@@ -62,32 +62,22 @@ pub trait Field {
     fn set(&mut self, value: f64);
 }
 
-impl Field for f64 {
-    fn get(&self) -> f64 {
-        *self
-    }
-    fn set(&mut self, value: f64) {
-        *self = value;
-    }
+/// Lengths, angles, counts and seeds: read as they are, set by `as` (a whole key's
+/// value is already whole and within its field's range).
+macro_rules! number_field {
+    ($($t:ty),*) => {$(
+        impl Field for $t {
+            fn get(&self) -> f64 {
+                *self as f64
+            }
+            fn set(&mut self, value: f64) {
+                *self = value as $t;
+            }
+        }
+    )*};
 }
 
-impl Field for u64 {
-    fn get(&self) -> f64 {
-        *self as f64
-    }
-    fn set(&mut self, value: f64) {
-        *self = value as u64;
-    }
-}
-
-impl Field for u8 {
-    fn get(&self) -> f64 {
-        *self as f64
-    }
-    fn set(&mut self, value: f64) {
-        *self = value as u8;
-    }
-}
+number_field!(f64, u64, u8);
 
 impl Field for bool {
     fn get(&self) -> f64 {
