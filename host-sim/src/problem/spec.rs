@@ -200,6 +200,41 @@ mod tests {
     use crate::problem::families::{ForestSpec, SlotSpec};
     use crate::problem::pipes::PipeSpec;
 
+    /// Parses `good` and checks that its name builds it again, and that every spec
+    /// of `bad` is refused.
+    fn round_trip<F: Family + std::fmt::Debug + PartialEq>(good: &str, bad: &[&str]) {
+        let f = F::parse(good).unwrap();
+        let name = f.name();
+        let (family, text) = name.split_once(':').unwrap();
+        assert_eq!((family, F::parse(text).unwrap()), (F::FAMILY, f));
+        for bad in bad {
+            assert!(F::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn names_round_trip_and_ranges_are_checked() {
+        let forest_bad = [
+            "spacing=2",
+            "res=0.2",
+            "seed=-1",
+            "seed=1.5",
+            "nope=1",
+            "seed",
+        ];
+        round_trip::<ForestSpec>("spacing=1,seed=7,res=0.1", &forest_bad);
+        round_trip::<SlotSpec>("tilt=45,angle=-20,res=0.05", &["tilt=70"]);
+        let pipe_bad = [
+            "d=0.5",
+            "bends=3",
+            "bends=1.5",
+            "radius=0.5",
+            "res=0.2",
+            "nope=1",
+        ];
+        round_trip::<PipeSpec>("d=0.9,square=1,bends=2,radius=1.5,res=0.05", &pipe_bad);
+    }
+
     #[test]
     fn names_list_every_key_in_the_tables_order() {
         // The benchmarks write these names into their CSV files.
