@@ -83,6 +83,32 @@ pub struct Stats {
     pub roadmap_edges: usize,
 }
 
+impl Stats {
+    /// Where the query's time went, phase by phase: [`Self::timings`]' roadmap and
+    /// planning times split at the free regions and the lattice route they include.
+    pub fn phases(&self) -> Phases {
+        Phases {
+            regions_s: self.regions_s,
+            roadmap_s: (self.timings.roadmap_s - self.regions_s).max(0.0),
+            lattice_s: self.lattice_s,
+            shapes_s: (self.timings.planning_s - self.lattice_s).max(0.0),
+        }
+    }
+}
+
+/// Where an ARCplanner query's time went (s), phase by phase ([`Stats::phases`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Phases {
+    /// Labelling the map's free regions.
+    pub regions_s: f64,
+    /// Building the uniform head roadmap.
+    pub roadmap_s: f64,
+    /// The head route over the lattice.
+    pub lattice_s: f64,
+    /// The shape search along the route or roadmap (the rest of the query).
+    pub shapes_s: f64,
+}
+
 /// The planner: a map context, a chain's shape tables, settings, and the roadmap.
 pub struct ArcPlanner {
     /// The map and chain at the preferred clearance.

@@ -48,7 +48,7 @@ use std::time::{Duration, Instant};
 use aerial_chain_core::Shape;
 use nalgebra::Point3;
 
-pub use arc::{ArcPlanner, Stats};
+pub use arc::{ArcPlanner, Phases, Stats};
 pub use candidates::Source;
 pub use carry::Carried;
 pub(crate) use checker::Checker;

@@ -127,14 +127,16 @@ mod tests {
 
     #[test]
     fn a_time_limit_says_what_was_tried_and_other_failures_do_not() {
-        let n = NoPlan {
-            error: PlanError::TimeLimit { replans: 3 },
-            planning_s: 60.0,
+        // The same query stopped by its time limit, and refused for its goal.
+        let no_plan = |error, planning_s, collision_checks| NoPlan {
+            error,
+            planning_s,
             setup_s: 0.5,
             time_limit_s: Some(60.0),
             roadmap_vertices: 1500,
-            collision_checks: 12345,
+            collision_checks,
         };
+        let n = no_plan(PlanError::TimeLimit { replans: 3 }, 60.0, 12345);
         let s = PlanningError::NoPlan(Box::new(n)).to_string();
         assert!(
             s.starts_with("no plan: time limit reached after 3 replans"),
@@ -147,14 +149,7 @@ mod tests {
         ] {
             assert!(s.contains(part), "{s}");
         }
-        let n = NoPlan {
-            error: PlanError::Unreachable { tol: 0.3 },
-            planning_s: 1.0,
-            setup_s: 0.5,
-            time_limit_s: Some(60.0),
-            roadmap_vertices: 1500,
-            collision_checks: 1,
-        };
+        let n = no_plan(PlanError::Unreachable { tol: 0.3 }, 1.0, 1);
         let e = PlanningError::NoPlan(Box::new(n));
         assert!(!e.is_input());
         assert!(!e.to_string().contains("time limit"), "{e}");

@@ -28,47 +28,12 @@
 use rand::{Rng, SeedableRng};
 
 use super::scenarios::{fill, points, shell_box, Scenario};
+use super::spec::{
+    Family, Key,
+    Values::{Real, Whole},
+};
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
-
-/// `KEY=VALUE,...` as pairs, the values numbers.
-pub(super) fn key_values(text: &str) -> Result<Vec<(String, f64)>, ProblemError> {
-    let mut out = Vec::new();
-    for part in text.split(',').filter(|p| !p.trim().is_empty()) {
-        let (k, v) = part
-            .split_once('=')
-            .ok_or_else(|| ProblemError::ExpectedKeyValue(part.into()))?;
-        let v: f64 = v.trim().parse().map_err(|_| ProblemError::NotANumber {
-            part: part.into(),
-            value: v.into(),
-        })?;
-        out.push((k.trim().to_string(), v));
-    }
-    Ok(out)
-}
-
-/// `Ok` when `value` is finite and within `lo..=hi`.
-pub(super) fn within(name: &'static str, value: f64, lo: f64, hi: f64) -> Result<(), ProblemError> {
-    if value.is_finite() && (lo..=hi).contains(&value) {
-        Ok(())
-    } else {
-        Err(ProblemError::OutOfRange {
-            name,
-            value,
-            lo,
-            hi,
-        })
-    }
-}
-
-/// `value` as a whole number within `lo..=hi`.
-pub(super) fn whole(name: &'static str, value: f64, lo: f64, hi: f64) -> Result<u64, ProblemError> {
-    within(name, value, lo, hi)?;
-    if value.fract() != 0.0 {
-        return Err(ProblemError::NotWhole { name, value });
-    }
-    Ok(value as u64)
-}
 
 /// Parameters of one forest.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,6 +56,15 @@ impl Default for ForestSpec {
     }
 }
 
+impl Family for ForestSpec {
+    const FAMILY: &'static str = "forest";
+    const KEYS: &'static [Key<Self>] = &[
+        Key::new("spacing", Real(1.0, 1.5), |s| &mut s.spacing),
+        Key::new("seed", Whole(0.0, 1e9), |s| &mut s.seed),
+        Key::new("res", Real(0.05, 0.1), |s| &mut s.res),
+    ];
+}
+
 /// The clearing (m): x, y, z.
 const FOREST: [f64; 3] = [27.0, 10.0, 4.0];
 /// Where trunks stand along x (m).
@@ -101,35 +75,6 @@ const TRUNK_D: (f64, f64) = (0.2, 0.6);
 const FOREST_Z: f64 = 1.5;
 
 impl ForestSpec {
-    /// Parses `KEY=VALUE,...` (see the module docs).
-    pub fn parse(text: &str) -> Result<Self, ProblemError> {
-        let mut s = Self::default();
-        for (k, v) in key_values(text)? {
-            match k.as_str() {
-                "spacing" => s.spacing = v,
-                "seed" => s.seed = whole("seed", v, 0.0, 1e9)?,
-                "res" => s.res = v,
-                _ => return Err(ProblemError::UnknownKey(k)),
-            }
-        }
-        s.check()?;
-        Ok(s)
-    }
-
-    /// Checks the ranges of the module docs.
-    pub fn check(&self) -> Result<(), ProblemError> {
-        within("spacing", self.spacing, 1.0, 1.5)?;
-        within("res", self.res, 0.05, 0.1)
-    }
-
-    /// The name that builds this forest.
-    pub fn name(&self) -> String {
-        format!(
-            "forest:spacing={},seed={},res={}",
-            self.spacing, self.seed, self.res
-        )
-    }
-
     /// Trunk centres `(x, y)` and diameters, drawn from the seed.
     pub fn trunks(&self) -> Vec<([f64; 2], f64)> {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(self.seed);
@@ -215,6 +160,15 @@ impl Default for SlotSpec {
     }
 }
 
+impl Family for SlotSpec {
+    const FAMILY: &'static str = "slot";
+    const KEYS: &'static [Key<Self>] = &[
+        Key::new("tilt", Real(0.0, 60.0), |s| &mut s.tilt_deg),
+        Key::new("angle", Real(-60.0, 60.0), |s| &mut s.angle_deg),
+        Key::new("res", Real(0.025, 0.1), |s| &mut s.res),
+    ];
+}
+
 /// The room (m): x, y, z; the wall's near face and thickness (m).
 const ROOM: [f64; 3] = [10.5, 10.0, 2.6];
 const SLOT_WALL: (f64, f64) = (6.0, 0.2);
@@ -222,36 +176,6 @@ const SLOT_WALL: (f64, f64) = (6.0, 0.2);
 const SLOT: (f64, f64) = (0.5, 1.5);
 
 impl SlotSpec {
-    /// Parses `KEY=VALUE,...` (see the module docs).
-    pub fn parse(text: &str) -> Result<Self, ProblemError> {
-        let mut s = Self::default();
-        for (k, v) in key_values(text)? {
-            match k.as_str() {
-                "tilt" => s.tilt_deg = v,
-                "angle" => s.angle_deg = v,
-                "res" => s.res = v,
-                _ => return Err(ProblemError::UnknownKey(k)),
-            }
-        }
-        s.check()?;
-        Ok(s)
-    }
-
-    /// Checks the ranges of the module docs.
-    pub fn check(&self) -> Result<(), ProblemError> {
-        within("tilt", self.tilt_deg, 0.0, 60.0)?;
-        within("angle", self.angle_deg, -60.0, 60.0)?;
-        within("res", self.res, 0.025, 0.1)
-    }
-
-    /// The name that builds this slot.
-    pub fn name(&self) -> String {
-        format!(
-            "slot:tilt={},angle={},res={}",
-            self.tilt_deg, self.angle_deg, self.res
-        )
-    }
-
     /// The scenario.
     pub fn build(&self) -> Result<Scenario, ProblemError> {
         self.check()?;
@@ -309,21 +233,10 @@ mod tests {
     use super::*;
 
     #[test]
-    fn forests_are_drawn_from_their_seed_and_names_round_trip() {
+    fn forests_are_drawn_from_their_seed() {
         let f = ForestSpec::parse("spacing=1,seed=7,res=0.1").unwrap();
-        assert_eq!(ForestSpec::parse(&f.name()["forest:".len()..]).unwrap(), f);
         assert_eq!(f.trunks(), f.trunks());
         assert_ne!(f.trunks(), ForestSpec { seed: 8, ..f }.trunks());
-        for bad in [
-            "spacing=2",
-            "res=0.2",
-            "seed=-1",
-            "seed=1.5",
-            "nope=1",
-            "seed",
-        ] {
-            assert!(ForestSpec::parse(bad).is_err(), "{bad}");
-        }
         let sc = f.build().unwrap();
         // Columns x = 6..22 and rows y = 0.5..9.5, 1 m apart.
         assert_eq!(f.trunks().len(), 17 * 10);
@@ -339,8 +252,6 @@ mod tests {
     #[test]
     fn a_slot_is_open_along_its_tilted_long_side_and_closed_across_it() {
         let s = SlotSpec::parse("tilt=45,angle=-20,res=0.05").unwrap();
-        assert_eq!(SlotSpec::parse(&s.name()["slot:".len()..]).unwrap(), s);
-        assert!(SlotSpec::parse("tilt=70").is_err());
         let sc = s.build().unwrap();
         let g = &sc.grid;
         let (x, yc, zc) = (6.1, 5.0, 1.3);

@@ -11,6 +11,7 @@ pub mod large;
 pub mod passages;
 pub mod pipes;
 pub mod scenarios;
+pub mod spec;
 
 use crate::collision::verify::PlanViolation;
 

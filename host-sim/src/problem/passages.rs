@@ -28,8 +28,11 @@
 //! follow-the-leader fashion, and the exact verifier checks the result: an instance
 //! with a witness is solvable, whatever the planner does.
 
-use super::families::{key_values, whole, within};
 use super::scenarios::fill;
+use super::spec::{
+    self, key_values, whole, within, Key,
+    Values::{Flag, Real},
+};
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
 use crate::problem::scenarios::Scenario;
@@ -90,6 +93,19 @@ pub const SLIT_PITCH: f64 = 0.6;
 const SLIT_HEIGHT: f64 = 1.5;
 
 impl PassageSpec {
+    /// The keys of `passage:` that stand for a field each, in the order their ranges
+    /// are checked; `door`, `door_offset`, `slit` and `slits` are read in pairs by
+    /// [`Self::parse`].
+    const KEYS: &'static [Key<Self>] = &[
+        Key::new("w", Real(0.4, 1.0), |s| &mut s.w),
+        Key::new("angle", Real(-60.0, 60.0), |s| &mut s.angle_deg),
+        Key::new("offset", Real(-0.4, 0.4), |s| &mut s.offset),
+        Key::new("wall", Real(0.1, 2.0), |s| &mut s.wall),
+        Key::new("res", Real(0.025, 0.1), |s| &mut s.res),
+        Key::new("gap", Real(1.0, 3.0), |s| &mut s.gap),
+        Key::new("sealed", Flag, |s| &mut s.sealed),
+    ];
+
     /// Parses `KEY=VALUE,...` (see the module docs).
     pub fn parse(text: &str) -> Result<Self, ProblemError> {
         let mut s = Self::default();
@@ -98,18 +114,11 @@ impl PassageSpec {
         let (mut slit, mut slits) = (None, 3.0);
         for (k, v) in key_values(text)? {
             match k.as_str() {
-                "w" => s.w = v,
-                "angle" => s.angle_deg = v,
-                "offset" => s.offset = v,
-                "wall" => s.wall = v,
                 "door" => door = Some(v),
                 "door_offset" => door_offset = v,
-                "gap" => s.gap = v,
-                "res" => s.res = v,
-                "sealed" => s.sealed = v != 0.0,
                 "slit" => slit = Some(v),
                 "slits" => slits = v,
-                _ => return Err(ProblemError::UnknownKey(k)),
+                _ => spec::apply(Self::KEYS, &mut s, k, v)?,
             }
         }
         s.door = door.map(|d| (d, door_offset));
@@ -122,12 +131,7 @@ impl PassageSpec {
 
     /// Checks the ranges of the module docs.
     pub fn check(&self) -> Result<(), ProblemError> {
-        within("w", self.w, 0.4, 1.0)?;
-        within("angle", self.angle_deg, -60.0, 60.0)?;
-        within("offset", self.offset, -0.4, 0.4)?;
-        within("wall", self.wall, 0.1, 2.0)?;
-        within("res", self.res, 0.025, 0.1)?;
-        within("gap", self.gap, 1.0, 3.0)?;
+        spec::check(self, Self::KEYS)?;
         if let Some((d, o)) = self.door {
             within("door", d, 0.4, 1.0)?;
             within("door_offset", o, -3.0, 3.0)?;

@@ -21,8 +21,11 @@ use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::{Point3, Vector2};
 
-use super::families::{key_values, whole, within};
 use super::scenarios::Scenario;
+use super::spec::{
+    Family, Key,
+    Values::{Flag, Real, Whole},
+};
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
 
@@ -53,6 +56,17 @@ impl Default for PipeSpec {
     }
 }
 
+impl Family for PipeSpec {
+    const FAMILY: &'static str = "pipe";
+    const KEYS: &'static [Key<Self>] = &[
+        Key::new("d", Real(0.6, 1.2), |s| &mut s.d),
+        Key::new("square", Flag, |s| &mut s.square),
+        Key::new("bends", Whole(0.0, 2.0), |s| &mut s.bends),
+        Key::new("radius", Real(0.8, 2.0), |s| &mut s.radius),
+        Key::new("res", Real(0.025, 0.1), |s| &mut s.res),
+    ];
+}
+
 /// Straight run from the closed end to the first bend, and after the last (m).
 const RUN_IN: f64 = 4.2;
 const RUN_OUT: f64 = 2.5;
@@ -63,39 +77,6 @@ const AXIS_Z: f64 = 1.2;
 const ROCK: f64 = 0.3;
 
 impl PipeSpec {
-    /// Parses `KEY=VALUE,...` (see the module docs).
-    pub fn parse(text: &str) -> Result<Self, ProblemError> {
-        let mut s = Self::default();
-        for (k, v) in key_values(text)? {
-            match k.as_str() {
-                "d" => s.d = v,
-                "square" => s.square = v != 0.0,
-                "bends" => s.bends = whole("bends", v, 0.0, 2.0)? as u8,
-                "radius" => s.radius = v,
-                "res" => s.res = v,
-                _ => return Err(ProblemError::UnknownKey(k)),
-            }
-        }
-        s.check()?;
-        Ok(s)
-    }
-
-    /// Checks the ranges of the module docs.
-    pub fn check(&self) -> Result<(), ProblemError> {
-        within("d", self.d, 0.6, 1.2)?;
-        within("bends", self.bends as f64, 0.0, 2.0)?;
-        within("radius", self.radius, 0.8, 2.0)?;
-        within("res", self.res, 0.025, 0.1)
-    }
-
-    /// The name that builds this pipe.
-    pub fn name(&self) -> String {
-        format!(
-            "pipe:d={},square={},bends={},radius={},res={}",
-            self.d, self.square as u8, self.bends, self.radius, self.res
-        )
-    }
-
     /// The axis in the horizontal plane, sampled every `step` m from the closed end
     /// (x = 0) to the open end.
     fn axis(&self, step: f64) -> Vec<Vector2<f64>> {
@@ -210,22 +191,6 @@ impl PipeSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn names_round_trip_and_ranges_are_checked() {
-        let p = PipeSpec::parse("d=0.9,square=1,bends=2,radius=1.5,res=0.05").unwrap();
-        assert_eq!(PipeSpec::parse(&p.name()["pipe:".len()..]).unwrap(), p);
-        for bad in [
-            "d=0.5",
-            "bends=3",
-            "bends=1.5",
-            "radius=0.5",
-            "res=0.2",
-            "nope=1",
-        ] {
-            assert!(PipeSpec::parse(bad).is_err(), "{bad}");
-        }
-    }
 
     #[test]
     fn the_bore_is_open_on_its_axis_and_closed_beyond_its_wall() {

@@ -29,6 +29,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use aerial_chain_core::{ChainParams, Shape};
 use nalgebra::Point3;
 
+use super::spec::Family;
 use super::ProblemError;
 use crate::map::grid::{Cell, Grid};
 use crate::map::octomap::{MapFileError, OcTree};

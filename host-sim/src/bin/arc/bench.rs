@@ -589,14 +589,7 @@ fn run_robust(a: RobustArgs) -> CliResult {
     );
     let svg = robust::figure(&results);
     let runs = study::runs_csv(&results);
-    let stem = family.stem();
-    let names = ["_runs.csv", ".md", ".svg"].map(|end| format!("{stem}{end}"));
-    let files: [(&str, &[u8]); 3] = [
-        (&names[0], runs.as_bytes()),
-        (&names[1], md.as_bytes()),
-        (&names[2], svg.as_bytes()),
-    ];
-    publish(&a.out_dir, &md, &files)
+    publish_runs(&a.out_dir, family.stem(), &md, &runs, Some(&svg))
 }
 
 fn run_flight(a: FlightArgs) -> CliResult {
@@ -635,24 +628,9 @@ fn run_flight(a: FlightArgs) -> CliResult {
         if cfg!(debug_assertions) { "debug" } else { "release" },
         t.elapsed().as_secs_f64()
     );
-    let files = [
-        study::write_out(
-            &a.out_dir,
-            "flight_runs.csv",
-            study::flight::csv(&runs, speed).as_bytes(),
-        )?,
-        study::write_out(&a.out_dir, "flight.md", md.as_bytes())?,
-        study::write_out(
-            &a.out_dir,
-            "flight.svg",
-            study::flight::figure(&runs, speed).as_bytes(),
-        )?,
-    ];
-    println!("{md}");
-    for f in files {
-        println!("wrote {}", f.display());
-    }
-    Ok(())
+    let csv = study::flight::csv(&runs, speed);
+    let svg = study::flight::figure(&runs, speed);
+    publish_runs(&a.out_dir, "flight", &md, &csv, Some(&svg))
 }
 
 fn run_families(a: FamiliesArgs) -> CliResult {
@@ -666,7 +644,13 @@ fn run_families(a: FamiliesArgs) -> CliResult {
         a.instances, a.instances, a.seed
     );
     let md = study_page(&study::families::markdown(&runs), &what, began);
-    publish_table(&a.out_dir, "families", &md, &study::families::csv(&runs))
+    publish_runs(
+        &a.out_dir,
+        "families",
+        &md,
+        &study::families::csv(&runs),
+        None,
+    )
 }
 
 /// A study's markdown page: its table, then what ran, the build, the worker threads
@@ -684,10 +668,14 @@ fn study_page(table: &str, what: &str, began: Instant) -> String {
     )
 }
 
-/// Writes a study's page `STEM.md` and its runs `STEM_runs.csv` under `dir`.
-fn publish_table(dir: &Path, stem: &str, md: &str, csv: &str) -> CliResult {
-    let (runs, page) = (format!("{stem}_runs.csv"), format!("{stem}.md"));
-    publish(dir, md, &[(&runs, csv.as_bytes()), (&page, md.as_bytes())])
+/// Publishes a study's runs `{stem}_runs.csv`, its page `{stem}.md` (also printed)
+/// and, for a study that draws one, its figure `{stem}.svg`.
+fn publish_runs(dir: &Path, stem: &str, md: &str, csv: &str, svg: Option<&str>) -> CliResult {
+    let names = ["_runs.csv", ".md", ".svg"].map(|end| format!("{stem}{end}"));
+    let mut files: Vec<(&str, &[u8])> =
+        vec![(&names[0], csv.as_bytes()), (&names[1], md.as_bytes())];
+    files.extend(svg.map(|svg| (names[2].as_str(), svg.as_bytes())));
+    publish(dir, md, &files)
 }
 
 fn run_refuse(a: RefuseArgs) -> CliResult {
@@ -695,7 +683,7 @@ fn run_refuse(a: RefuseArgs) -> CliResult {
     let runs = study::refuse::run()?;
     let what = "`arc plan`'s defaults through the library's facade";
     let md = study_page(&study::refuse::markdown(&runs), what, began);
-    publish_table(&a.out_dir, "refuse", &md, &study::refuse::csv(&runs))
+    publish_runs(&a.out_dir, "refuse", &md, &study::refuse::csv(&runs), None)
 }
 
 fn run_limit(a: LimitArgs) -> CliResult {
@@ -738,7 +726,7 @@ fn run_limit(a: LimitArgs) -> CliResult {
         jobs.len()
     );
     let md = study_page(&study::limit::markdown(&runs), &what, began);
-    publish_table(&a.out_dir, "limit", &md, &study::limit::csv(&runs))
+    publish_runs(&a.out_dir, "limit", &md, &study::limit::csv(&runs), None)
 }
 
 fn run_online(a: OnlineArgs) -> CliResult {
@@ -781,24 +769,9 @@ fn run_online(a: OnlineArgs) -> CliResult {
         std::env::var("RAYON_NUM_THREADS").unwrap_or_else(|_| "every core's".into()),
         t.elapsed().as_secs_f64()
     );
-    let files = [
-        study::write_out(
-            &a.out_dir,
-            "online_runs.csv",
-            study::online::csv(&runs).as_bytes(),
-        )?,
-        study::write_out(&a.out_dir, "online.md", md.as_bytes())?,
-        study::write_out(
-            &a.out_dir,
-            "online.svg",
-            study::online::figure(&runs).as_bytes(),
-        )?,
-    ];
-    println!("{md}");
-    for f in files {
-        println!("wrote {}", f.display());
-    }
-    Ok(())
+    let csv = study::online::csv(&runs);
+    let svg = study::online::figure(&runs);
+    publish_runs(&a.out_dir, "online", &md, &csv, Some(&svg))
 }
 
 fn run_prm(a: PrmArgs) -> CliResult {

@@ -357,16 +357,13 @@ fn options(a: &PlanArgs, file: Option<&Loaded>, given: &Given) -> Result<PlanOpt
 /// the search's structures and its two searches (the head's route over the lattice,
 /// the chain's shapes along it), then post-processing and the trajectory.
 fn phases(setup_s: f64, planned: &planning::Planned) -> String {
-    let (s, t) = (&planned.stats, &planned.timings);
+    let (p, t) = (planned.stats.phases(), &planned.timings);
     let mut parts = vec![
         ("setup", setup_s),
-        ("free regions", s.regions_s),
-        ("head roadmap", (s.timings.roadmap_s - s.regions_s).max(0.0)),
-        ("head route (lattice)", s.lattice_s),
-        (
-            "shape search",
-            (s.timings.planning_s - s.lattice_s).max(0.0),
-        ),
+        ("free regions", p.regions_s),
+        ("head roadmap", p.roadmap_s),
+        ("head route (lattice)", p.lattice_s),
+        ("shape search", p.shapes_s),
         ("post-processing", t.post_s),
     ];
     if planned.trajectory.is_some() {

@@ -20,6 +20,7 @@ use aerial_chain::planning::{self, PlanOptions};
 use aerial_chain::problem::families::{ForestSpec, SlotSpec};
 use aerial_chain::problem::pipes::PipeSpec;
 use aerial_chain::problem::scenarios::{self, Scenario};
+use aerial_chain::problem::spec::Family;
 use aerial_chain::witness::witness;
 use aerial_chain_core::ChainParams;
 

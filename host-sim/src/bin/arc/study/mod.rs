@@ -50,7 +50,7 @@ use aerial_chain::collision::{verify_plan, CollisionContext, DEFAULT_CLEARANCE};
 use aerial_chain::map::DistanceField;
 use aerial_chain::plan_file::MapSection;
 use aerial_chain::planner::{
-    to_plan, ArcPlanner, Failure, Planner, Settings, Solution, SolutionStats, Termination,
+    to_plan, ArcPlanner, Failure, Phases, Planner, Settings, Solution, SolutionStats, Termination,
 };
 use aerial_chain::planning;
 use aerial_chain::problem::passages::PassageSpec;
@@ -113,31 +113,6 @@ pub struct RunResult {
     pub passage: Option<PassageResult>,
     /// Where an ARCplanner query's time went, for a successful run.
     pub phases: Option<Phases>,
-}
-
-/// Where an ARCplanner query's time went (s), phase by phase, as `arc plan` prints it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Phases {
-    /// Labelling the map's free regions.
-    pub regions_s: f64,
-    /// Building the uniform head roadmap.
-    pub roadmap_s: f64,
-    /// The head route over the lattice.
-    pub lattice_s: f64,
-    /// The shape search along the route or roadmap (the rest of the query).
-    pub shapes_s: f64,
-}
-
-impl Phases {
-    /// The phases of a query from its stats.
-    fn of(s: &aerial_chain::planner::Stats) -> Self {
-        Self {
-            regions_s: s.regions_s,
-            roadmap_s: (s.timings.roadmap_s - s.regions_s).max(0.0),
-            lattice_s: s.lattice_s,
-            shapes_s: (s.timings.planning_s - s.lattice_s).max(0.0),
-        }
-    }
 }
 
 /// The plan of a `passage:` instance after `arc plan`'s post-processing, and the
@@ -504,7 +479,7 @@ fn run_arc(
     let (mut r, res) = run_planner(env, spec, &mut planner, &q, stops);
     r.tables_s = tables_s;
     r.roadmap_vertices = spec.key.vertices;
-    r.phases = res.as_ref().ok().map(|sol| Phases::of(&sol.stats));
+    r.phases = res.as_ref().ok().map(|sol| sol.stats.phases());
     if let Ok(sol) = res {
         if let Some(p) = spec.key.scenario.strip_prefix("passage:") {
             r.passage = passage_result(env, &planner, &sol, p);

@@ -14,13 +14,14 @@
 use std::fmt::Write as _;
 
 use aerial_chain::picture::{palette, Colour};
+use aerial_chain::planner::Phases;
 use aerial_chain_core::lsc::library;
 
 use super::plot::{self, Chart, Curve};
 use super::statistics::nearest_rank;
 use super::{
-    fitting_query, ArcMode, Budgets, Envs, Method, Phases, Query, RunKey, RunResult, RunSpec,
-    StudyError, Summary,
+    fitting_query, ArcMode, Budgets, Envs, Method, Query, RunKey, RunResult, RunSpec, StudyError,
+    Summary,
 };
 
 /// What to run.
