@@ -35,6 +35,16 @@ fn rule(holds: bool, why: &'static str) -> Result<(), LimitsError> {
 /// time: `max d/dx (3x^2 - 2x^3) = 1.5`.
 const RAMP_PEAK_ACCEL: f64 = 1.5;
 
+/// Default largest rate of any shape angle (rad/s, about 23 degrees/s): what the
+/// defaults of `arc sim` and `arc trajectory` fly. Faster: shorter flights, larger
+/// link torques.
+const DEFAULT_ANGULAR_RATE: f64 = 0.4;
+
+/// Largest difference (m or rad) between one reference's end and the next one's start
+/// that still joins them: far below what the controllers resolve, above the rounding
+/// of a plan written to a file and read back.
+const JOIN_TOLERANCE: f64 = 1e-6;
+
 /// Why a plan's waypoints cannot be timed into a reference.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ReferenceError {
@@ -92,7 +102,7 @@ impl Default for ReferenceLimits {
         Self {
             speed: 0.5,
             accel: 0.5,
-            angular_rate: 0.4,
+            angular_rate: DEFAULT_ANGULAR_RATE,
             angular_accel: 0.5,
             start_hold: 1.0,
         }
@@ -558,7 +568,7 @@ impl Reference {
                 } else {
                     d
                 };
-                d.abs() <= 1e-6
+                d.abs() <= JOIN_TOLERANCE
             });
         if !joined {
             return Err(ReferenceError::Join {
