@@ -520,6 +520,215 @@ pub fn exact_clearance(
     best
 }
 
+/// [`exact_clearance`] as the conservative checks use it: `Some(v)` with `v` the value
+/// it returns (to the bit: the exact distance from `p` to the nearest obstacle cube,
+/// capped at `cap`) when that value is above `stop`, `None` when it is not (some cube
+/// lies within `stop`).
+///
+/// It reads the same rows with the same row gaps and measures a cube as that does, so
+/// the minimum is the same to the bit; only the order and the work differ. The rows
+/// straight across `p` in y and in z come first, nearest out: beside a flat wall they
+/// hold the nearest cube, which settles a blocked point at once and keeps the rows
+/// read after them (those left within the nearest distance found) few. Inside the
+/// grid a row is one gap read from the whole arrays, and a candidate cube's state is
+/// read only when its distance could lower the minimum. What this path does not cover
+/// (a point beyond the grid's x extent, a row whose gap saturates within reach, a
+/// large cap) goes to [`exact_clearance`] itself.
+pub(crate) fn exact_clearance_above(
+    field: &DistanceField,
+    p: Point3<f64>,
+    stop: f64,
+    cap: f64,
+) -> Option<f64> {
+    let slow = || {
+        let e = exact_clearance(field, p, stop, cap);
+        (e > stop).then_some(e)
+    };
+    let g = field.grid();
+    let r = g.resolution();
+    // The rings `exact_clearance` reads: no row beyond them holds a cube within `cap`.
+    let rings = (cap / r).ceil();
+    // (A point this far out would overflow the lattice's indices: that one reads it.)
+    let near = p.iter().all(|v| v.abs() < 1e9);
+    if !(cap >= 0.0 && rings < (STACK_SPAN / 2) as f64 && near) {
+        return slow();
+    }
+    let rings = rings as i32 + 1;
+    let span = (2 * rings + 1) as usize;
+    if span > STACK_SPAN {
+        return slow();
+    }
+    let c0 = g.lattice_index(p);
+    let o = g.origin();
+    let [nx, ny, nz] = g.dims().map(|d| d as i64);
+    let lx = c0[0] as i64 - o[0] as i64;
+    if lx < 0 || lx >= nx {
+        return slow();
+    }
+    let mut gy = [0.0f64; STACK_SPAN];
+    let mut gz = [0.0f64; STACK_SPAN];
+    for d in 0..span {
+        let off = d as i64 - rings as i64;
+        gy[d] = slab_gap(r, p[1], c0[1] as i64 + off);
+        gz[d] = slab_gap(r, p[2], c0[2] as i64 + off);
+    }
+    let mut rows = Rows {
+        cells: g.raw_cells(),
+        gaps: field.row_gaps(),
+        grid: g,
+        dims: [nx, ny, nz],
+        lx,
+        ly: c0[1] as i64 - o[1] as i64,
+        lz: c0[2] as i64 - o[2] as i64,
+        x0: o[0] as i64,
+        r,
+        px: p[0],
+        unknown: g.unknown_is_occupied(),
+        best: cap,
+        skip: cap * cap * SQUARE_ALLOWANCE,
+        stop,
+    };
+    let at = |a: &[f64; STACK_SPAN], d: i32| a[(d + rings) as usize];
+    // The rows straight across p, nearest out (`exact_clearance`'s ring bound: every
+    // cube of a row `j` away is at least `(j - 1) r` away).
+    for j in 0..=rings {
+        if (j - 1) as f64 * r >= rows.best {
+            break;
+        }
+        let cross: &[(i32, i32)] = if j == 0 {
+            &[(0, 0)]
+        } else {
+            &[(0, -j), (0, j), (-j, 0), (j, 0)]
+        };
+        for &(dy, dz) in cross {
+            match rows.read(dy, dz, at(&gy, dy), at(&gz, dz)) {
+                Row::Go => {}
+                Row::Found => return None,
+                Row::Slow => return slow(),
+            }
+        }
+    }
+    // The others, planes nearest out and rows nearest out in each: the slab gaps grow
+    // away from p, so the first row beyond the minimum found ends its side.
+    for dz in (1..=rings).flat_map(|k| [-k, k]) {
+        let gz = at(&gz, dz);
+        if gz * gz > rows.skip {
+            continue;
+        }
+        for side in [-1, 1] {
+            for k in 1..=rings {
+                let gy = at(&gy, side * k);
+                if gy * gy + gz * gz > rows.skip {
+                    break;
+                }
+                match rows.read(side * k, dz, gy, gz) {
+                    Row::Go => {}
+                    Row::Found => return None,
+                    Row::Slow => return slow(),
+                }
+            }
+        }
+    }
+    (rows.best > stop).then_some(rows.best)
+}
+
+/// What reading one row decided.
+enum Row {
+    /// Nothing within `stop` so far.
+    Go,
+    /// A cube within `stop`.
+    Found,
+    /// The row needs [`exact_clearance`]'s own reading (its gap saturates).
+    Slow,
+}
+
+/// The search of [`exact_clearance_above`]: the arrays it reads and the minimum so far.
+struct Rows<'a> {
+    cells: &'a [u8],
+    gaps: &'a [u8],
+    grid: &'a Grid,
+    /// The grid's dimensions.
+    dims: [i64; 3],
+    /// Grid-local indices of the voxel holding p.
+    lx: i64,
+    ly: i64,
+    lz: i64,
+    /// The grid's first lattice x.
+    x0: i64,
+    r: f64,
+    px: f64,
+    unknown: bool,
+    /// The nearest cube so far (at most the cap) and the squares beyond it.
+    best: f64,
+    skip: f64,
+    stop: f64,
+}
+
+impl Rows<'_> {
+    /// Reads the row `dy`, `dz` from p's, whose slab gaps are `gy`, `gz`: its nearest
+    /// obstacle cubes either way along x, each measured as `exact_clearance` does.
+    #[inline(always)]
+    fn read(&mut self, dy: i32, dz: i32, gy: f64, gz: f64) -> Row {
+        if gy * gy + gz * gz > self.skip {
+            return Row::Go;
+        }
+        let [nx, ny, nz] = self.dims;
+        let (y, z) = (self.ly + dy as i64, self.lz + dz as i64);
+        if y < 0 || y >= ny || z < 0 || z >= nz {
+            // Beyond the grid every voxel is unknown: the one across from p is the
+            // row's nearest obstacle when unknown space is one.
+            return match self.unknown {
+                true => self.cube(self.lx, None, gy, gz),
+                false => Row::Go,
+            };
+        }
+        let start = ((z * ny + y) * nx) as usize;
+        let n = self.gaps[start + self.lx as usize];
+        if n == FAR {
+            // The row holds no obstacle within `FAR - 1` voxels along x.
+            return match (FAR - 1) as f64 * self.r >= self.best {
+                true => Row::Go,
+                false => Row::Slow,
+            };
+        }
+        // Both of the row's candidates lie `n` voxels from p's along x, so at least
+        // `(n - 1) r` away along x (less a relative allowance far above the rounding of
+        // `slab_gap`); a square from that bound is no larger than either cube's (each
+        // step of the sum is monotone), so a row beyond the minimum by it is left
+        // without measuring its cubes or reading their states.
+        let near = (n.max(1) - 1) as f64 * self.r * (1.0 - 1e-12);
+        if near * near + gy * gy + gz * gz > self.skip {
+            return Row::Go;
+        }
+        let n = n as i64;
+        for x in [self.lx - n, self.lx + n] {
+            let raw = (0..nx).contains(&x).then(|| self.cells[start + x as usize]);
+            if let Row::Found = self.cube(x, Some(raw), gy, gz) {
+                return Row::Found;
+            }
+        }
+        Row::Go
+    }
+
+    /// Measures the voxel at grid-local `x` of a row (`raw`: `None` for a row beyond
+    /// the grid, else the voxel's raw state, `None` beyond the row's ends) when its
+    /// square distance could lower the minimum and it is an obstacle.
+    #[inline]
+    fn cube(&mut self, x: i64, raw: Option<Option<u8>>, gy: f64, gz: f64) -> Row {
+        let gx = slab_gap(self.r, self.px, self.x0 + x);
+        // As `exact_clearance` sums the squares.
+        let s = gx * gx + gy * gy + gz * gz;
+        if s <= self.skip && self.grid.is_obstacle_raw(raw.flatten()) {
+            self.best = self.best.min(s.sqrt());
+            self.skip = self.best * self.best * SQUARE_ALLOWANCE;
+            if self.best <= self.stop {
+                return Row::Found;
+            }
+        }
+        Row::Go
+    }
+}
+
 /// How far the coordinate `v` lies from the slab of voxels `i` (lattice index,
 /// resolution `r`) along its axis, as `point_box_distance` measures it from a voxel's
 /// faces: a row or plane left out by it holds no cube nearer, to the bit.

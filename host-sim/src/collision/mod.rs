@@ -354,14 +354,9 @@ impl CollisionContext {
             return c;
         }
         let r_v = self.field.grid().resolution();
-        let e = exact::exact_clearance(&self.field, p, need, need + r_v);
         // Below `need`, `exact_clearance` may give a cube that is not the nearest: only
         // a value above `need` is a proven distance.
-        if e > need {
-            e
-        } else {
-            c
-        }
+        exact::exact_clearance_above(&self.field, p, need, need + r_v).unwrap_or(c)
     }
 
     /// Whether the head's unit sphere (grown by the clearance margin) is free at `p`

@@ -398,6 +398,49 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+
+    /// `exact_clearance_above` answers as `exact_clearance` does for the conservative
+    /// checks, to the bit: its value when that is above `stop`, else `None`; inside the
+    /// grid, across its faces and beyond, near `stop` and with caps past the grid.
+    #[test]
+    fn exact_clearance_above_is_exact_clearance(
+        grid in small_grid(),
+        p in proptest::array::uniform3(-1.0f64..1.6),
+        stop in -0.1f64..0.4,
+        reach in 0.0f64..0.8,
+    ) {
+        let (p, cap) = (Point3::from(p), stop.max(0.0) + reach);
+        let field = DistanceField::new(grid);
+        let e = exact::exact_clearance(&field, p, stop, cap);
+        let above = exact::exact_clearance_above(&field, p, stop, cap);
+        prop_assert_eq!(above.map(f64::to_bits), (e > stop).then_some(e.to_bits()));
+    }
+}
+
+#[test]
+fn exact_clearance_above_reads_rows_whose_gaps_saturate() {
+    // Rows of 300 voxels at 0.01 m: a gap beyond 254 voxels saturates, and within the
+    // cap such a row is read whole (by `exact_clearance`).
+    let mut g = Grid::new(0.01, [0, 0, 0], [300, 3, 3], Cell::Free, false).unwrap();
+    g.set([0, 1, 1], Cell::Occupied);
+    g.set([299, 0, 0], Cell::Occupied);
+    let field = DistanceField::new(g);
+    let p = Point3::new(2.905, 0.015, 0.015);
+    for (stop, cap) in [(0.0, 3.0), (0.0, 0.05), (2.9, 3.0), (0.1, 2.0)] {
+        let e = exact::exact_clearance(&field, p, stop, cap);
+        let above = exact::exact_clearance_above(&field, p, stop, cap);
+        assert_eq!(above, (e > stop).then_some(e), "stop {stop} cap {cap}");
+    }
+    // The cube at x = 299 is 0.085 m along x and a voxel across in y and z.
+    let d = exact::exact_clearance_above(&field, p, 0.0, 0.2).unwrap();
+    assert!(
+        (d - (0.085f64.powi(2) + 2.0 * 0.005f64.powi(2)).sqrt()).abs() < 1e-12,
+        "{d}"
+    );
+}
+
 #[test]
 fn nearest_obstacle_sees_voxels_set_after_a_search() {
     let mut g = Grid::new(0.1, [0, 0, 0], [20, 20, 20], Cell::Free, false).unwrap();

@@ -229,15 +229,29 @@ impl DistanceField {
     #[inline]
     pub fn clearance(&self, p: impl Into<Point3<f64>>) -> f64 {
         let p = p.into();
+        self.grid_coordinates(&p)
+            .map_or(0.0, |rel| self.clearance_at(&p, &rel))
+    }
+
+    /// [`Self::grid_coordinate`] of every axis of `p`; `None` where the clearance is 0.
+    #[inline]
+    fn grid_coordinates(&self, p: &Point3<f64>) -> Option<[f64; 3]> {
+        Some([
+            self.grid_coordinate(p[0], 0)?,
+            self.grid_coordinate(p[1], 1)?,
+            self.grid_coordinate(p[2], 2)?,
+        ])
+    }
+
+    /// [`Self::clearance`] of `p`, whose grid coordinates are `rel`.
+    #[inline]
+    fn clearance_at(&self, p: &Point3<f64>, rel: &[f64; 3]) -> f64 {
         let dims = self.grid.dims();
         let mut idx = [[0usize; 2]; 3];
         let mut d2 = [[0f64; 2]; 3];
         for a in 0..3 {
-            let Some(rel) = self.grid_coordinate(p[a], a) else {
-                return 0.0;
-            };
             // Centres bracketing p: local indices floor(rel - 0.5) and + 1, clamped.
-            let lo = floor(rel - 0.5);
+            let lo = floor(rel[a] - 0.5);
             let max = self.extent[a] - 1.0;
             for (j, v) in [lo, lo + 1.0].into_iter().enumerate() {
                 let li = v.clamp(0.0, max);
@@ -270,15 +284,18 @@ impl DistanceField {
     #[inline]
     pub fn clearance_coarse(&self, p: impl Into<Point3<f64>>) -> f64 {
         let p = p.into();
+        self.grid_coordinates(&p)
+            .map_or(0.0, |rel| self.coarse_at(&p, &rel))
+    }
+
+    /// [`Self::clearance_coarse`] of `p`, whose grid coordinates are `rel`.
+    #[inline]
+    fn coarse_at(&self, p: &Point3<f64>, rel: &[f64; 3]) -> f64 {
         let dims = self.grid.dims();
         let mut l = [0usize; 3];
         let mut d2 = 0.0;
         for a in 0..3 {
-            let Some(rel) = self.grid_coordinate(p[a], a) else {
-                return 0.0;
-            };
-            let rel = floor(rel);
-            let li = rel.clamp(0.0, self.extent[a] - 1.0);
+            let li = floor(rel[a]).clamp(0.0, self.extent[a] - 1.0);
             l[a] = local_index(li);
             d2 += self.centre_gap_sq(p[a], li, a);
         }
@@ -288,14 +305,20 @@ impl DistanceField {
 
     /// [`Self::clearance_coarse`] when it exceeds `need`, else [`Self::clearance`]: a
     /// proven lower bound, as tight as the fine query wherever it matters for `need`.
+    /// Both read the grid coordinates of `p` computed once (three divisions, which cost
+    /// about as much as the rest of the coarse query).
     #[inline]
     pub fn clearance_above(&self, p: impl Into<Point3<f64>>, need: f64) -> f64 {
         let p = p.into();
-        let c = self.clearance_coarse(p);
+        // Where a coordinate says 0, both queries say 0.
+        let Some(rel) = self.grid_coordinates(&p) else {
+            return 0.0;
+        };
+        let c = self.coarse_at(&p, &rel);
         if c > need {
             c
         } else {
-            self.clearance(p)
+            self.clearance_at(&p, &rel)
         }
     }
 
@@ -311,6 +334,12 @@ impl DistanceField {
     #[inline]
     pub(crate) fn row_gaps_at(&self, start: usize) -> &[u8] {
         &self.row_gaps[start..start + self.grid.dims()[0]]
+    }
+
+    /// [`Self::row_gaps_at`] of every voxel (the grid's layout, x fastest).
+    #[inline]
+    pub(crate) fn row_gaps(&self) -> &[u8] {
+        &self.row_gaps
     }
 
     /// Bytes held by the grid and the field, with what updates keep once built.

@@ -375,6 +375,13 @@ impl Grid {
         self.local([self.origin[0], y, z]).map(|l| self.linear(l))
     }
 
+    /// The raw states of every voxel (the grid's layout, x fastest). Read with
+    /// [`Self::is_obstacle_raw`].
+    #[inline]
+    pub(crate) fn raw_cells(&self) -> &[u8] {
+        &self.cells
+    }
+
     /// The raw states of the row starting at `start` ([`Self::row_start`]). Read with
     /// [`Self::is_obstacle_raw`].
     #[inline]
