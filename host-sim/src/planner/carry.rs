@@ -33,16 +33,15 @@
 //!    of the search's own checks). It is guided by the plan's route,
 //!    shifted so that the shape's middle follows it, and keeps within 1 m of it.
 //!    Candidates whose search found no way at all on that lattice are searched again
-//!    at the map's resolution, once no candidate got through on the coarse one.
+//!    at the map's resolution, after every candidate has been tried on the coarse one.
 //! 4. **Taut.** The lattice path is pulled taut by the planner's translation checks,
 //!    which are what makes the result admissible (the lattice only guides). A path
 //!    more than 25 % (plus 1 m) longer than the route it replaces is refused: a long
 //!    detour costs more flight than the changes it saves.
 //!
-//! The first candidate that passes is taken, and the next stretch is looked for on the
-//! plan it made, until none passes: a long route is carried stretch by stretch. Every
-//! check counts towards fixed budgets (one per stretch looked for), not time, so the
-//! result is deterministic.
+//! Every candidate that passes is taken, unless its span overlaps one taken before: a
+//! long route is carried stretch by stretch. Every check counts towards fixed budgets,
+//! not time, so the result is deterministic.
 
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
@@ -90,9 +89,8 @@ struct Takeover {
 
 /// The plan `steps` with stretches of it flown in one library shape each, where that
 /// moves the angles less (see the module docs), and those stretches in the order they
-/// were taken; checks by `checker`. The placements its searches make are added to
-/// `spent`: at most `CarrySettings::total_points` for each stretch looked for, so the
-/// work grows with the number of stretches a long route has, not with its length.
+/// were found; checks by `checker`. The placements its searches make are added to
+/// `spent` (at most `CarrySettings::total_points`).
 pub(super) fn carried(
     checker: &mut Checker,
     library: &[LscEntry],
@@ -100,30 +98,12 @@ pub(super) fn carried(
     s: &CarrySettings,
     spent: &mut usize,
 ) -> Option<(Vec<Step>, Vec<Carried>)> {
-    let mut plan = steps.to_vec();
-    let mut stretches = Vec::new();
-    // Each stretch taken saves at least `s.saving` of the plan's shape motion, so this
-    // ends; it ends sooner where too few changes are left to carry.
-    while let Some((next, c)) = carried_once(checker, library, &plan, s, spent) {
-        plan = next;
-        stretches.push(c);
-    }
-    (!stretches.is_empty()).then_some((plan, stretches))
-}
-
-/// One stretch of `steps` flown in one library shape: the candidate with the largest
-/// saving whose search gets through, within `total_points` placements.
-fn carried_once(
-    checker: &mut Checker,
-    library: &[LscEntry],
-    steps: &[Step],
-    s: &CarrySettings,
-    spent: &mut usize,
-) -> Option<(Vec<Step>, Carried)> {
     if Quality::of(steps).shape_changes < s.min_changes {
         return None;
     }
     let mut tried = takeovers(checker, library, steps, s);
+    // Stretches taken: their spans, paths and what they carried.
+    let mut taken: Vec<(Takeover, Vec<Point3<f64>>, Carried)> = Vec::new();
     // The coarse lattice first; where it found no way at all (rather than running out
     // of placements), the fine one may pass a spot the coarse one steps over.
     let r_v = checker.ctx.field().grid().resolution();
@@ -131,8 +111,12 @@ fn carried_once(
     for spacing in s.spacings {
         let mut closed = Vec::new();
         for t in tried {
+            // A span that overlaps a stretch taken would undo part of it.
+            if taken.iter().any(|(o, ..)| t.i <= o.j && o.i <= t.j) {
+                continue;
+            }
             if *spent - start >= s.total_points {
-                return None;
+                break;
             }
             let route = head_route(&steps[t.i..=t.j]);
             let guide = Guide::new(&route, middle(checker, &t.x), s.tube);
@@ -160,12 +144,22 @@ fn carried_once(
                 kind: t.kind,
                 head_path_m,
             };
-            let source = Source::Lsc(t.kind);
-            return Some((splice(steps, t.i, t.j, &path, t.x, source), carried));
+            taken.push((t, path, carried));
         }
         tried = closed;
     }
-    None
+    if taken.is_empty() {
+        return None;
+    }
+    let stretches = taken.iter().map(|(.., c)| *c).collect();
+    // Spliced from the plan's end, so that the spans still to splice keep their
+    // indices (they are disjoint).
+    taken.sort_by_key(|(t, ..)| Reverse(t.i));
+    let mut plan = steps.to_vec();
+    for (t, path, _) in &taken {
+        plan = splice(&plan, t.i, t.j, path, t.x, Source::Lsc(t.kind));
+    }
+    Some((plan, stretches))
 }
 
 /// Every library shape that could take over somewhere in the plan and fits along the

@@ -390,8 +390,7 @@ pub struct CarrySettings {
     /// Placements one shape's search may check.
     /// More: longer detours found, for time.
     pub search_points: usize,
-    /// Placements all shapes' searches for one stretch together may check (each
-    /// stretch looked for has its own, so a long route with many stretches gets more).
+    /// Placements all shapes' searches together may check.
     /// More: more candidates searched, for time.
     pub total_points: usize,
     /// The search keeps within this distance (m) of its guide.

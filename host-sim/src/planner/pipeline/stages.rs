@@ -193,16 +193,13 @@ impl Stage for Carry {
         let mut checker = Checker::new(draft.ctx.clone(), cx.deadline);
         let mut spent = 0;
         let found = carry::carried(&mut checker, cx.lsc, &draft.steps, &cx.s.carry, &mut spent);
-        let mut stretches = 0;
         if let Some((steps, carried)) = found {
             draft.steps = steps;
-            stretches = carried.len();
             draft.notes.carried = carried;
         }
-        // Each stretch looked for (the one that found none too) has its own budget.
         let budget = Budget {
             unit: Unit::Placements,
-            limit: (cx.s.carry.total_points * (stretches + 1)) as u64,
+            limit: cx.s.carry.total_points as u64,
             used: spent as u64,
         };
         (draft, budget)
