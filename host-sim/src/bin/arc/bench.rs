@@ -620,11 +620,14 @@ fn run_flight(a: FlightArgs) -> CliResult {
         );
         runs.push(r);
     }
+    let robust = match a.runs.robust {
+        0 => String::new(),
+        k => format!(" (the robust family: over its first {k} instances, N = 4..8 as drawn)"),
+    };
     let md = format!(
-        "{}\nMedians over seeds 1..={} (the robust family: over its first {} instances, N = 4..8 as drawn); flight time from the start of the flight (1 s hold included) to arrival; {} build; whole study {:.0} s.\n",
+        "{}\nMedians over seeds 1..={}{robust}; flight time from the start of the flight (1 s hold included) to arrival; {} build; whole study {:.0} s.\n",
         study::flight::markdown(&runs, speed),
         a.seeds,
-        a.runs.robust,
         if cfg!(debug_assertions) { "debug" } else { "release" },
         t.elapsed().as_secs_f64()
     );

@@ -264,11 +264,21 @@ pub fn markdown(runs: &[FlightRun], speed: f64) -> String {
     );
     let mut keys: Vec<(String, String)> = runs.iter().map(group_of).collect();
     keys.dedup();
+    // Groups of which no run flew, with the first run's reason.
+    let mut unflown = Vec::new();
     for (sc, n) in keys {
         let group: Vec<&FlightRun> = runs
             .iter()
             .filter(|r| group_of(r) == (sc.clone(), n.clone()) && r.error.is_empty())
             .collect();
+        if group.is_empty() {
+            let why = runs.iter().find(|r| group_of(r) == (sc.clone(), n.clone()));
+            unflown.push(format!(
+                "{sc} N = {n} ({})",
+                why.map_or("", |r| r.error.as_str())
+            ));
+            continue;
+        }
         let med = |f: &dyn Fn(&FlightRun) -> f64| median(group.iter().map(|r| f(r)).collect());
         let ok = group
             .iter()
@@ -288,6 +298,9 @@ pub fn markdown(runs: &[FlightRun], speed: f64) -> String {
             med(&|r| (r.refine_s + r.trajectory_s) * 1e3),
             if ok { "yes" } else { "no" }
         );
+    }
+    if !unflown.is_empty() {
+        let _ = writeln!(s, "\nNot flown: {}.", unflown.join("; "));
     }
     s
 }
@@ -401,6 +414,17 @@ mod tests {
         assert!(
             md.contains("| robust family | 4-8 | 2 | 10.0 | 20.0 | 20.0 -> 12.0 | 35.0 | 1.75 | 25.0 | 1.25 |"),
             "{md}"
+        );
+        assert!(!md.contains("Not flown"), "{md}");
+        // A size whose runs all failed gets no row of NaNs but a line with the reason.
+        let mut failed = run("corridor:100", 1, 60.0, 30.0);
+        failed.units = 8;
+        failed.error = "start is invalid".into();
+        let md_failed = markdown(&[runs[0].clone(), failed], 0.5);
+        assert!(!md_failed.contains("NaN"), "{md_failed}");
+        assert!(
+            md_failed.contains("Not flown: corridor:100 N = 8 (start is invalid)."),
+            "{md_failed}"
         );
         let csv = csv(&runs, 0.5);
         assert_eq!(csv.lines().count(), 5);
