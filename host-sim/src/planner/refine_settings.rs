@@ -48,7 +48,8 @@ mod defaults {
     pub const THREAD_TUNNEL: f64 = 0.4;
     pub const THREAD_TUNNEL_ENDS: f64 = 0.8;
     pub const THREAD_TUNNEL_ALIGNED: f64 = 0.9;
-    pub const THREAD_MAX_STEPS: usize = 4000;
+    pub const THREAD_MAX_STEPS: usize = 40_000;
+    pub const THREAD_BAND_ROUNDS: usize = 40;
     pub const THREAD_JOIN_REACH: usize = 200;
     pub const THREAD_ALONGSIDE: f64 = 1.0;
     pub const THREAD_MEASURE_SLACK: f64 = 0.01;
@@ -343,6 +344,10 @@ pub struct ThreadSettings {
     /// Most ascent steps at each step length.
     /// More: farther moves at each step length, for queries.
     pub centre_rounds: usize,
+    /// Rounds of the elastic band that a route the chain cannot follow is pulled into
+    /// (each moves every sample half way to its neighbours' middle and away from the
+    /// map). More: smoother routes that keep farther from corners, for queries.
+    pub band_rounds: usize,
 }
 
 impl Default for ThreadSettings {
@@ -374,6 +379,7 @@ impl Default for ThreadSettings {
             cone_deg: d::THREAD_CONE_DEG,
             centre_steps: d::THREAD_CENTRE_STEPS,
             centre_rounds: d::THREAD_CENTRE_ROUNDS,
+            band_rounds: d::THREAD_BAND_ROUNDS,
         }
     }
 }
@@ -531,6 +537,7 @@ impl RefineSettings {
             positive("thread.centre_steps", v)?;
         }
         rounds("thread.centre_rounds", t.centre_rounds as f64)?;
+        rounds("thread.band_rounds", t.band_rounds as f64)?;
         let c = &self.carry;
         check(
             &name("carry.min_changes"),

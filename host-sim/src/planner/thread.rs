@@ -37,6 +37,10 @@ use crate::collision::CollisionContext;
 /// this (m): derived, the passages widening works on (`super::widen::CAP`).
 const PINCH: f64 = super::widen::CAP;
 
+/// Samples per link length of the elastic band handed to the follower: derived, finer
+/// than the link so that the body laid along it follows the band's bends.
+const BAND_SAMPLES_PER_LINK: f64 = 4.0;
+
 /// Radians per degree, for the direction grid given in degrees.
 const DEGREE: f64 = std::f64::consts::PI / 180.0;
 
@@ -79,6 +83,19 @@ impl Threading {
             pinches,
             s: *s,
         })
+    }
+
+    /// The head route of `raw` pulled into an elastic band (`Router::band`), then
+    /// straightened through its pinches: for a plan whose own route the chain cannot
+    /// follow. `None` when the band has no pinch.
+    pub(super) fn banded(ctx: &CollisionContext, raw: &[Step], s: &ThreadSettings) -> Option<Self> {
+        let route = head_route(raw);
+        if route.len() < 2 {
+            return None;
+        }
+        let router = Router { ctx, s };
+        let band = router.band(&route);
+        Self::along(ctx, &band, s)
     }
 
     /// The head route `route` (start first) as it is, with no pinch straightened: for a
@@ -266,6 +283,43 @@ impl Router<'_> {
         }
         out.dedup();
         (out, taken)
+    }
+
+    /// The route as an elastic band (Quinlan and Khatib): sampled every voxel, then
+    /// for `ThreadSettings::band_rounds` rounds every sample but the ends moves half
+    /// way to the middle of its neighbours (which takes out the wandering of a
+    /// search's route and spreads its kinks) and away from the map where a unit there
+    /// would keep less than the pinch limit, by half of what it lacks (which keeps the
+    /// band off the corners it would otherwise be pulled onto); a move the head could
+    /// not make is not made. The band comes back sampled every quarter link: a follower
+    /// lays its body along it, and its step is shorter.
+    fn band(&self, route: &[Point3<f64>]) -> Vec<Point3<f64>> {
+        let h = self.res();
+        let (mut p, _) = densify(route, h);
+        let limit = self.r_u() + PINCH;
+        let n = p.len();
+        for _ in 0..self.s.band_rounds {
+            for k in 1..n - 1 {
+                let mid = nalgebra::center(&p[k - 1], &p[k + 1]);
+                let d = distance(self.ctx, p[k]);
+                let push = if d < limit {
+                    gradient(self.ctx, p[k]) * (limit - d)
+                } else {
+                    Vector3::zeros()
+                };
+                let q = p[k] + (mid - p[k]) * 0.5 + push * 0.5;
+                if self.ctx.is_head_free(q) {
+                    p[k] = q;
+                }
+            }
+        }
+        let spacing = self.ctx.params().link_length as f64 / BAND_SAMPLES_PER_LINK;
+        let every = (spacing / h).round().max(1.0) as usize;
+        let mut out: Vec<Point3<f64>> = p.iter().step_by(every).copied().collect();
+        if out.last() != p.last() {
+            out.push(p[n - 1]);
+        }
+        out
     }
 
     /// The pinches the route crosses: the first and last samples of each narrow

@@ -38,9 +38,12 @@ impl Select for KeepMotion {
     }
 }
 
-/// Between the main lane's plan and the threaded one. **Rule:** where the main plan
+/// Between the main lane's plan and the threaded one. **Rule:** the threaded plan is
+/// kept when it moves the angles less than the main plan by more than
+/// `ThreadSettings::motion` per link and keeps at least the main plan's narrowest
+/// clearance (a long route the main plan snakes along). Else, where the main plan
 /// passes every pinch of the search's route at a share of its middle of
-/// `WidenSettings::centred` or more, it stays. Else the threaded plan is kept when
+/// `WidenSettings::centred` or more, it stays; and the threaded plan is kept when
 /// its share is at least `ThreadSettings::share`, larger than the main plan's by
 /// more than `ThreadSettings::gain`, and its shape motion exceeds the main plan's by
 /// at most `ThreadSettings::motion` per link. The threaded plan is not widened: its
@@ -63,14 +66,19 @@ impl Select for ThreadedIfBetter {
             return (main, 0);
         };
         let (threading, passing) = (&t.0, &t.1);
-        let share = threading.measure(cx.ctx, &main.steps, false).share;
-        if share >= cx.s.widen.centred {
-            return (main, 0);
-        }
         let th = &cx.s.thread;
         let links = cx.ctx.params().links() as f64;
+        // Less shape motion by more than the allowance, at no less clearance: the
+        // chain bends less on its way (a long route the main plan snakes along).
+        let calmer = motion(&threaded) + links * th.motion < motion(&main)
+            && passing.narrowest >= main.notes.widening.after;
+        let share = threading.measure(cx.ctx, &main.steps, false).share;
+        if share >= cx.s.widen.centred && !calmer {
+            return (main, 0);
+        }
         let affordable = motion(&threaded) <= motion(&main) + links * th.motion;
-        if !(passing.share >= th.share && passing.share > share + th.gain && affordable) {
+        let centred = passing.share >= th.share && passing.share > share + th.gain;
+        if !(calmer || centred && affordable) {
             return (main, 0);
         }
         // The main lane's notes stay for the report, with the threaded plan's figures.

@@ -253,7 +253,19 @@ impl Stage for Thread {
             draft.notes.withdrawn = true;
             return (draft, budget);
         };
-        match threading.follow(&draft.ctx, &draft.steps[0], cx.follow_step, cx.deadline) {
+        // Where the plan's own route cannot be followed (it wanders where the search
+        // tried shape after shape, or hugs corners), the route pulled into a band.
+        let mut threading = threading;
+        let mut r = threading.follow(&draft.ctx, &draft.steps[0], cx.follow_step, cx.deadline);
+        if r.is_err() {
+            if let Some(banded) = Threading::banded(&draft.ctx, &draft.steps, &cx.s.thread) {
+                let again = banded.follow(&draft.ctx, &draft.steps[0], cx.follow_step, cx.deadline);
+                if again.is_ok() {
+                    (threading, r) = (banded, again);
+                }
+            }
+        }
+        match r {
             Ok((steps, _)) => {
                 budget.used = steps.len() as u64;
                 let passing = threading.measure(&draft.ctx, &steps, true);
