@@ -66,6 +66,31 @@ fn a_long_corridor_is_carried_stretch_by_stretch_and_flies_within_twice_its_path
     assert!(ratio <= 2.0, "{st}");
 }
 
+/// The same corridor at N = 7: no library shape carries it, and the search's route
+/// cannot be followed as it is (it wanders where the search tried shape after shape).
+/// Pulled into an elastic band, the route is threaded, and the trajectory (verified
+/// exactly) lasts at most twice head path / speed.
+#[test]
+fn a_long_corridor_at_seven_units_is_threaded_along_a_band_within_twice_its_path() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let plan = dir.path().join("plan.json");
+    let tr = dir.path().join("t.json");
+    let scenario = "corridor:100";
+    plan_scenario(scenario, 7, &["--trajectory", s(&tr)], &plan).expect("a plan");
+    arc_ok(&["verify", "--scenario", scenario, "--trajectory", s(&tr)])
+        .unwrap_or_else(|e| panic!("trajectory not verified: {e}"));
+    let read = |p: &std::path::Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).expect("file")).expect("JSON")
+    };
+    let refinement = read(&plan)["stats"]["refinement"].clone();
+    assert_eq!(refinement["threaded"], true, "{refinement}");
+    let st = &read(&tr)["stats"];
+    let f = |k: &str| st[k].as_f64().unwrap_or_else(|| panic!("stats.{k}"));
+    let ratio = f("duration_s") / (f("head_path_m") / 0.5);
+    eprintln!("corridor:100 N=7: threaded, flight {ratio:.2}x head path / speed");
+    assert!(ratio <= 2.0, "{st}");
+}
+
 #[test]
 fn trajectory_command_csv_and_refusals() {
     let dir = tempfile::tempdir().expect("temporary directory");

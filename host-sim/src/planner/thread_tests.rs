@@ -126,3 +126,40 @@ fn a_pinch_becomes_its_axis_through_the_middle() {
     assert_eq!(on_axis.len(), 2, "{out:?}");
     assert!(on_axis[0].x < 2.0 && on_axis[1].x > 2.15, "{on_axis:?}");
 }
+
+#[test]
+fn a_wandering_route_pulled_into_a_band_is_smooth_free_and_keeps_its_ends() {
+    let (_, ctx) = window();
+    // Up and down by 0.2 m every 0.1 m, as a search's route wanders, but level
+    // through the window (x = 2.0 .. 2.2).
+    let route: Vec<Point3<f64>> = (0..=30)
+        .map(|k| {
+            let x = 0.6 + 0.1 * k as f64;
+            let up = k % 2 == 1 && !(14..=16).contains(&k);
+            Point3::new(x, 1.0, if up { 1.2 } else { 1.0 })
+        })
+        .collect();
+    let s = ThreadSettings::default();
+    let band = Router { ctx: &ctx, s: &s }.band(&route);
+    assert_eq!(band[0], route[0]);
+    assert_eq!(band.last(), route.last());
+    assert!(band.iter().all(|p| ctx.is_head_free(*p)));
+    // Total turning along the way: the band's is a small part of the route's.
+    let turning = |r: &[Point3<f64>]| {
+        r.windows(3)
+            .filter_map(|w| {
+                let (a, b) = (
+                    (w[1] - w[0]).try_normalize(TIE)?,
+                    (w[2] - w[1]).try_normalize(TIE)?,
+                );
+                Some(a.dot(&b).clamp(-1.0, 1.0).acos())
+            })
+            .sum::<f64>()
+    };
+    assert!(
+        turning(&band) < 0.2 * turning(&route),
+        "{} against {}",
+        turning(&band),
+        turning(&route)
+    );
+}

@@ -111,6 +111,9 @@ pub fn run_one(scenario: &str, units: u8, seed: u64) -> FlightRun {
     run
 }
 
+/// How a run's error begins where only its stop-and-go flight could not be flown.
+const STOP_AND_GO_NOT_FLOWN: &str = "stop and go not flown";
+
 fn fly_both(run: &mut FlightRun) -> Result<(), String> {
     let sc = scenarios::build(&run.scenario).map_err(|e| e.to_string())?;
     let params = ChainParams::new(run.units)
@@ -166,8 +169,14 @@ fn fly_both(run: &mut FlightRun) -> Result<(), String> {
     run.blended = tr.blended();
     run.merged = tr.merged();
     run.trajectory_duration_s = tr.duration();
-    // Both as `arc sim` flies them: `--no-blend`, then the default, along the
-    // trajectory made above.
+    // Both as `arc sim` flies them: the default, along the trajectory made above,
+    // then `--no-blend`. A plan of many short steps can stop and go for hours, past
+    // what the simulation records: its blended flight still counts.
+    let blended = FlyOptions::default();
+    let timed = Timed::along(tr, &blended);
+    let after = flying::fly_timed(&plan, &timed, grid, &blended, &Progress::default())
+        .map_err(|e| e.to_string())?;
+    run.after = Some(Flown::of(&after.report));
     let stopping = FlyOptions {
         timing: trajectory::Settings {
             blend: false,
@@ -175,14 +184,9 @@ fn fly_both(run: &mut FlightRun) -> Result<(), String> {
         },
         ..Default::default()
     };
-    let (before, _) =
-        flying::fly(&plan, grid, &stopping, &Progress::default()).map_err(|e| e.to_string())?;
+    let (before, _) = flying::fly(&plan, grid, &stopping, &Progress::default())
+        .map_err(|e| format!("{STOP_AND_GO_NOT_FLOWN}: {e}"))?;
     run.before = Some(Flown::of(&before.report));
-    let blended = FlyOptions::default();
-    let timed = Timed::along(tr, &blended);
-    let after = flying::fly_timed(&plan, &timed, grid, &blended, &Progress::default())
-        .map_err(|e| e.to_string())?;
-    run.after = Some(Flown::of(&after.report));
     Ok(())
 }
 
@@ -264,13 +268,17 @@ pub fn markdown(runs: &[FlightRun], speed: f64) -> String {
     );
     let mut keys: Vec<(String, String)> = runs.iter().map(group_of).collect();
     keys.dedup();
-    // Groups of which no run flew, with the first run's reason.
+    // Groups of which no run flew, with the first run's reason; runs whose stop and
+    // go alone was not flown, with theirs.
     let mut unflown = Vec::new();
     for (sc, n) in keys {
         let group: Vec<&FlightRun> = runs
             .iter()
-            .filter(|r| group_of(r) == (sc.clone(), n.clone()) && r.error.is_empty())
+            .filter(|r| group_of(r) == (sc.clone(), n.clone()) && r.after.is_some())
             .collect();
+        for r in group.iter().filter(|r| !r.error.is_empty()) {
+            unflown.push(format!("{sc} N = {n} seed {}: {}", r.seed, r.error));
+        }
         if group.is_empty() {
             let why = runs.iter().find(|r| group_of(r) == (sc.clone(), n.clone()));
             unflown.push(format!(
@@ -282,7 +290,7 @@ pub fn markdown(runs: &[FlightRun], speed: f64) -> String {
         let med = |f: &dyn Fn(&FlightRun) -> f64| median(group.iter().map(|r| f(r)).collect());
         let ok = group
             .iter()
-            .all(|r| r.before.is_some_and(|f| f.success) && r.after.is_some_and(|f| f.success));
+            .all(|r| r.before.is_none_or(|f| f.success) && r.after.is_some_and(|f| f.success));
         let _ = writeln!(
             s,
             "| {sc} | {n} | {} | {:.1} | {:.1} | {:.1} -> {:.1} | {:.1} | {:.2} | {:.1} | {:.2} | {:.0} | {} |",
@@ -420,11 +428,25 @@ mod tests {
         let mut failed = run("corridor:100", 1, 60.0, 30.0);
         failed.units = 8;
         failed.error = "start is invalid".into();
+        (failed.before, failed.after) = (None, None);
         let md_failed = markdown(&[runs[0].clone(), failed], 0.5);
         assert!(!md_failed.contains("NaN"), "{md_failed}");
         assert!(
             md_failed.contains("Not flown: corridor:100 N = 8 (start is invalid)."),
             "{md_failed}"
+        );
+        // A run whose stop and go alone was not flown keeps its blended flight.
+        let mut partial = run("corridor:100", 2, 60.0, 30.0);
+        partial.before = None;
+        partial.error = format!("{STOP_AND_GO_NOT_FLOWN}: too long");
+        let md_partial = markdown(&[partial], 0.5);
+        assert!(
+            md_partial.contains("| corridor:100 | 5 | 1 |"),
+            "{md_partial}"
+        );
+        assert!(
+            md_partial.contains("corridor:100 N = 5 seed 2: stop and go not flown: too long"),
+            "{md_partial}"
         );
         let csv = csv(&runs, 0.5);
         assert_eq!(csv.lines().count(), 5);
