@@ -291,8 +291,7 @@ pub fn markdown(runs: &[FlightRun], speed: f64) -> String {
         let ok = group
             .iter()
             .all(|r| r.before.is_none_or(|f| f.success) && r.after.is_some_and(|f| f.success));
-        let _ = writeln!(
-            s,
+        let row = format!(
             "| {sc} | {n} | {} | {:.1} | {:.1} | {:.1} -> {:.1} | {:.1} | {:.2} | {:.1} | {:.2} | {:.0} | {} |",
             group.len(),
             med(&|r| r.head_path_m),
@@ -306,6 +305,8 @@ pub fn markdown(runs: &[FlightRun], speed: f64) -> String {
             med(&|r| (r.refine_s + r.trajectory_s) * 1e3),
             if ok { "yes" } else { "no" }
         );
+        // A figure no run has (a stop and go not flown) is a dash, not NaN.
+        let _ = writeln!(s, "{}", row.replace(" NaN ", " - "));
     }
     if !unflown.is_empty() {
         let _ = writeln!(s, "\nNot flown: {}.", unflown.join("; "));
