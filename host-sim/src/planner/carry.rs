@@ -46,6 +46,7 @@
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
 use std::hash::BuildHasherDefault;
+use std::ops::Range;
 
 use aerial_chain_core::kinematics::offsets;
 use aerial_chain_core::lsc::{LscEntry, LscKind};
@@ -57,6 +58,7 @@ use super::lattice::{offsets26, KeyHasher};
 use super::numeric::{SAME_HEADING, TIE};
 use super::plan_ops::{differs, farthest, head_route, shape_motion, Quality};
 use super::{CarrySettings, Checker, Step};
+use crate::collision::CollisionContext;
 
 /// Costs of the search are kept in micrometres, so that its heap orders integers: an
 /// encoding, not tuning (a micrometre is far below any step of the lattice).
@@ -178,6 +180,7 @@ fn takeovers(
     for k in 1..steps.len() {
         upto[k] = upto[k - 1] + shape_motion(&steps[k - 1].shape, &steps[k].shape);
     }
+    let samples = RouteSamples::along(&checker.ctx, steps);
     let mut out = Vec::new();
     for (x, kind) in shapes(library, &steps[0].shape, s.headings) {
         // Ranges of waypoints still to look at, the plan's start first.
@@ -186,7 +189,7 @@ fn takeovers(
             let Some((i, j, saving)) = span(checker, steps, &upto, &x, s.saving, from, to) else {
                 continue;
             };
-            match misfit(checker, &steps[i..=j], &x, s.fit_spacing) {
+            match misfit(checker, &samples, i..j, &x, s.fit_spacing) {
                 None => out.push(Takeover {
                     saving,
                     i,
@@ -197,8 +200,8 @@ fn takeovers(
                 // Edge `k` of the span is where it does not fit: what lies after it,
                 // then what lies before it (popped first).
                 Some(k) => {
-                    ranges.push((i + k + 1, j));
-                    ranges.push((i, i + k));
+                    ranges.push((k + 1, j));
+                    ranges.push((i, k));
                 }
             }
         }
@@ -311,32 +314,51 @@ fn middle(checker: &Checker, x: &Shape) -> Vector3<f64> {
     (lo + hi) / 2.0
 }
 
-/// Where the chain in shape `x` cannot be along the head route of `steps`, tested at
-/// points `fit_spacing` (m) apart (the tightest, where the head is nearest the map,
-/// first): the edge `k` (from `steps[k]` to `steps[k + 1]`) of the first point at which
-/// no unit can be at the point or one map resolution from it along or across the axes
-/// with the rest of the body clear; `None` where it fits everywhere. A carried chain
-/// takes its body through every passage the route takes its head through; this turns
-/// away, before any search, a shape that is too wide for one.
-fn misfit(checker: &mut Checker, steps: &[Step], x: &Shape, fit_spacing: f64) -> Option<usize> {
-    let r_v = checker.ctx.field().grid().resolution();
-    // (clearance, point, edge)
-    let mut samples: Vec<(f64, Point3<f64>, usize)> = Vec::new();
-    for (k, w) in steps.windows(2).enumerate() {
-        let (a, b) = (w[0].xi, w[1].xi);
-        if (b - a).norm() <= TIE {
-            continue;
+/// The plan's head route sampled every map resolution, each sample with the head's
+/// clearance there and its edge (`k`: from `steps[k]` to `steps[k + 1]`), the tightest
+/// first (ties in route order). Made once per plan: every shape and every span reads
+/// its own edges from it.
+struct RouteSamples(Vec<(f64, Point3<f64>, usize)>);
+
+impl RouteSamples {
+    fn along(ctx: &CollisionContext, steps: &[Step]) -> Self {
+        let r_v = ctx.field().grid().resolution();
+        let mut samples = Vec::new();
+        for (k, w) in steps.windows(2).enumerate() {
+            let (a, b) = (w[0].xi, w[1].xi);
+            if (b - a).norm() <= TIE {
+                continue;
+            }
+            let n = ((b - a).norm() / r_v).ceil().max(1.0) as usize;
+            for m in 0..n {
+                let p = a + (b - a) * (m as f64 / n as f64);
+                samples.push((ctx.clearance(p), p, k));
+            }
         }
-        let n = ((b - a).norm() / r_v).ceil().max(1.0) as usize;
-        for m in 0..n {
-            let p = a + (b - a) * (m as f64 / n as f64);
-            samples.push((checker.ctx.clearance(p), p, k));
-        }
+        // Stable: equal clearances keep the route's order.
+        samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+        Self(samples)
     }
-    samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+}
+
+/// Where the chain in shape `x` cannot be along the plan's head route on `edges`,
+/// tested at `samples` `fit_spacing` (m) apart (the tightest, where the head is
+/// nearest the map, first): the edge of the first point at which no unit can be at
+/// the point or one map resolution from it along or across the axes with the rest of
+/// the body clear; `None` where it fits everywhere. A carried chain takes its body
+/// through every passage the route takes its head through; this turns away, before
+/// any search, a shape that is too wide for one.
+fn misfit(
+    checker: &mut Checker,
+    samples: &RouteSamples,
+    edges: Range<usize>,
+    x: &Shape,
+    fit_spacing: f64,
+) -> Option<usize> {
+    let r_v = checker.ctx.field().grid().resolution();
     let units = offsets(checker.ctx.params(), x);
     let mut tested: Vec<Point3<f64>> = Vec::new();
-    for &(_, p, k) in &samples {
+    for &(_, p, k) in samples.0.iter().filter(|s| edges.contains(&s.2)) {
         if tested.iter().any(|t| (t - p).norm() < fit_spacing) {
             continue;
         }

@@ -197,17 +197,21 @@ fn a_shape_across_the_window_does_not_fit_there_and_one_along_it_does() {
         step(3.5, line, false),
         step(4.5, line, false),
     ];
+    let samples = RouteSamples::along(&checker.ctx, &steps);
     // Trailing along -x passes end first; trailing along -y lies across the window,
     // whose wall (x = 3.0..3.2) the second edge crosses.
-    assert_eq!(misfit(&mut checker, &steps, &line, d().fit_spacing), None);
+    assert_eq!(
+        misfit(&mut checker, &samples, 0..3, &line, d().fit_spacing),
+        None
+    );
     let across = Shape::line(4, std::f32::consts::FRAC_PI_2);
     assert_eq!(
-        misfit(&mut checker, &steps, &across, d().fit_spacing),
+        misfit(&mut checker, &samples, 0..3, &across, d().fit_spacing),
         Some(1)
     );
     // Away from the wall it fits.
     assert_eq!(
-        misfit(&mut checker, &steps[..2], &across, d().fit_spacing),
+        misfit(&mut checker, &samples, 0..1, &across, d().fit_spacing),
         None
     );
 }
@@ -227,9 +231,19 @@ fn a_shape_that_cannot_take_the_window_still_takes_over_on_either_side_of_it() {
     let mut checker = Checker::new(ctx, None);
     let lsc = library(checker.ctx.params()).entries;
     let all = takeovers(&mut checker, &lsc, &steps, &d());
+    let samples = RouteSamples::along(&checker.ctx, &steps);
     let split: Vec<&Takeover> = all
         .iter()
-        .filter(|t| misfit(&mut checker, &steps, &t.x, d().fit_spacing).is_some())
+        .filter(|t| {
+            misfit(
+                &mut checker,
+                &samples,
+                0..steps.len() - 1,
+                &t.x,
+                d().fit_spacing,
+            )
+            .is_some()
+        })
         .collect();
     assert!(split.iter().any(|t| t.j <= crossing), "before the window");
     assert!(split.iter().any(|t| t.i > crossing), "after it");

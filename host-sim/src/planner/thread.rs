@@ -89,13 +89,7 @@ impl Threading {
     /// straightened through its pinches: for a plan whose own route the chain cannot
     /// follow. `None` when the band has no pinch.
     pub(super) fn banded(ctx: &CollisionContext, raw: &[Step], s: &ThreadSettings) -> Option<Self> {
-        let route = head_route(raw);
-        if route.len() < 2 {
-            return None;
-        }
-        let router = Router { ctx, s };
-        let band = router.band(&route);
-        Self::along(ctx, &band, s)
+        Self::along(ctx, &Router { ctx, s }.band(&head_route(raw)), s)
     }
 
     /// The head route `route` (start first) as it is, with no pinch straightened: for a

@@ -249,13 +249,12 @@ impl Stage for Thread {
             limit: cx.s.thread.max_steps as u64,
             used: 0,
         };
-        let Some(threading) = Threading::of(&draft.ctx, &draft.steps, &cx.s.thread) else {
+        let Some(mut threading) = Threading::of(&draft.ctx, &draft.steps, &cx.s.thread) else {
             draft.notes.withdrawn = true;
             return (draft, budget);
         };
         // Where the plan's own route cannot be followed (it wanders where the search
         // tried shape after shape, or hugs corners), the route pulled into a band.
-        let mut threading = threading;
         let mut r = threading.follow(&draft.ctx, &draft.steps[0], cx.follow_step, cx.deadline);
         if r.is_err() {
             if let Some(banded) = Threading::banded(&draft.ctx, &draft.steps, &cx.s.thread) {
