@@ -230,7 +230,7 @@ impl DistanceField {
     pub fn clearance(&self, p: impl Into<Point3<f64>>) -> f64 {
         let p = p.into();
         self.grid_coordinates(&p)
-            .map_or(0.0, |rel| self.clearance_at(&p, &rel))
+            .map_or(0.0, |rel| self.clearance_at::<false>(&p, &rel))
     }
 
     /// [`Self::grid_coordinate`] of every axis of `p`; `None` where the clearance is 0.
@@ -243,9 +243,13 @@ impl DistanceField {
         ])
     }
 
-    /// [`Self::clearance`] of `p`, whose grid coordinates are `rel`.
+    /// [`Self::clearance`] of `p`, whose grid coordinates are `rel`. With `SKIP`, a
+    /// centre whose stored bound cannot beat the best so far is passed over without
+    /// its square root: the same value, cheaper where the coarse query already fell
+    /// short ([`Self::clearance_above`]); dearer where every centre is read
+    /// ([`Self::clearance`]), as the skips branch unpredictably.
     #[inline]
-    fn clearance_at(&self, p: &Point3<f64>, rel: &[f64; 3]) -> f64 {
+    fn clearance_at<const SKIP: bool>(&self, p: &Point3<f64>, rel: &[f64; 3]) -> f64 {
         let dims = self.grid.dims();
         let mut idx = [[0usize; 2]; 3];
         let mut d2 = [[0f64; 2]; 3];
@@ -268,6 +272,10 @@ impl DistanceField {
                 let dyz = d2[1][j] + d2[2][k];
                 for i in 0..2 {
                     let v = self.lb[base + idx[0][i] * sx] as f64;
+                    // `v` bounds what this centre can give.
+                    if SKIP && v <= best {
+                        continue;
+                    }
                     let b = v - (d2[0][i] + dyz).sqrt();
                     if b > best {
                         best = b;
@@ -318,7 +326,7 @@ impl DistanceField {
         if c > need {
             c
         } else {
-            self.clearance_at(&p, &rel)
+            self.clearance_at::<true>(&p, &rel)
         }
     }
 
