@@ -118,8 +118,8 @@ pub struct Exploration {
     /// With `audit`: per piece, the exact test's first violation on the map it was
     /// committed on (unknown space occupied), `None` when valid.
     pub audit: Option<Vec<Option<String>>>,
-    /// Time to build the commit field from scratch on the final seen map (s), with
-    /// `audit`: what an update is compared with.
+    /// Time to build both fields (the commit and the route field) from scratch on the
+    /// final seen map (s), with `audit`: what an update of both is compared with.
     pub rebuild_s: Option<f64>,
 }
 
@@ -509,12 +509,19 @@ impl Loop<'_> {
                 .collect()
         });
         let rebuild_s = self.settings.audit.then(|| {
-            let grid = planner.belief().commit_field().grid().clone();
-            let began = Instant::now();
-            let field = DistanceField::new(grid);
-            let s = began.elapsed().as_secs_f64();
-            drop(field);
-            s
+            let belief = planner.belief();
+            let grids = [belief.commit_field().grid(), belief.route_field().grid()];
+            grids
+                .map(|g| {
+                    let grid = g.clone();
+                    let began = Instant::now();
+                    let field = DistanceField::new(grid);
+                    let s = began.elapsed().as_secs_f64();
+                    drop(field);
+                    s
+                })
+                .iter()
+                .sum()
         });
         let mut sensing = self.sensing;
         sensing.known = planner.belief().seen().known();
