@@ -422,6 +422,40 @@ impl ArcPlanner {
         Some((steps, stats))
     }
 
+    /// The last try of a query that fails for want of a shape: the chain following its
+    /// head along the route the query holds (the quick route, or the lattice's guided
+    /// one), threaded through the route's pinches, else as the route runs. Where the
+    /// search's shapes and the roadmap found no way, a follower may still pass: a long
+    /// chain that must turn right behind an opening (a door a metre behind a window and
+    /// to its side) lays its body along the route where no whole shape fits the turn.
+    /// Tried only where the query would fail otherwise, so every plan the search finds
+    /// stays as it was.
+    fn followed_anyway(
+        &self,
+        query: &Query,
+        built: &Built,
+        deadline: Option<Instant>,
+    ) -> Option<(Vec<Step>, Stats)> {
+        let route = built.route.as_ref().or(built.quick.as_ref())?;
+        let points: Vec<Point3<f64>> = route.points.iter().map(|&p| p.into()).collect();
+        let s = &self.refine.thread;
+        let ways = [
+            super::thread::Threading::along(&self.ctx, &points, s),
+            super::thread::Threading::as_is(&points, s),
+        ];
+        let start = query.start_step();
+        let (steps, checks) = ways.into_iter().flatten().find_map(|threading| {
+            threading
+                .follow(&self.ctx, &start, self.settings.follow_step, deadline)
+                .ok()
+        })?;
+        let mut stats = Stats::default();
+        super::construction::count_sources(&steps, &mut stats);
+        stats.min_margin = self.ctx.clearance_margin();
+        stats.timings.collision_s = checks.as_secs_f64();
+        Some((steps, stats))
+    }
+
     /// Where the uniform roadmap failed: the quick route, if the query found one,
     /// joins the roadmap; else the lattice search guided by the labelled free regions
     /// (labelled now if need be) runs: a proof that start and goal lie in separate
@@ -463,7 +497,9 @@ impl ArcPlanner {
     /// The online construction over the uniform head roadmap (joined by the lattice's
     /// route when `built` holds one). Where it fails, the guided lattice search
     /// ([`Self::guided_attempt`]) runs once; then, like OMPL's PRM, the roadmap grows
-    /// while the query fails and time remains.
+    /// while the query fails and time remains; where no growth is left, the chain
+    /// follows its head along the route ([`Self::followed_anyway`]) before the query
+    /// fails.
     fn solve_on_roadmap(
         &mut self,
         query: &Query,
@@ -513,12 +549,15 @@ impl ArcPlanner {
                 Err(PlanError::NoShape {
                     from, to, replans, ..
                 }) => {
+                    if let Some(solved) = self.followed_anyway(query, built, deadline) {
+                        return Ok(solved);
+                    }
                     return Err(PlanError::NoShape {
                         from,
                         to,
                         replans,
                         narrowest: route.map(|r| (r.narrowest.into(), r.narrowest_margin)),
-                    })
+                    });
                 }
                 Err(e) => return Err(e),
             }
