@@ -4,6 +4,7 @@
 //   gen OUT         2000 random SRS placements in `window` (N = 5) this commit accepts,
 //                   each with a translation target 0.5 m away and a shape to change to
 //   filter IN OUT   the cases whose placement this commit accepts too
+//   translating IN OUT  the cases whose translation this commit accepts
 //   time IN         medians of 15 passes: a translation and a shape change per case
 //                   (scaled to 200 cases, as `cargo bench ... x200`), a placement per case
 use std::io::Write;
@@ -86,6 +87,14 @@ fn main() {
             println!("kept {}", v.len());
             write(&args[3], &v);
         }
+        "translating" => {
+            let v: Vec<Case> = read(&args[2])
+                .into_iter()
+                .filter(|(p, q, s, _)| ctx.check_translation(*p, *q, s).is_ok())
+                .collect();
+            println!("kept {}", v.len());
+            write(&args[3], &v);
+        }
         "time" => {
             let cases = read(&args[2]);
             let n = cases.len() as f64;
@@ -119,6 +128,6 @@ fn main() {
                 med(&mut pl) * 1e9
             );
         }
-        _ => panic!("gen | filter | time"),
+        _ => panic!("gen | filter | translating | time"),
     }
 }
