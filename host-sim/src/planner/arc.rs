@@ -407,6 +407,17 @@ impl ArcPlanner {
                 }
                 None => return None,
             };
+        self.followed(&threading, query, deadline)
+    }
+
+    /// The chain following its head along `threading`'s route from the query's start,
+    /// with the plan's counters; `None` where a step fails.
+    fn followed(
+        &self,
+        threading: &super::thread::Threading,
+        query: &Query,
+        deadline: Option<Instant>,
+    ) -> Option<(Vec<Step>, Stats)> {
         let (steps, checks) = threading
             .follow(
                 &self.ctx,
@@ -443,17 +454,9 @@ impl ArcPlanner {
             super::thread::Threading::along(&self.ctx, &points, s),
             super::thread::Threading::as_is(&points, s),
         ];
-        let start = query.start_step();
-        let (steps, checks) = ways.into_iter().flatten().find_map(|threading| {
-            threading
-                .follow(&self.ctx, &start, self.settings.follow_step, deadline)
-                .ok()
-        })?;
-        let mut stats = Stats::default();
-        super::construction::count_sources(&steps, &mut stats);
-        stats.min_margin = self.ctx.clearance_margin();
-        stats.timings.collision_s = checks.as_secs_f64();
-        Some((steps, stats))
+        ways.into_iter()
+            .flatten()
+            .find_map(|threading| self.followed(&threading, query, deadline))
     }
 
     /// Where the uniform roadmap failed: the quick route, if the query found one,
