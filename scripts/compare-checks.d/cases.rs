@@ -21,10 +21,15 @@ use rand::{Rng, SeedableRng};
 
 type Case = ([f64; 3], [f64; 3], Shape, Shape);
 
+/// The chain every case is for, and the angles of one of its shapes (head yaw, then
+/// every link's pitch and yaw).
+const UNITS: u8 = 5;
+const ANGLES: usize = 2 * UNITS as usize - 1;
+
 fn ctx_and_tables() -> (CollisionContext, ShapeTables) {
     let sc = scenarios::build("window").expect("built-in scenario");
     let field = Arc::new(DistanceField::new(sc.grid.clone()));
-    let params = ChainParams::new(5);
+    let params = ChainParams::new(UNITS);
     let ctx = CollisionContext::new(field, params, DEFAULT_CLEARANCE).expect("valid chain");
     let tables = ShapeTables::build(params, &TableSettings::default(), &AtomicUsize::new(0))
         .expect("tables");
@@ -48,12 +53,15 @@ fn read(path: &str) -> Vec<Case> {
         .map(|l| {
             let v: Vec<&str> = l.split(' ').collect();
             let f = |i: usize| v[i].parse::<f64>().unwrap();
-            let e = |a: usize| -> Vec<f32> { (a..a + 9).map(|i| v[i].parse::<f32>().unwrap()).collect() };
+            let shape = |a: usize| {
+                let eta: Vec<f32> = (a..a + ANGLES).map(|i| v[i].parse().unwrap()).collect();
+                Shape::from_slice(UNITS, &eta).unwrap()
+            };
             (
                 [f(0), f(1), f(2)],
                 [f(3), f(4), f(5)],
-                Shape::from_slice(5, &e(6)).unwrap(),
-                Shape::from_slice(5, &e(15)).unwrap(),
+                shape(6),
+                shape(6 + ANGLES),
             )
         })
         .collect()

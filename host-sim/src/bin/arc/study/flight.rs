@@ -271,20 +271,20 @@ pub fn markdown(runs: &[FlightRun], speed: f64) -> String {
     // Groups of which no run flew, with the first run's reason; runs whose stop and
     // go alone was not flown, with theirs.
     let mut unflown = Vec::new();
-    for (sc, n) in keys {
-        let group: Vec<&FlightRun> = runs
+    for key in keys {
+        let members: Vec<&FlightRun> = runs.iter().filter(|r| group_of(r) == key).collect();
+        let (sc, n) = key;
+        let group: Vec<&FlightRun> = members
             .iter()
-            .filter(|r| group_of(r) == (sc.clone(), n.clone()) && r.after.is_some())
+            .copied()
+            .filter(|r| r.after.is_some())
             .collect();
         for r in group.iter().filter(|r| !r.error.is_empty()) {
             unflown.push(format!("{sc} N = {n} seed {}: {}", r.seed, r.error));
         }
         if group.is_empty() {
-            let why = runs.iter().find(|r| group_of(r) == (sc.clone(), n.clone()));
-            unflown.push(format!(
-                "{sc} N = {n} ({})",
-                why.map_or("", |r| r.error.as_str())
-            ));
+            let why = members.first().map_or("", |r| r.error.as_str());
+            unflown.push(format!("{sc} N = {n} ({why})"));
             continue;
         }
         let med = |f: &dyn Fn(&FlightRun) -> f64| median(group.iter().map(|r| f(r)).collect());
