@@ -116,3 +116,27 @@ fn a_map_cut_in_two_exits_1_with_the_reason_whatever_max_growth_says() {
     assert!(e.message.contains("separate free regions"), "{e}");
     assert!(!out.exists());
 }
+
+#[test]
+fn a_shaft_that_passes_a_unit_but_no_link_is_refused_with_the_stretch_named() {
+    // A 0.45 m hatch through a 1.5 m floor: a unit's sphere fits, but half way down
+    // every link within 60 degrees of level ends in the rock (src/problem/shafts.rs).
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p.json");
+    let e = support::plan_scenario("shaft:w=0.45,depth=1.5,res=0.05", 4, &[], &out)
+        .expect_err("no chain passes the shaft");
+    assert_eq!(e.code, Some(1), "{e}");
+    assert!(e.message.contains("no unit can hold its link"), "{e}");
+    assert!(
+        e.message
+            .contains("where the head route runs from (6.025, 2.525, "),
+        "{e}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_hatch_in_a_thin_floor_is_flown_through_not_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    plan_and_verify("shaft:w=0.8,depth=0.3,res=0.05", 4, dir.path());
+}

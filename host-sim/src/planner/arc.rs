@@ -278,6 +278,38 @@ impl ArcPlanner {
         }
     }
 
+    /// The proof that the chain cannot pass where its head's sphere can
+    /// ([`super::linked`]): `route`, the head's way, crosses voxels where no unit holds
+    /// its link within the pitch limit, and those that do leave start and goal apart.
+    /// Asked where the chain failed to fly a route, before any sampling or replanning.
+    fn links_cut(
+        &self,
+        query: &Query,
+        route: Option<&lattice::HeadRoute>,
+        deadline: Option<Instant>,
+    ) -> Option<PlanError> {
+        let route = route?;
+        let p = self.ctx.params();
+        let rule = super::linked::LinkRule {
+            link: f64::from(p.link_length),
+            theta_max: f64::from(p.theta_max),
+            radius: f64::from(p.unit_radius) + self.ctx_min.clearance_margin(),
+        };
+        let field = self.ctx.field();
+        let flood = super::linked::LinkFlood::new(field, &rule);
+        let proof = flood.separated(&route.points, query.ends().1, query.goal_tol, deadline)?;
+        Some(PlanError::LinksCut {
+            from: proof.stretch.0,
+            to: proof.stretch.1,
+            link: rule.link,
+            pitch_deg: rule.theta_max.to_degrees(),
+            radius: rule.radius,
+            side: proof.side,
+            size: proof.cells,
+            spacing: proof.cell_m,
+        })
+    }
+
     /// Full-chain checks made so far by both contexts.
     fn check_count(&self) -> u64 {
         [self.ctx.stats(), self.ctx_min.stats()]
@@ -313,6 +345,9 @@ impl ArcPlanner {
                 .lattice
                 .quick_route(&self.ctx_min, start, goal, deadline);
             built.lattice_s += t.elapsed().as_secs_f64();
+            if let Some(cut) = self.links_cut(query, built.route.as_ref(), deadline) {
+                return Err(cut);
+            }
             on_route = self.solve_on_route(query, stop, began, &built)?;
             if on_route.is_none() {
                 on_route = self.threaded_on_route(query, &built, deadline);
@@ -489,6 +524,9 @@ impl ArcPlanner {
             return Err(self.separated(sep));
         }
         built.route = self.head_route(start, goal, budget, deadline, &mut built.lattice_s)?;
+        if let Some(cut) = self.links_cut(query, built.route.as_ref(), deadline) {
+            return Err(cut);
+        }
         if let Some(solved) = self.solve_on_route(query, stop, began, built)? {
             return Ok(Some(solved));
         }

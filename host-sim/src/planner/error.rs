@@ -66,6 +66,29 @@ pub enum PlanError {
         /// Spacing of what was counted (m).
         spacing: f64,
     },
+    /// The head's sphere gets through, but no unit of the chain holding its link does:
+    /// on the head route's stretch `from -> to`, no point holds a unit whose link (of
+    /// `link` m, pitch within `pitch_deg`) ends at a unit as free, and the voxels that
+    /// do hold one leave start and goal apart (`super::linked`).
+    #[error("no unit can hold its link ({link:.3} m, pitch within {pitch_deg:.0} degrees, units of radius {radius:.3} m with the smallest clearance) where the head route runs from {} to {}: the {side}'s region for a unit with its link ({size} cells of {spacing:.3} m) does not reach the other", point(from), point(to))]
+    LinksCut {
+        /// First point of the head route where no unit holds a link.
+        from: Point3<f64>,
+        /// Last such point.
+        to: Point3<f64>,
+        /// Link length (m).
+        link: f64,
+        /// Largest link pitch (degrees).
+        pitch_deg: f64,
+        /// Unit radius plus the smallest clearance (m).
+        radius: f64,
+        /// Which side's region was measured whole ("start" or "goal").
+        side: &'static str,
+        /// Its size (flood cells).
+        size: u64,
+        /// The cells' edge (m).
+        spacing: f64,
+    },
     /// The termination condition stopped the query.
     #[error("time limit reached after {replans} replans")]
     TimeLimit {
@@ -101,6 +124,7 @@ impl Failure for PlanError {
             PlanError::NoShape { .. } => "no_shape",
             PlanError::Unreachable { .. } => "unreachable",
             PlanError::Separated { .. } => "separated",
+            PlanError::LinksCut { .. } => "links_cut",
             PlanError::StartInvalid(_) => "start_invalid",
             PlanError::GoalInvalid(_) => "goal_invalid",
             PlanError::TablesMismatch { .. } => "error",

@@ -30,6 +30,7 @@ pub(crate) mod follow;
 mod goal_pose;
 pub(crate) mod graph;
 pub(crate) mod lattice;
+mod linked;
 pub(crate) mod motion;
 mod numeric;
 mod pipeline;

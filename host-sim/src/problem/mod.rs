@@ -1,6 +1,7 @@
 //! Problems to plan for: the built-in scenarios (the paper's rooms and more) and the
-//! parametric families (hard cases `passage:`, `forest:`, `slot:` and `pipe:`), each a map with a start, a goal and a
-//! hand-made route that shows the problem can be solved.
+//! parametric families (hard cases `passage:`, `forest:`, `slot:`, `pipe:` and
+//! `shaft:`), each a map with a start, a goal and a hand-made route that shows the
+//! problem can be solved (a forest's and a shaft's: the head's way only).
 //!
 //! This layer sits above the map and collision layers (a scenario is a grid; the
 //! reason a witness fails is the exact verifier's) and below plan files: the witness
@@ -11,6 +12,7 @@ pub mod large;
 pub mod passages;
 pub mod pipes;
 pub mod scenarios;
+pub mod shafts;
 pub mod spec;
 
 use crate::collision::verify::PlanViolation;
@@ -20,7 +22,7 @@ use crate::collision::verify::PlanViolation;
 pub enum ProblemError {
     /// A name that is no built-in scenario.
     #[error(
-        "unknown scenario {0:?}; known: {known}, corridor:LENGTH, passage:KEY=VALUE,..., forest:KEY=VALUE,..., slot:KEY=VALUE,..., pipe:KEY=VALUE,..., campus[:RES], hall[:RES]",
+        "unknown scenario {0:?}; known: {known}, corridor:LENGTH, passage:KEY=VALUE,..., forest:KEY=VALUE,..., slot:KEY=VALUE,..., pipe:KEY=VALUE,..., shaft:KEY=VALUE,..., campus[:RES], hall[:RES]",
         known = scenarios::NAMES.join(", ")
     )]
     UnknownScenario(String),
@@ -42,7 +44,7 @@ pub enum ProblemError {
         value: String,
     },
     /// A key that the family does not have.
-    #[error("unknown key {0:?}; known: w, angle, offset, wall, door, door_offset, res, sealed, slit, slits (passage:), spacing, seed, res (forest:), tilt, angle, res (slot:), d, square, bends, radius, res (pipe:)")]
+    #[error("unknown key {0:?}; known: w, angle, offset, wall, door, door_offset, res, sealed, slit, slits (passage:), spacing, seed, res (forest:), tilt, angle, res (slot:), d, square, bends, radius, res (pipe:), w, depth, res (shaft:)")]
     UnknownKey(String),
     /// A count or seed that is not a whole number.
     #[error("{name} = {value} must be a whole number")]

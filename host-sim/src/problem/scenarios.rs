@@ -117,6 +117,8 @@ pub fn build(name: &str) -> Result<Scenario, ProblemError> {
                 super::families::SlotSpec::parse(spec)?.build()
             } else if let Some(spec) = name.strip_prefix("pipe:") {
                 super::pipes::PipeSpec::parse(spec)?.build()
+            } else if let Some(spec) = name.strip_prefix("shaft:") {
+                super::shafts::ShaftSpec::parse(spec)?.build()
             } else if let Some(len) = name.strip_prefix("corridor:") {
                 let l: f64 = len
                     .parse()

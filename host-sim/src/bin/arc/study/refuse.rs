@@ -4,13 +4,18 @@
 //!
 //! The queries: hard-case instances whose only opening is one or three slits
 //! narrower than a unit (`passage:slit=W,slits=K`, at 0.025-0.1 m, straight on and 30
-//! degrees off), sealed windows, and the goal of each large generated map walled
-//! into a box (0.2 m walls, 1 m clear inside). Each is planned through the library's
-//! facade at N = 4, 6 and 8.
+//! degrees off), sealed windows, shafts a unit fits but no link can leave (`shaft:`,
+//! hatches of 0.4 and 0.45 m through floors 1 and 1.5 m thick, where the hatch as
+//! built is narrow enough: `ShaftSpec::closed`), and the goal of each
+//! large generated map walled into a box (0.2 m walls, 1 m clear inside). Each is
+//! planned through the library's facade at N = 4, 6 and 8.
 
 use aerial_chain::map::Cell;
 use aerial_chain::planning::PlanOptions;
 use aerial_chain::problem::scenarios::{self, Scenario};
+use aerial_chain::problem::shafts::ShaftSpec;
+use aerial_chain::problem::spec::Family;
+use aerial_chain_core::ChainParams;
 
 use super::limit::{field_of, request, tables_for, timed};
 use super::report::{csv_table, missed, Column};
@@ -41,12 +46,15 @@ pub struct Refusal {
 impl Refusal {
     /// A refusal with a proof, within [`TARGET_S`].
     pub fn kept(&self) -> bool {
-        self.outcome == "no plan" && self.reason != "time limit" && self.after_setup_s <= TARGET_S
+        self.outcome == "no plan" && PROOFS.contains(&self.reason) && self.after_setup_s <= TARGET_S
     }
 }
 
-/// The study's scenario names: slits and sealed windows of the family, then the large
-/// maps (whose goals are walled in by [`walled_goal`]).
+/// The reasons that prove a query has no plan (the others give up).
+const PROOFS: [&str; 2] = ["separate regions", "no unit holds its link"];
+
+/// The study's scenario names: slits and sealed windows of the family, shafts, then
+/// the large maps (whose goals are walled in by [`walled_goal`]).
 pub fn names() -> Vec<String> {
     let mut out = Vec::new();
     for res in [0.025, 0.05, 0.087, 0.1] {
@@ -59,6 +67,13 @@ pub fn names() -> Vec<String> {
             out.push(format!(
                 "passage:w=0.5,angle={angle},offset=0,wall=0.2,res={res},sealed=1"
             ));
+        }
+        // Only shafts no chain passes (as built: the hatch widens to whole voxels).
+        for (w, depth) in [(0.4, 1.0), (0.45, 1.5)] {
+            let spec = ShaftSpec { w, depth, res };
+            if spec.closed(&ChainParams::new(UNITS[0])) {
+                out.push(spec.name());
+            }
         }
     }
     out.extend(["campus".to_string(), "hall".to_string()]);
@@ -91,7 +106,7 @@ pub fn run() -> Result<Vec<Refusal>, StudyError> {
     let mut out = Vec::new();
     for name in names() {
         let mut sc = scenarios::build(&name)?;
-        if !name.starts_with("passage:") {
+        if !name.contains(':') {
             sc = walled_goal(sc);
         }
         let field = field_of(&sc);
@@ -114,6 +129,8 @@ pub fn run() -> Result<Vec<Refusal>, StudyError> {
 fn reason(why: &str) -> &'static str {
     if why.contains("separate free regions") {
         "separate regions"
+    } else if why.contains("no unit can hold its link") {
+        "no unit holds its link"
     } else if why.contains("no shape fits") {
         "no shape fits the narrowest stretch"
     } else if why.contains("time limit") {
@@ -134,9 +151,10 @@ pub fn markdown(runs: &[Refusal]) -> String {
     let mut s = String::from(
         "| queries | runs | refused with a proof within 1 s | reasons | after setup: median / max (ms) |\n|---|---|---|---|---|\n",
     );
-    let groups: [(&str, Kind); 3] = [
+    let groups: [(&str, Kind); 4] = [
         ("slits narrower than a unit", |n| n.contains("slit=")),
         ("sealed windows", |n| n.contains("sealed=1")),
+        ("shafts a unit fits, no link", |n| n.starts_with("shaft:")),
         ("large maps, goal walled in", |n| n.ends_with("+box")),
     ];
     for (label, is) in groups {
@@ -197,7 +215,7 @@ mod tests {
 
     #[test]
     fn every_name_builds_and_the_walled_goal_is_closed() {
-        for name in names().iter().filter(|n| n.starts_with("passage:")) {
+        for name in names().iter().filter(|n| n.contains(':')) {
             scenarios::build(name).unwrap_or_else(|e| panic!("{name}: {e}"));
         }
         let sc = walled_goal(scenarios::build("window").unwrap());
@@ -220,6 +238,8 @@ mod tests {
         };
         assert!(r("no plan", "separate regions", 0.02).kept());
         assert!(!r("no plan", "time limit", 0.5).kept());
+        assert!(r("no plan", "no unit holds its link", 0.3).kept());
+        assert!(!r("no plan", "no shape fits the narrowest stretch", 0.3).kept());
         assert!(!r("no plan", "separate regions", 1.5).kept());
         assert!(!r("plan", "-", 0.1).kept());
         let md = markdown(&[r("no plan", "separate regions", 0.02), r("plan", "-", 0.1)]);

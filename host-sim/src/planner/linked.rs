@@ -1,0 +1,521 @@
+//! Where no unit can hold a link: a proof that the chain cannot pass where its head's
+//! sphere can.
+//!
+//! The free regions (`lattice::regions`) prove a query impossible when the head's
+//! sphere cannot get through. A chain needs more: every unit holds at least one link,
+//! `l` long, whose pitch is at most `theta_max`, with the unit at its other end as free
+//! as itself. A vertical shaft a unit fits into but deeper than a tilted link can
+//! leave (the neighbour of a unit half way down lies `l cos(theta_max)` aside, in the
+//! rock) passes the head's sphere and no chain.
+//!
+//! # The rule
+//! Call a voxel LINK-BLOCKED when no point of its closed cube can hold the centre of a
+//! unit (radius `R`: `r_u` plus the smallest clearance) with a free neighbour at
+//! distance `l` in a direction whose pitch is at most `theta_max`. Every unit of a
+//! chain of two or more always holds such a neighbour, so the head's centre never
+//! enters a link-blocked voxel; as it moves, the voxels holding it change only to
+//! 26-neighbours. So when the voxels that are NOT link-blocked split into 26-connected
+//! regions with the start in one and every voxel within the goal tolerance in others,
+//! no plan exists.
+//!
+//! # The certificate
+//! A voxel is link-blocked when every point of it, and every point of the voxels its
+//! neighbour could occupy, lies within `R` of an obstacle cube. Both come from one
+//! test, WITHIN: every point of voxel `u` lies within `R` of an obstacle cube when the
+//! centre of some obstacle voxel lies within `R` of `u`'s centre (a cube's farthest
+//! point from another cube of the same size, `k` voxels away, is `r |k|` away: the
+//! corners line up). The distance field stores `r G(n)` for the squared distance `n`
+//! (voxel units) to the nearest obstacle centre, with `G` non-decreasing, so
+//! `n <= (R / r)^2` holds whenever the stored value is below `r G(n* + 1)`: one
+//! comparison per voxel ([`Within`]).
+//!
+//! The neighbour of a unit in voxel `v` lies in a voxel `v + k` for `k` in a STENCIL:
+//! the offsets whose cube, grown by a voxel (the unit's own extent), meets the zone
+//! `|x| = l, |x_z| <= l sin(theta_max)`. A voxel is link-blocked when it is WITHIN
+//! itself (no free centre), or when every voxel of its stencil is (no free
+//! neighbour). Every step only leaves out what could be free (the link's capsule, the
+//! bend limits, the other units), so a voxel the test blocks is blocked; a voxel it
+//! does not block may still be. The stencil is scanned level links first, so in open
+//! space the first offset settles it.
+//!
+//! # The flood
+//! Only a route that crosses link-blocked voxels can be cut; the head route is checked
+//! first (a route whose every voxel holds a link joins start and goal). Then the
+//! voxels that hold a link are flooded from both ends at once, one voxel from each
+//! side in turn, testing each as it is reached: the side that runs out first is the
+//! proof (its size is reported); the sides meeting means no proof. The flood stays in
+//! the grid (unit centres lie inside the map's box).
+
+use std::collections::VecDeque;
+use std::time::Instant;
+
+use nalgebra::Point3;
+
+use crate::map::distance::{cube_distance_bound, DistanceField};
+use crate::planner::expired;
+
+/// Relative allowance for the field's rounding to `f32` (and of `r G` in `f64`).
+const ROUND_REL: f64 = 1e-6;
+
+/// What the flood proved: the side whose region ran out, and the stretch of the head
+/// route where no unit holds a link.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinkProof {
+    /// "start" or "goal": whose region for a unit holding a link was measured whole.
+    pub side: &'static str,
+    /// Its size (flood cells).
+    pub cells: u64,
+    /// The cells' edge (m).
+    pub cell_m: f64,
+    /// First and last point of the head route in link-blocked voxels.
+    pub stretch: (Point3<f64>, Point3<f64>),
+}
+
+/// The chain's measures the proof needs.
+#[derive(Clone, Copy, Debug)]
+pub struct LinkRule {
+    /// Link length `l` (m).
+    pub link: f64,
+    /// Largest link pitch (rad).
+    pub theta_max: f64,
+    /// `r_u` plus the smallest clearance (m).
+    pub radius: f64,
+}
+
+/// The test WITHIN for one field: every point of a voxel lies within the radius of an
+/// obstacle cube.
+struct Within<'a> {
+    field: &'a DistanceField,
+    /// A stored bound below this proves `n <= n*`.
+    below: f64,
+}
+
+impl<'a> Within<'a> {
+    fn new(field: &'a DistanceField, radius: f64) -> Self {
+        let r = field.grid().resolution();
+        let n_star = ((radius - 1e-9) / r).powi(2).floor().max(-1.0);
+        let below = if n_star < 0.0 {
+            0.0
+        } else {
+            r * cube_distance_bound(n_star as u64 + 1) * (1.0 - ROUND_REL)
+        };
+        Self { field, below }
+    }
+
+    /// Every point of voxel `i` lies within the radius of an obstacle cube. Outside the
+    /// grid, only where unknown space is occupied (it is an obstacle there).
+    fn holds(&self, i: [i32; 3]) -> bool {
+        let g = self.field.grid();
+        match g.local(i) {
+            Some(_) => self.field.voxel_clearance(i) < self.below,
+            None => g.unknown_is_occupied(),
+        }
+    }
+}
+
+/// The voxel offsets a unit's neighbour may lie in, level links first.
+fn stencil(r: f64, rule: &LinkRule) -> Vec<[i32; 3]> {
+    // A hair wider than the rule: the chain's own measures are `f32`.
+    let (l, h) = (rule.link, rule.link * rule.theta_max.sin() + 1e-6);
+    let m = (l / r).ceil() as i32 + 2;
+    let mut out = Vec::new();
+    for z in -m..=m {
+        for y in -m..=m {
+            for x in -m..=m {
+                let k = [x, y, z];
+                // The offset's cube grown by a voxel: `[k r - r, k r + r]` per axis,
+                // clipped to the zone's heights.
+                let lo = k.map(|c| (c - 1) as f64 * r);
+                let hi = k.map(|c| (c + 1) as f64 * r);
+                let (zlo, zhi) = (lo[2].max(-h), hi[2].min(h));
+                if zlo > zhi {
+                    continue;
+                }
+                let (lo, hi) = ([lo[0], lo[1], zlo], [hi[0], hi[1], zhi]);
+                let near: f64 = (0..3)
+                    .map(|a| (lo[a].max(0.0) - hi[a].min(0.0)).max(0.0).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                let far: f64 = (0..3)
+                    .map(|a| lo[a].abs().max(hi[a].abs()).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                if near <= l + 1e-6 && far >= l - 1e-6 {
+                    out.push(k);
+                }
+            }
+        }
+    }
+    // Level links first; among them, directions spread round the compass early.
+    out.sort_by_key(|k| (k[2].abs(), spread(k), k[0].abs() + k[1].abs()));
+    out
+}
+
+/// A key that interleaves compass directions: sixteen sectors in bit-reversed order.
+fn spread(k: &[i32; 3]) -> u8 {
+    let a = (k[1] as f64).atan2(k[0] as f64);
+    let sector = (((a + std::f64::consts::PI) / std::f64::consts::TAU * 16.0) as u8).min(15);
+    sector.reverse_bits() >> 4
+}
+
+/// The proof for one field and chain ([`Self::separated`]).
+pub struct LinkFlood<'a> {
+    field: &'a DistanceField,
+    within: Within<'a>,
+    stencil: Vec<[i32; 3]>,
+    /// Voxels per edge of the flood's cells.
+    cell: usize,
+}
+
+impl<'a> LinkFlood<'a> {
+    /// The rule for `field`.
+    pub fn new(field: &'a DistanceField, rule: &LinkRule) -> Self {
+        let r = field.grid().resolution();
+        Self {
+            field,
+            within: Within::new(field, rule.radius),
+            stencil: stencil(r, rule),
+            cell: ((rule.radius / (3.0 * r)).floor() as usize).max(1),
+        }
+    }
+
+    /// No point of voxel `i` holds a unit with its link (see the module docs).
+    pub fn blocked(&self, i: [i32; 3]) -> bool {
+        self.within.holds(i)
+            || self
+                .stencil
+                .iter()
+                .all(|k| self.within.holds([i[0] + k[0], i[1] + k[1], i[2] + k[2]]))
+    }
+
+    /// The stretch of `route` (sampled every half voxel) in link-blocked voxels: its
+    /// first and last sample there; `None` where every sample holds a link.
+    fn blocked_stretch(&self, route: &[[f64; 3]]) -> Option<(Point3<f64>, Point3<f64>)> {
+        let g = self.field.grid();
+        let step = g.resolution() / 2.0;
+        let mut stretch: Option<(Point3<f64>, Point3<f64>)> = None;
+        for w in route.windows(2) {
+            let (a, b) = (Point3::from(w[0]), Point3::from(w[1]));
+            let n = ((b - a).norm() / step).ceil().max(1.0) as usize;
+            for s in 0..=n {
+                let p = a + (b - a) * (s as f64 / n as f64);
+                if self.blocked(g.lattice_index(p)) {
+                    stretch = Some(stretch.map_or((p, p), |(first, _)| (first, p)));
+                }
+            }
+        }
+        stretch
+    }
+
+    /// Proves that no unit holding a link gets from `start` to within `tol` of `goal`,
+    /// where the head `route` crosses link-blocked voxels; `None` where it does not,
+    /// where the flood's sides meet, or when `deadline` passes.
+    pub fn separated(
+        &self,
+        route: &[[f64; 3]],
+        goal: [f64; 3],
+        tol: f64,
+        deadline: Option<Instant>,
+    ) -> Option<LinkProof> {
+        let stretch = self.blocked_stretch(route)?;
+        let g = self.field.grid();
+        let start = g.lattice_index(*route.first()?);
+        if self.blocked(start) {
+            return None;
+        }
+        let mut flood = Flood::new(g.dims().map(|d| d.div_ceil(self.cell)));
+        flood.seed(Side::Start, self.cell_of(g.local(start)?));
+        for v in self.near_goal(goal, tol) {
+            let c = self.cell_of(v);
+            match flood.state(c) {
+                UNSEEN if !self.blocked(to_index(g.origin(), v)) => flood.seed(Side::Goal, c),
+                s if s == Side::Start as u8 && !self.blocked(to_index(g.origin(), v)) => {
+                    return None
+                }
+                _ => {}
+            }
+        }
+        let mut turn = 0usize;
+        while !flood.empty(Side::Start) && !flood.empty(Side::Goal) {
+            turn += 1;
+            if turn.is_multiple_of(4096) && expired(deadline) {
+                return None;
+            }
+            for side in [Side::Start, Side::Goal] {
+                if self.expand(&mut flood, side) {
+                    return None;
+                }
+            }
+        }
+        let side = if flood.empty(Side::Start) {
+            Side::Start
+        } else {
+            Side::Goal
+        };
+        Some(LinkProof {
+            side: side.name(),
+            cells: flood.size[side as usize - 1],
+            cell_m: self.cell as f64 * g.resolution(),
+            stretch,
+        })
+    }
+
+    /// The flood's cell holding local voxel `v`.
+    fn cell_of(&self, v: [usize; 3]) -> [usize; 3] {
+        v.map(|c| c / self.cell)
+    }
+
+    /// Some voxel of cell `c` may hold a unit with its link.
+    fn passable(&self, c: [usize; 3]) -> bool {
+        let g = self.field.grid();
+        let dims = g.dims();
+        let span = |a: usize| c[a] * self.cell..((c[a] + 1) * self.cell).min(dims[a]);
+        span(2).any(|z| {
+            span(1).any(|y| span(0).any(|x| !self.blocked(to_index(g.origin(), [x, y, z]))))
+        })
+    }
+
+    /// Grid voxels (local) whose cube lies within `tol` of `goal`.
+    fn near_goal(&self, goal: [f64; 3], tol: f64) -> Vec<[usize; 3]> {
+        let g = self.field.grid();
+        let r = g.resolution();
+        let lo = g.lattice_index([goal[0] - tol, goal[1] - tol, goal[2] - tol]);
+        let hi = g.lattice_index([goal[0] + tol, goal[1] + tol, goal[2] + tol]);
+        let mut out = Vec::new();
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    let c = g.voxel_center([x, y, z]);
+                    let gap: f64 = (0..3)
+                        .map(|a| ((c[a] - goal[a]).abs() - r / 2.0).max(0.0).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    if let (true, Some(l)) = (gap <= tol, g.local([x, y, z])) {
+                        out.push(l);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Takes one cell off `side`'s queue and adds its 26 neighbours that may hold a
+    /// unit with its link; `true` where one belongs to the other side (the sides meet).
+    fn expand(&self, flood: &mut Flood, side: Side) -> bool {
+        let Some(v) = flood.queue[side as usize - 1].pop_front() else {
+            return false;
+        };
+        let dims = flood.dims;
+        for dz in -1i64..=1 {
+            for dy in -1i64..=1 {
+                for dx in -1i64..=1 {
+                    let n = [v[0] as i64 + dx, v[1] as i64 + dy, v[2] as i64 + dz];
+                    if (0..3).any(|a| n[a] < 0 || n[a] >= dims[a] as i64) {
+                        continue;
+                    }
+                    let n = n.map(|c| c as usize);
+                    match flood.state(n) {
+                        UNSEEN => {
+                            if self.passable(n) {
+                                flood.seed(side, n);
+                            } else {
+                                flood.set(n, BLOCKED);
+                            }
+                        }
+                        s if s == side.other() as u8 => return true,
+                        _ => {}
+                    }
+                }
+            }
+        }
+        false
+    }
+}
+
+/// The lattice index of local voxel `l`.
+fn to_index(origin: [i32; 3], l: [usize; 3]) -> [i32; 3] {
+    [0, 1, 2].map(|a| origin[a] + l[a] as i32)
+}
+
+/// Which end a flooded voxel was reached from.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Side {
+    Start = 1,
+    Goal = 2,
+}
+
+impl Side {
+    fn other(self) -> Side {
+        match self {
+            Side::Start => Side::Goal,
+            Side::Goal => Side::Start,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Side::Start => "start",
+            Side::Goal => "goal",
+        }
+    }
+}
+
+const UNSEEN: u8 = 0;
+const BLOCKED: u8 = 3;
+
+/// Two bits a voxel (unseen, a side, link-blocked) and each side's queue.
+struct Flood {
+    dims: [usize; 3],
+    bits: Vec<u64>,
+    queue: [VecDeque<[usize; 3]>; 2],
+    size: [u64; 2],
+}
+
+impl Flood {
+    fn new(dims: [usize; 3]) -> Self {
+        let n = dims.iter().product::<usize>();
+        Self {
+            dims,
+            bits: vec![0; n.div_ceil(32)],
+            queue: [VecDeque::new(), VecDeque::new()],
+            size: [0; 2],
+        }
+    }
+
+    fn slot(&self, l: [usize; 3]) -> (usize, u32) {
+        let k = l[0] + self.dims[0] * (l[1] + self.dims[1] * l[2]);
+        (k / 32, (k % 32) as u32 * 2)
+    }
+
+    fn state(&self, l: [usize; 3]) -> u8 {
+        let (w, s) = self.slot(l);
+        ((self.bits[w] >> s) & 3) as u8
+    }
+
+    fn set(&mut self, l: [usize; 3], state: u8) {
+        let (w, s) = self.slot(l);
+        self.bits[w] = (self.bits[w] & !(3 << s)) | (u64::from(state) << s);
+    }
+
+    fn seed(&mut self, side: Side, l: [usize; 3]) {
+        self.set(l, side as u8);
+        self.queue[side as usize - 1].push_back(l);
+        self.size[side as usize - 1] += 1;
+    }
+
+    fn empty(&self, side: Side) -> bool {
+        self.queue[side as usize - 1].is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::map::grid::{Cell, Grid};
+
+    const RULE: LinkRule = LinkRule {
+        link: 0.5,
+        theta_max: std::f64::consts::FRAC_PI_3,
+        radius: 0.2,
+    };
+
+    /// Two storeys of `room` m (x, y) by 2 m, joined by a square hatch of side `w`
+    /// through a floor `depth` thick, at resolution `r`, the rest occupied.
+    fn storeys(r: f64, w: f64, depth: f64) -> (DistanceField, [f64; 3], [f64; 3]) {
+        let room = 3.0;
+        let h = 2.0;
+        let n = |m: f64| (m / r).round() as usize;
+        let dims = [n(room) + 2, n(room) + 2, n(2.0 * h + depth) + 2];
+        let mut g = Grid::new(r, [-1, -1, -1], dims, Cell::Occupied, true).unwrap();
+        let c = room / 2.0;
+        g.fill_where(Cell::Free, |p| {
+            let inside = (0.0..room).contains(&p.x) && (0.0..room).contains(&p.y);
+            let lower = (0.0..h).contains(&p.z);
+            let upper = (h + depth..2.0 * h + depth).contains(&p.z);
+            let hatch = (p.x - c).abs() < w / 2.0 && (p.y - c).abs() < w / 2.0;
+            inside && (lower || upper || hatch)
+        });
+        let start = [c, c, h / 2.0];
+        let goal = [c, c, h + depth + h / 2.0];
+        (DistanceField::new(g), start, goal)
+    }
+
+    #[test]
+    fn a_shaft_deeper_than_a_tilted_link_can_leave_is_proved_closed() {
+        // Within reach of the rule at 0.025-0.087 m (at 0.1 m, a voxel's extent hides
+        // the margin of this hatch: 0.45 m against the 0.477 m a link would need).
+        for r in [0.025, 0.05, 0.087] {
+            let (field, start, goal) = storeys(r, 0.45, 1.5);
+            let flood = LinkFlood::new(&field, &RULE);
+            let proof = flood
+                .separated(&[start, goal], goal, 0.3, None)
+                .unwrap_or_else(|| panic!("no proof at {r} m"));
+            assert!(
+                proof.stretch.0.z > 2.0 && proof.stretch.1.z < 3.5,
+                "{proof:?}"
+            );
+            assert_eq!(proof.cell_m, r * ((0.2 / (3.0 * r)).floor()).max(1.0));
+        }
+    }
+
+    #[test]
+    fn a_hatch_in_a_thin_floor_is_not_closed() {
+        // A link at 60 degrees crosses 0.2 m of floor within 0.12 m aside.
+        let (field, start, goal) = storeys(0.05, 0.6, 0.2);
+        let flood = LinkFlood::new(&field, &RULE);
+        assert!(flood.blocked_stretch(&[start, goal]).is_none());
+        assert!(flood.separated(&[start, goal], goal, 0.3, None).is_none());
+    }
+
+    #[test]
+    fn open_air_holds_a_link_everywhere() {
+        let g = Grid::new(0.05, [0, 0, 0], [40, 40, 40], Cell::Free, false).unwrap();
+        let field = DistanceField::new(g);
+        let flood = LinkFlood::new(&field, &RULE);
+        for i in [[20, 20, 20], [5, 5, 5], [0, 0, 0]] {
+            assert!(!flood.blocked(i), "{i:?}");
+        }
+    }
+
+    #[test]
+    fn the_stencil_keeps_within_the_pitch_limit() {
+        let r = 0.05;
+        let s = stencil(r, &RULE);
+        let h = RULE.link * RULE.theta_max.sin();
+        assert!(s.iter().all(|k| (k[2].abs() - 1) as f64 * r <= h));
+        // Straight up is out of reach, level in every direction is in.
+        assert!(!s.contains(&[0, 0, 10]));
+        for k in [[10, 0, 0], [-10, 0, 0], [0, 10, 0], [0, -10, 0], [7, 7, 0]] {
+            assert!(s.contains(&k), "{k:?}");
+        }
+        assert_eq!(s[0][2], 0, "level offsets come first");
+    }
+
+    #[test]
+    fn no_instance_with_a_verified_witness_is_refused() {
+        // Passages, tunnels, a door behind a window, a slot, pipes: each has a
+        // follow-the-leader witness the exact verifier accepts (their own tests), so
+        // the rule must find no cut along their routes.
+        let rule = LinkRule {
+            radius: 0.15,
+            ..RULE
+        };
+        for name in [
+            "passage:w=0.4,angle=45,res=0.1",
+            "passage:w=0.45,angle=30,wall=1.2,res=0.025",
+            "passage:w=0.5,angle=-45,door=0.6,door_offset=1.5,gap=1",
+            "slot:tilt=60,angle=30",
+            "pipe:d=0.6,bends=2,radius=0.8",
+            "pipe:d=0.6,square=1,bends=1,res=0.087",
+            "window",
+            "maze",
+        ] {
+            let sc = crate::problem::scenarios::build(name).unwrap();
+            let field = DistanceField::new(sc.grid.clone());
+            let route: Vec<[f64; 3]> = sc.route.iter().map(|p| [p.x, p.y, p.z]).collect();
+            let flood = LinkFlood::new(&field, &rule);
+            let goal = [sc.goal.x, sc.goal.y, sc.goal.z];
+            assert_eq!(flood.separated(&route, goal, 0.3, None), None, "{name}");
+        }
+    }
+}
