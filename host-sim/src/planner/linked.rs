@@ -223,7 +223,7 @@ impl<'a> LinkFlood<'a> {
         if self.blocked(start) {
             return None;
         }
-        let mut flood = Flood::new(g.dims().map(|d| d.div_ceil(self.cell)));
+        let mut flood = Flood::new(g.dims().map(|d| d.div_ceil(self.cell)))?;
         flood.seed(Side::Start, self.cell_of(g.local(start)?));
         for v in self.near_goal(goal, tol) {
             let c = self.cell_of(v);
@@ -302,7 +302,7 @@ impl<'a> LinkFlood<'a> {
     /// Takes one cell off `side`'s queue and adds its 26 neighbours that may hold a
     /// unit with its link; `true` where one belongs to the other side (the sides meet).
     fn expand(&self, flood: &mut Flood, side: Side) -> bool {
-        let Some(v) = flood.queue[side as usize - 1].pop_front() else {
+        let Some(v) = flood.pop(side) else {
             return false;
         };
         let dims = flood.dims;
@@ -363,27 +363,36 @@ impl Side {
 const UNSEEN: u8 = 0;
 const BLOCKED: u8 = 3;
 
-/// Two bits a voxel (unseen, a side, link-blocked) and each side's queue.
+/// Two bits a cell (unseen, a side, link-blocked) and each side's queue of cells (by
+/// linear index: four bytes a cell, where a queue may hold much of a large map).
 struct Flood {
     dims: [usize; 3],
     bits: Vec<u64>,
-    queue: [VecDeque<[usize; 3]>; 2],
+    queue: [VecDeque<u32>; 2],
     size: [u64; 2],
 }
 
 impl Flood {
-    fn new(dims: [usize; 3]) -> Self {
+    /// A flood over `dims` cells; `None` beyond four-byte indices.
+    fn new(dims: [usize; 3]) -> Option<Self> {
         let n = dims.iter().product::<usize>();
-        Self {
+        if n > u32::MAX as usize {
+            return None;
+        }
+        Some(Self {
             dims,
             bits: vec![0; n.div_ceil(32)],
             queue: [VecDeque::new(), VecDeque::new()],
             size: [0; 2],
-        }
+        })
+    }
+
+    fn linear(&self, l: [usize; 3]) -> usize {
+        l[0] + self.dims[0] * (l[1] + self.dims[1] * l[2])
     }
 
     fn slot(&self, l: [usize; 3]) -> (usize, u32) {
-        let k = l[0] + self.dims[0] * (l[1] + self.dims[1] * l[2]);
+        let k = self.linear(l);
         (k / 32, (k % 32) as u32 * 2)
     }
 
@@ -399,8 +408,15 @@ impl Flood {
 
     fn seed(&mut self, side: Side, l: [usize; 3]) {
         self.set(l, side as u8);
-        self.queue[side as usize - 1].push_back(l);
+        let k = self.linear(l) as u32;
+        self.queue[side as usize - 1].push_back(k);
         self.size[side as usize - 1] += 1;
+    }
+
+    fn pop(&mut self, side: Side) -> Option<[usize; 3]> {
+        let k = self.queue[side as usize - 1].pop_front()? as usize;
+        let (x, yz) = (k % self.dims[0], k / self.dims[0]);
+        Some([x, yz % self.dims[1], yz / self.dims[1]])
     }
 
     fn empty(&self, side: Side) -> bool {
@@ -516,6 +532,78 @@ mod tests {
             let flood = LinkFlood::new(&field, &rule);
             let goal = [sc.goal.x, sc.goal.y, sc.goal.z];
             assert_eq!(flood.separated(&route, goal, 0.3, None), None, "{name}");
+        }
+    }
+
+    /// The exact distance from `p` to the obstacle cubes of `g` (and to the space
+    /// outside it, where unknown space is occupied), by brute force.
+    fn exact_distance(g: &Grid, p: Point3<f64>) -> f64 {
+        let (lo, hi) = g.bounds();
+        let r = g.resolution();
+        let mut best = f64::INFINITY;
+        if g.unknown_is_occupied() {
+            for a in 0..3 {
+                best = best.min((p[a] - lo[a]).min(hi[a] - p[a]).max(0.0));
+            }
+        }
+        let (o, dims) = (g.origin(), g.dims());
+        for z in 0..dims[2] as i32 {
+            for y in 0..dims[1] as i32 {
+                for x in 0..dims[0] as i32 {
+                    let i = [o[0] + x, o[1] + y, o[2] + z];
+                    if g.is_obstacle(i) {
+                        let c = g.voxel_center(i);
+                        let d: f64 = (0..3)
+                            .map(|a| ((p[a] - c[a]).abs() - r / 2.0).max(0.0).powi(2))
+                            .sum::<f64>()
+                            .sqrt();
+                        best = best.min(d);
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(48))]
+
+        /// A voxel the rule closes holds no unit with its link: at points all over it
+        /// (corners included) and at every yaw and pitch within the limit (the limit
+        /// included), the unit or the unit at the link's other end is within the radius
+        /// of an obstacle, measured exactly.
+        #[test]
+        fn a_closed_voxel_holds_no_unit_with_its_link(
+            g in crate::map::random_grids::grids(3..10, |b| if b < 60 { Cell::Occupied } else { Cell::Free }),
+            pick in proptest::array::uniform3(0usize..10),
+        ) {
+            let rule = LinkRule { link: 0.3, theta_max: std::f64::consts::FRAC_PI_3, radius: 0.12 };
+            let field = DistanceField::new(g.clone());
+            let flood = LinkFlood::new(&field, &rule);
+            let (o, dims) = (g.origin(), g.dims());
+            let v = [0, 1, 2].map(|a| o[a] + (pick[a] % dims[a]) as i32);
+            if flood.blocked(v) {
+                let (c, r) = (g.voxel_center(v), g.resolution());
+                for k in 0..27 {
+                    let f = [k % 3, (k / 3) % 3, k / 9].map(|t| (t as f64 - 1.0) * r / 2.0);
+                    let p = c + nalgebra::Vector3::from(f);
+                    let own = exact_distance(&g, p);
+                    if own <= rule.radius {
+                        continue;
+                    }
+                    for yaw in 0..16 {
+                        for pitch in -3..=3 {
+                            let (psi, th) = (yaw as f64 * std::f64::consts::TAU / 16.0, pitch as f64 / 3.0 * rule.theta_max);
+                            let d = nalgebra::Vector3::new(th.cos() * psi.cos(), th.cos() * psi.sin(), th.sin());
+                            let q = p + d * rule.link;
+                            proptest::prop_assert!(
+                                exact_distance(&g, q) <= rule.radius + 1e-9,
+                                "voxel {v:?} closed, but a unit at {p:?} holds a link to {q:?}"
+                            );
+                        }
+                    }
+                }
+            }
         }
     }
 }
