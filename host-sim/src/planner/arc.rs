@@ -125,6 +125,9 @@ pub struct ArcPlanner {
     pub(super) refine: RefineSettings,
     roadmap: Option<Roadmap>,
     roadmap_s: f64,
+    /// The rule that proves where no unit holds its link, made at the first query
+    /// that asks it.
+    links: std::sync::OnceLock<super::linked::LinkCheck>,
 }
 
 impl ArcPlanner {
@@ -161,6 +164,7 @@ impl ArcPlanner {
             refine: RefineSettings::default(),
             roadmap: None,
             roadmap_s: 0.0,
+            links: std::sync::OnceLock::new(),
         })
     }
 
@@ -281,23 +285,32 @@ impl ArcPlanner {
     /// The proof that the chain cannot pass where its head's sphere can
     /// ([`super::linked`]): `route`, the head's way, crosses voxels where no unit holds
     /// its link within the pitch limit, and those that do leave start and goal apart.
-    /// Asked where the chain failed to fly a route, before any sampling or replanning.
+    /// Asked where a route is found, before the chain tries it; `refine` (asked after
+    /// the chain failed once: it costs a finer distance field around the route's
+    /// narrowest point) lets the rule see margins finer than a coarse map's voxels.
     fn links_cut(
         &self,
         query: &Query,
         route: Option<&lattice::HeadRoute>,
+        refine: bool,
         deadline: Option<Instant>,
     ) -> Option<PlanError> {
         let route = route?;
-        let p = self.ctx.params();
-        let rule = super::linked::LinkRule {
-            link: f64::from(p.link_length),
-            theta_max: f64::from(p.theta_max),
-            radius: f64::from(p.unit_radius) + self.ctx_min.clearance_margin(),
-        };
         let field = self.ctx.field();
-        let flood = super::linked::LinkFlood::new(field, &rule);
+        let check = self.links.get_or_init(|| {
+            let p = self.ctx.params();
+            let rule = super::linked::LinkRule {
+                link: f64::from(p.link_length),
+                theta_max: f64::from(p.theta_max),
+                // The regions' radius: what the planner's own checks keep at the least.
+                radius: self.lattice.radius_min(),
+            };
+            super::linked::LinkCheck::new(field.grid().resolution(), rule)
+        });
+        let refine_at = refine.then_some(route.narrowest);
+        let flood = super::linked::LinkFlood::new(field, check, refine_at);
         let proof = flood.separated(&route.points, query.ends().1, query.goal_tol, deadline)?;
+        let rule = check.rule();
         Some(PlanError::LinksCut {
             from: proof.stretch.0,
             to: proof.stretch.1,
@@ -345,7 +358,7 @@ impl ArcPlanner {
                 .lattice
                 .quick_route(&self.ctx_min, start, goal, deadline);
             built.lattice_s += t.elapsed().as_secs_f64();
-            if let Some(cut) = self.links_cut(query, built.route.as_ref(), deadline) {
+            if let Some(cut) = self.links_cut(query, built.route.as_ref(), false, deadline) {
                 return Err(cut);
             }
             on_route = self.solve_on_route(query, stop, began, &built)?;
@@ -524,7 +537,7 @@ impl ArcPlanner {
             return Err(self.separated(sep));
         }
         built.route = self.head_route(start, goal, budget, deadline, &mut built.lattice_s)?;
-        if let Some(cut) = self.links_cut(query, built.route.as_ref(), deadline) {
+        if let Some(cut) = self.links_cut(query, built.route.as_ref(), true, deadline) {
             return Err(cut);
         }
         if let Some(solved) = self.solve_on_route(query, stop, began, built)? {

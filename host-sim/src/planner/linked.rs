@@ -52,6 +52,7 @@ use std::time::Instant;
 use nalgebra::Point3;
 
 use crate::map::distance::{cube_distance_bound, DistanceField};
+use crate::map::grid::{Cell, Grid};
 use crate::planner::expired;
 
 /// Relative allowance for the field's rounding to `f32` (and of `r G` in `f64`).
@@ -78,38 +79,120 @@ pub struct LinkRule {
     pub link: f64,
     /// Largest link pitch (rad).
     pub theta_max: f64,
-    /// `r_u` plus the smallest clearance (m).
+    /// `r_u` plus the smallest clearance and the forward kinematics' tolerance: the
+    /// least the planner's checks keep a unit's centre from the map (m).
     pub radius: f64,
 }
 
-/// The test WITHIN for one field: every point of a voxel lies within the radius of an
-/// obstacle cube.
-struct Within<'a> {
-    field: &'a DistanceField,
+/// The test CLOSED at one resolution (see the module docs): WITHIN's threshold and
+/// the stencil.
+#[derive(Clone, Debug)]
+struct Closure {
     /// A stored bound below this proves `n <= n*`.
     below: f64,
+    stencil: Vec<[i32; 3]>,
 }
 
-impl<'a> Within<'a> {
-    fn new(field: &'a DistanceField, radius: f64) -> Self {
-        let r = field.grid().resolution();
-        let n_star = ((radius - 1e-9) / r).powi(2).floor().max(-1.0);
+impl Closure {
+    fn new(r: f64, rule: &LinkRule) -> Self {
+        let n_star = ((rule.radius - 1e-9) / r).powi(2).floor().max(-1.0);
         let below = if n_star < 0.0 {
             0.0
         } else {
             r * cube_distance_bound(n_star as u64 + 1) * (1.0 - ROUND_REL)
         };
-        Self { field, below }
+        Self {
+            below,
+            stencil: stencil(r, rule),
+        }
     }
 
-    /// Every point of voxel `i` lies within the radius of an obstacle cube. Outside the
-    /// grid, only where unknown space is occupied (it is an obstacle there).
-    fn holds(&self, i: [i32; 3]) -> bool {
-        let g = self.field.grid();
+    /// Every point of voxel `i` of `field` lies within the radius of an obstacle cube.
+    /// Outside the grid, only where unknown space is occupied (it is an obstacle there).
+    fn within(&self, field: &DistanceField, i: [i32; 3]) -> bool {
+        let g = field.grid();
         match g.local(i) {
-            Some(_) => self.field.voxel_clearance(i) < self.below,
+            Some(_) => field.voxel_clearance(i) < self.below,
             None => g.unknown_is_occupied(),
         }
+    }
+
+    /// No point of voxel `i` of `field` holds a unit with its link.
+    fn closed(&self, field: &DistanceField, i: [i32; 3]) -> bool {
+        self.within(field, i)
+            || self
+                .stencil
+                .iter()
+                .all(|k| self.within(field, [i[0] + k[0], i[1] + k[1], i[2] + k[2]]))
+    }
+}
+
+/// The map `scale` times finer over a box of its voxels (lattice indices `lo..hi`),
+/// where a voxel is coarse against the radius: each voxel's obstacle is the same cube
+/// cut into `scale^3`, and outside the box counts as free (which only opens voxels).
+struct Fine {
+    field: DistanceField,
+    closure: Closure,
+    scale: i32,
+    lo: [i32; 3],
+    hi: [i32; 3],
+}
+
+impl Fine {
+    /// The box of `half` m around `at`, within `field`'s grid; `None` where it is empty.
+    fn around(
+        field: &DistanceField,
+        rule: &LinkRule,
+        scale: i32,
+        at: [f64; 3],
+        half: f64,
+    ) -> Option<Self> {
+        let g = field.grid();
+        let (o, dims) = (g.origin(), g.dims());
+        let lo = g.lattice_index(at.map(|c| c - half));
+        let hi = g.lattice_index(at.map(|c| c + half));
+        let lo = [0, 1, 2].map(|a| lo[a].max(o[a]));
+        let hi = [0, 1, 2].map(|a| (hi[a] + 1).min(o[a] + dims[a] as i32));
+        if (0..3).any(|a| lo[a] >= hi[a]) {
+            return None;
+        }
+        let r = g.resolution() / f64::from(scale);
+        let fine_dims = [0, 1, 2].map(|a| ((hi[a] - lo[a]) * scale) as usize);
+        let mut fine = Grid::new(r, lo.map(|c| c * scale), fine_dims, Cell::Free, false).ok()?;
+        for z in lo[2]..hi[2] {
+            for y in lo[1]..hi[1] {
+                for x in lo[0]..hi[0] {
+                    if g.is_obstacle([x, y, z]) {
+                        for k in 0..scale.pow(3) {
+                            let d = [k % scale, (k / scale) % scale, k / (scale * scale)];
+                            let j = [x * scale + d[0], y * scale + d[1], z * scale + d[2]];
+                            fine.set(j, Cell::Occupied);
+                        }
+                    }
+                }
+            }
+        }
+        Some(Self {
+            field: DistanceField::new(fine),
+            closure: Closure::new(r, rule),
+            scale,
+            lo,
+            hi,
+        })
+    }
+
+    fn covers(&self, i: [i32; 3]) -> bool {
+        (0..3).all(|a| (self.lo[a]..self.hi[a]).contains(&i[a]))
+    }
+
+    /// Every fine voxel of coarse voxel `i` is closed.
+    fn closed(&self, i: [i32; 3]) -> bool {
+        let s = self.scale;
+        (0..s.pow(3)).all(|k| {
+            let d = [k % s, (k / s) % s, k / (s * s)];
+            let j = [i[0] * s + d[0], i[1] * s + d[1], i[2] * s + d[2]];
+            self.closure.closed(&self.field, j)
+        })
     }
 }
 
@@ -147,7 +230,7 @@ fn stencil(r: f64, rule: &LinkRule) -> Vec<[i32; 3]> {
         }
     }
     // Level links first; among them, directions spread round the compass early.
-    out.sort_by_key(|k| (k[2].abs(), spread(k), k[0].abs() + k[1].abs()));
+    out.sort_by_cached_key(|k| (k[2].abs(), spread(k), k[0].abs() + k[1].abs()));
     out
 }
 
@@ -158,34 +241,83 @@ fn spread(k: &[i32; 3]) -> u8 {
     sector.reverse_bits() >> 4
 }
 
-/// The proof for one field and chain ([`Self::separated`]).
-pub struct LinkFlood<'a> {
-    field: &'a DistanceField,
-    within: Within<'a>,
-    stencil: Vec<[i32; 3]>,
+/// The rule for one map's resolution and one chain, made once for all queries.
+#[derive(Clone, Debug)]
+pub struct LinkCheck {
+    rule: LinkRule,
+    closure: Closure,
+    /// How many times finer the map is cut where it is refined (1: never).
+    scale: i32,
     /// Voxels per edge of the flood's cells.
     cell: usize,
 }
 
-impl<'a> LinkFlood<'a> {
-    /// The rule for `field`.
-    pub fn new(field: &'a DistanceField, rule: &LinkRule) -> Self {
-        let r = field.grid().resolution();
+impl LinkCheck {
+    /// The chain's measures it was made for.
+    pub fn rule(&self) -> &LinkRule {
+        &self.rule
+    }
+
+    /// The rule at resolution `r` (m). Where a voxel is coarser than a third of the
+    /// radius (its extent would hide the margins the rule needs), a refined flood cuts
+    /// the map finer, to a third of the radius or less ([`LinkFlood::new`]). The flood
+    /// runs in cells of about a third of the radius too: its cost follows the cells,
+    /// and a cut thinner than a cell only goes unseen.
+    pub fn new(r: f64, rule: LinkRule) -> Self {
         Self {
-            field,
-            within: Within::new(field, rule.radius),
-            stencil: stencil(r, rule),
+            rule,
+            closure: Closure::new(r, &rule),
+            scale: (3.0 * r / rule.radius - 1e-9).ceil().max(1.0) as i32,
             cell: ((rule.radius / (3.0 * r)).floor() as usize).max(1),
         }
+    }
+}
+
+/// The proof for one field and chain ([`Self::separated`]).
+pub struct LinkFlood<'a> {
+    field: &'a DistanceField,
+    check: &'a LinkCheck,
+    /// The map finer around the head route's narrowest point, where its voxels are
+    /// coarse against the radius.
+    fine: Option<Fine>,
+}
+
+impl<'a> LinkFlood<'a> {
+    /// The flood over `field` (at `check`'s resolution). With `refine_at` (the head
+    /// route's narrowest point), where the voxels are coarse against the radius, the map
+    /// is cut finer over the box around it that holds every voxel a unit within a link
+    /// and a radius of it, and its link's other end, can touch (a cut across a
+    /// passage lies about that near its narrowest point).
+    pub fn new(
+        field: &'a DistanceField,
+        check: &'a LinkCheck,
+        refine_at: Option<[f64; 3]>,
+    ) -> Self {
+        let (rule, r) = (&check.rule, field.grid().resolution());
+        let fine = refine_at.filter(|_| check.scale > 1).and_then(|at| {
+            let half = 2.0 * (rule.link + rule.radius) + 2.0 * r;
+            Fine::around(field, rule, check.scale, at, half)
+        });
+        Self { field, check, fine }
     }
 
     /// No point of voxel `i` holds a unit with its link (see the module docs).
     pub fn blocked(&self, i: [i32; 3]) -> bool {
-        self.within.holds(i)
+        self.check.closure.closed(self.field, i)
             || self
-                .stencil
-                .iter()
-                .all(|k| self.within.holds([i[0] + k[0], i[1] + k[1], i[2] + k[2]]))
+                .fine
+                .as_ref()
+                .is_some_and(|f| f.covers(i) && f.closed(i))
+    }
+
+    /// No unit with its link holds the point `p`: its voxel is closed, or where the
+    /// map is finer there, its fine voxel.
+    fn blocked_at(&self, p: Point3<f64>) -> bool {
+        let i = self.field.grid().lattice_index(p);
+        self.check.closure.closed(self.field, i)
+            || self.fine.as_ref().is_some_and(|f| {
+                f.covers(i) && f.closure.closed(&f.field, f.field.grid().lattice_index(p))
+            })
     }
 
     /// The stretch of `route` (sampled every half voxel) in link-blocked voxels: its
@@ -199,7 +331,7 @@ impl<'a> LinkFlood<'a> {
             let n = ((b - a).norm() / step).ceil().max(1.0) as usize;
             for s in 0..=n {
                 let p = a + (b - a) * (s as f64 / n as f64);
-                if self.blocked(g.lattice_index(p)) {
+                if self.blocked_at(p) {
                     stretch = Some(stretch.map_or((p, p), |(first, _)| (first, p)));
                 }
             }
@@ -223,7 +355,7 @@ impl<'a> LinkFlood<'a> {
         if self.blocked(start) {
             return None;
         }
-        let mut flood = Flood::new(g.dims().map(|d| d.div_ceil(self.cell)))?;
+        let mut flood = Flood::new(g.dims().map(|d| d.div_ceil(self.check.cell)))?;
         flood.seed(Side::Start, self.cell_of(g.local(start)?));
         for v in self.near_goal(goal, tol) {
             let c = self.cell_of(v);
@@ -255,21 +387,21 @@ impl<'a> LinkFlood<'a> {
         Some(LinkProof {
             side: side.name(),
             cells: flood.size[side as usize - 1],
-            cell_m: self.cell as f64 * g.resolution(),
+            cell_m: self.check.cell as f64 * g.resolution(),
             stretch,
         })
     }
 
     /// The flood's cell holding local voxel `v`.
     fn cell_of(&self, v: [usize; 3]) -> [usize; 3] {
-        v.map(|c| c / self.cell)
+        v.map(|c| c / self.check.cell)
     }
 
     /// Some voxel of cell `c` may hold a unit with its link.
     fn passable(&self, c: [usize; 3]) -> bool {
         let g = self.field.grid();
         let dims = g.dims();
-        let span = |a: usize| c[a] * self.cell..((c[a] + 1) * self.cell).min(dims[a]);
+        let span = |a: usize| c[a] * self.check.cell..((c[a] + 1) * self.check.cell).min(dims[a]);
         span(2).any(|z| {
             span(1).any(|y| span(0).any(|x| !self.blocked(to_index(g.origin(), [x, y, z]))))
         })
@@ -427,7 +559,6 @@ impl Flood {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::map::grid::{Cell, Grid};
 
     const RULE: LinkRule = LinkRule {
         link: 0.5,
@@ -462,7 +593,8 @@ mod tests {
         // the margin of this hatch: 0.45 m against the 0.477 m a link would need).
         for r in [0.025, 0.05, 0.087] {
             let (field, start, goal) = storeys(r, 0.45, 1.5);
-            let flood = LinkFlood::new(&field, &RULE);
+            let check = LinkCheck::new(field.grid().resolution(), RULE);
+            let flood = LinkFlood::new(&field, &check, None);
             let proof = flood
                 .separated(&[start, goal], goal, 0.3, None)
                 .unwrap_or_else(|| panic!("no proof at {r} m"));
@@ -475,10 +607,41 @@ mod tests {
     }
 
     #[test]
+    fn a_coarse_map_is_cut_finer_around_the_narrowest_point_where_its_voxels_hide_the_margin() {
+        // The planner's radius: r_u plus its checks' tolerance. A 0.4 m hatch through a
+        // metre of floor; at 0.087 and 0.1 m a voxel is over half that radius.
+        let rule = LinkRule {
+            radius: 0.1501,
+            ..RULE
+        };
+        for res in [0.025, 0.05, 0.087, 0.1] {
+            let sc = crate::problem::scenarios::build(&format!("shaft:w=0.4,depth=1,res={res}"))
+                .unwrap();
+            let field = DistanceField::new(sc.grid.clone());
+            let check = LinkCheck::new(res, rule);
+            let route: Vec<[f64; 3]> = sc.route.iter().map(|p| [p.x, p.y, p.z]).collect();
+            let goal = [sc.goal.x, sc.goal.y, sc.goal.z];
+            // The hatch's lower end, where the head route is narrowest.
+            let below = [route[1][0], route[1][1], 2.6];
+            let coarse = LinkFlood::new(&field, &check, None).separated(&route, goal, 0.3, None);
+            let refined =
+                LinkFlood::new(&field, &check, Some(below)).separated(&route, goal, 0.3, None);
+            assert_eq!(check.scale > 1, res > 0.06, "{res}");
+            assert_eq!(coarse.is_some(), res < 0.06, "{res}: {coarse:?}");
+            let proof = refined.unwrap_or_else(|| panic!("no proof at {res} m"));
+            assert!(
+                proof.stretch.0.z > 2.8 && proof.stretch.1.z < 3.4,
+                "{proof:?}"
+            );
+        }
+    }
+
+    #[test]
     fn a_hatch_in_a_thin_floor_is_not_closed() {
         // A link at 60 degrees crosses 0.2 m of floor within 0.12 m aside.
         let (field, start, goal) = storeys(0.05, 0.6, 0.2);
-        let flood = LinkFlood::new(&field, &RULE);
+        let check = LinkCheck::new(field.grid().resolution(), RULE);
+        let flood = LinkFlood::new(&field, &check, None);
         assert!(flood.blocked_stretch(&[start, goal]).is_none());
         assert!(flood.separated(&[start, goal], goal, 0.3, None).is_none());
     }
@@ -487,7 +650,8 @@ mod tests {
     fn open_air_holds_a_link_everywhere() {
         let g = Grid::new(0.05, [0, 0, 0], [40, 40, 40], Cell::Free, false).unwrap();
         let field = DistanceField::new(g);
-        let flood = LinkFlood::new(&field, &RULE);
+        let check = LinkCheck::new(field.grid().resolution(), RULE);
+        let flood = LinkFlood::new(&field, &check, None);
         for i in [[20, 20, 20], [5, 5, 5], [0, 0, 0]] {
             assert!(!flood.blocked(i), "{i:?}");
         }
@@ -529,7 +693,8 @@ mod tests {
             let sc = crate::problem::scenarios::build(name).unwrap();
             let field = DistanceField::new(sc.grid.clone());
             let route: Vec<[f64; 3]> = sc.route.iter().map(|p| [p.x, p.y, p.z]).collect();
-            let flood = LinkFlood::new(&field, &rule);
+            let check = LinkCheck::new(field.grid().resolution(), rule);
+            let flood = LinkFlood::new(&field, &check, None);
             let goal = [sc.goal.x, sc.goal.y, sc.goal.z];
             assert_eq!(flood.separated(&route, goal, 0.3, None), None, "{name}");
         }
@@ -571,17 +736,22 @@ mod tests {
         /// A voxel the rule closes holds no unit with its link: at points all over it
         /// (corners included) and at every yaw and pitch within the limit (the limit
         /// included), the unit or the unit at the link's other end is within the radius
-        /// of an obstacle, measured exactly.
+        /// of an obstacle, measured exactly. The map is cut three times finer around a
+        /// drawn point (0.1 m voxels against a 0.12 m radius), as on a coarse scan.
         #[test]
         fn a_closed_voxel_holds_no_unit_with_its_link(
             g in crate::map::random_grids::grids(3..10, |b| if b < 60 { Cell::Occupied } else { Cell::Free }),
             pick in proptest::array::uniform3(0usize..10),
+            refine in proptest::array::uniform3(0usize..10),
         ) {
             let rule = LinkRule { link: 0.3, theta_max: std::f64::consts::FRAC_PI_3, radius: 0.12 };
             let field = DistanceField::new(g.clone());
-            let flood = LinkFlood::new(&field, &rule);
+            let check = LinkCheck::new(field.grid().resolution(), rule);
+            proptest::prop_assert_eq!(check.scale, 3);
             let (o, dims) = (g.origin(), g.dims());
             let v = [0, 1, 2].map(|a| o[a] + (pick[a] % dims[a]) as i32);
+            let at = g.voxel_center([0, 1, 2].map(|a| o[a] + (refine[a] % dims[a]) as i32));
+            let flood = LinkFlood::new(&field, &check, Some([at.x, at.y, at.z]));
             if flood.blocked(v) {
                 let (c, r) = (g.voxel_center(v), g.resolution());
                 for k in 0..27 {
