@@ -536,9 +536,22 @@ impl ArcPlanner {
         {
             return Err(self.separated(sep));
         }
-        built.route = self.head_route(start, goal, budget, deadline, &mut built.lattice_s)?;
-        if let Some(cut) = self.links_cut(query, built.route.as_ref(), true, deadline) {
+        // Whether the chain can pass at all, asked along a way the head finds greedily:
+        // the guided route's A* prices tight stretches high, and may search a storey
+        // before it enters a hatch that no chain passes anyway.
+        let t = Instant::now();
+        let greedy = self
+            .lattice
+            .greedy_route(&self.ctx_min, start, goal, deadline);
+        built.lattice_s += t.elapsed().as_secs_f64();
+        if let Some(cut) = self.links_cut(query, greedy.as_ref(), true, deadline) {
             return Err(cut);
+        }
+        built.route = self.head_route(start, goal, budget, deadline, &mut built.lattice_s)?;
+        if greedy.is_none() {
+            if let Some(cut) = self.links_cut(query, built.route.as_ref(), true, deadline) {
+                return Err(cut);
+            }
         }
         if let Some(solved) = self.solve_on_route(query, stop, began, built)? {
             return Ok(Some(solved));

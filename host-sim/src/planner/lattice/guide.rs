@@ -36,6 +36,8 @@ pub(super) struct Guide<'a> {
     /// The Dijkstra's radius when it stopped: unsettled nodes are at least this far.
     reach: f64,
     goal: [f64; 3],
+    /// What the A* multiplies the estimate by (the lattice's `heuristic_weight`).
+    weight: f64,
 }
 
 impl<'a> Guide<'a> {
@@ -57,6 +59,7 @@ impl<'a> Guide<'a> {
             connected: false,
             reach: 0.0,
             goal,
+            weight: lat.tuning.heuristic_weight,
         };
         guide.search(starts, goals);
         guide
@@ -72,7 +75,19 @@ impl<'a> Guide<'a> {
             connected: false,
             reach: 0.0,
             goal,
+            weight: lat.tuning.heuristic_weight,
         }
+    }
+
+    /// The guide with the estimate weighted by `weight` instead.
+    pub(super) fn weighted(mut self, weight: f64) -> Self {
+        self.weight = weight;
+        self
+    }
+
+    /// The A*'s heuristic at lattice point `k` (at `p`): the weighted estimate.
+    pub(super) fn heuristic(&self, k: u64, p: [f64; 3]) -> f64 {
+        self.weight * self.estimate(k, p)
     }
 
     fn node(&self, k: u64) -> Option<u32> {

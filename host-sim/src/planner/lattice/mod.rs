@@ -334,6 +334,46 @@ impl HeadLattice {
         }
     }
 
+    /// A way for the head found greedily over the voxel centres: the regions' guide
+    /// alone orders the search (its estimate weighted far above any path's cost), so it
+    /// walks straight through the openings the guide points to, however narrow. Not a
+    /// route to fly (it ignores the preference for room, which can make the A* of
+    /// [`Self::guided_route`] search a whole storey before it enters a tight hatch): a
+    /// head path to prove things along (`planner::linked`). Labels the regions first
+    /// if that has not been done; `None`: not found within the budget.
+    pub fn greedy_route(
+        &self,
+        ctx_min: &CollisionContext,
+        start: [f64; 3],
+        goal: [f64; 3],
+        deadline: Option<Instant>,
+    ) -> Option<HeadRoute> {
+        /// The heuristic's weight: path costs are metres, so this leaves them to break
+        /// ties only.
+        const GREEDY: f64 = 1e6;
+        let field = ctx_min.field();
+        let regions = self.regions(field, deadline)?;
+        let mut nodes = Nodes::new(self, field);
+        let starts = self.anchors(&mut nodes, start, 1);
+        let goals = self.anchors(&mut nodes, goal, 1);
+        let guide = guide::Guide::new(self, regions, &starts, &goals, goal).weighted(GREEDY);
+        let limit = Limit {
+            budget: self.budget,
+            deadline,
+        };
+        let found = self.search(&mut nodes, start, goal, 2, &limit, &guide);
+        self.searched.take();
+        match found {
+            Search::Found(keys, n) => {
+                match self.finish(ctx_min, &mut nodes, start, goal, keys, n) {
+                    LatticeOutcome::Found(route) => Some(route),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
+    }
+
     /// The search guided by the labelled regions' coarse graph ([`guide`]): first
     /// over the voxel centres, then over the whole half-cell lattice with the floods
     /// that prove a failure. Labels the regions first if that has not been done.

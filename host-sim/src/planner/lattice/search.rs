@@ -134,7 +134,8 @@ impl HeadLattice {
         found.into_iter().map(|x| x.1).collect()
     }
 
-    /// One A* over the stride-`stride` sub-lattice. With stride 1, a flood from the
+    /// One A* over the stride-`stride` sub-lattice, its heuristic `guide`'s. With
+    /// stride 1, a flood from the
     /// goal runs beside it (one expansion each), and when the A* runs dry a flood from
     /// the start confirms it (the A* takes long steps in open space, so its running dry
     /// alone proves nothing): either flood exhausting its region without meeting the
@@ -166,7 +167,7 @@ impl HeadLattice {
             if c < n.g {
                 n.g = c;
                 open.push(Open {
-                    f: c + self.tuning.heuristic_weight * guide.estimate(s, self.point(s)),
+                    f: c + guide.heuristic(s, self.point(s)),
                     k: s,
                 });
             }
@@ -230,7 +231,7 @@ impl HeadLattice {
                     nn.g = ng;
                     nn.parent = k;
                     open.push(Open {
-                        f: ng + self.tuning.heuristic_weight * guide.estimate(n, pn),
+                        f: ng + guide.heuristic(n, pn),
                         k: n,
                     });
                 }
