@@ -321,15 +321,26 @@ impl HeadLattice {
             deadline,
         };
         let straight = guide::Guide::straight(self, goal);
-        let found = self.search(&mut nodes, start, goal, 2, &quick, &straight);
+        self.centres_route(ctx_min, &mut nodes, (start, goal), &quick, &straight)
+    }
+
+    /// One search over the voxel centres, the route it finds pulled taut; `None` where
+    /// it finds none (which proves nothing).
+    fn centres_route(
+        &self,
+        ctx_min: &CollisionContext,
+        nodes: &mut Nodes,
+        (start, goal): ([f64; 3], [f64; 3]),
+        limit: &Limit,
+        guide: &guide::Guide<'_>,
+    ) -> Option<HeadRoute> {
+        let found = self.search(nodes, start, goal, 2, limit, guide);
         self.searched.take();
         match found {
-            Search::Found(keys, n) => {
-                match self.finish(ctx_min, &mut nodes, start, goal, keys, n) {
-                    LatticeOutcome::Found(route) => Some(route),
-                    _ => None,
-                }
-            }
+            Search::Found(keys, n) => match self.finish(ctx_min, nodes, start, goal, keys, n) {
+                LatticeOutcome::Found(route) => Some(route),
+                _ => None,
+            },
             _ => None,
         }
     }
@@ -361,17 +372,7 @@ impl HeadLattice {
             budget: self.budget,
             deadline,
         };
-        let found = self.search(&mut nodes, start, goal, 2, &limit, &guide);
-        self.searched.take();
-        match found {
-            Search::Found(keys, n) => {
-                match self.finish(ctx_min, &mut nodes, start, goal, keys, n) {
-                    LatticeOutcome::Found(route) => Some(route),
-                    _ => None,
-                }
-            }
-            _ => None,
-        }
+        self.centres_route(ctx_min, &mut nodes, (start, goal), &limit, &guide)
     }
 
     /// The search guided by the labelled regions' coarse graph ([`guide`]): first
