@@ -65,7 +65,8 @@ class Map:
         """Reads an OctoMap binary tree (``.bt``); raises ``MapError`` naming the file."""
     @staticmethod
     def scenario(name: str, unknown_free: bool = False) -> Map:
-        """A built-in scenario (``SCENARIOS``, ``corridor:LENGTH``, ``passage:...``)."""
+        """A built-in scenario (``SCENARIOS``, ``corridor:LENGTH``, ``passage:...``,
+        ``forest:...``, ``slot:...``, ``pipe:...``, ``shaft:...``, ``campus``, ``hall``)."""
     @property
     def name(self) -> str:
         """The map's name: the file or ``scenario NAME``."""

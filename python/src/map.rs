@@ -52,8 +52,9 @@ impl Map {
         })
     }
 
-    /// A built-in scenario: `window`, `maze`, `silos`, `corridor`, `corridor:LENGTH` or
-    /// `passage:KEY=VALUE,...`. Raises `MapError` for an unknown name.
+    /// A built-in scenario: `window`, `maze`, `silos`, `corridor`, `corridor:LENGTH`, a
+    /// family instance (`passage:`, `forest:`, `slot:`, `pipe:` or `shaft:KEY=VALUE,...`)
+    /// or a large generated map (`campus`, `hall`). Raises `MapError` for an unknown name.
     #[staticmethod]
     #[pyo3(signature = (name, unknown_free = false))]
     fn scenario(py: Python<'_>, name: &str, unknown_free: bool) -> PyResult<Self> {

@@ -110,8 +110,9 @@ pub struct MapArgs {
         required_unless_present = "scenario"
     )]
     pub map: Option<PathBuf>,
-    /// Built-in scenario: window, maze, silos, corridor, corridor:LENGTH, passage:KEY=VALUE,...
-    /// or the large generated maps campus, campus:RES, hall and hall:RES.
+    /// Built-in scenario: window, maze, silos, corridor, corridor:LENGTH, a family instance
+    /// (passage:, forest:, slot:, pipe: or shaft:KEY=VALUE,...) or the large generated maps
+    /// campus, campus:RES, hall and hall:RES.
     #[arg(long)]
     pub scenario: Option<String>,
     /// Treat unknown space as free (the default treats it as occupied).
