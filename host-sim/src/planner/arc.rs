@@ -125,9 +125,9 @@ pub struct ArcPlanner {
     pub(super) refine: RefineSettings,
     roadmap: Option<Roadmap>,
     roadmap_s: f64,
-    /// The rule that proves where no unit holds its link, made at the first query
-    /// that asks it.
-    links: std::sync::OnceLock<super::linked::LinkCheck>,
+    /// The rule that proves where no unit holds its link, made with the planner (its
+    /// stencil is setup's work, not a query's).
+    links: super::linked::LinkCheck,
 }
 
 impl ArcPlanner {
@@ -154,6 +154,16 @@ impl ArcPlanner {
         ctx_min.set_min_step(ctx.min_step());
         let lattice =
             lattice::HeadLattice::tuned(&ctx, c_min, settings.clearance_weight, settings.lattice);
+        let p = ctx.params();
+        let links = super::linked::LinkCheck::new(
+            ctx.field().grid().resolution(),
+            super::linked::LinkRule {
+                link: f64::from(p.link_length),
+                theta_max: f64::from(p.theta_max),
+                // The regions' radius: what the planner's own checks keep at the least.
+                radius: lattice.radius_min(),
+            },
+        );
         Ok(Self {
             ctx,
             ctx_min,
@@ -164,7 +174,7 @@ impl ArcPlanner {
             refine: RefineSettings::default(),
             roadmap: None,
             roadmap_s: 0.0,
-            links: std::sync::OnceLock::new(),
+            links,
         })
     }
 
@@ -295,18 +305,9 @@ impl ArcPlanner {
         refine: bool,
         deadline: Option<Instant>,
     ) -> Option<PlanError> {
-        let route = route?;
+        let route = route.filter(|_| !expired(deadline))?;
         let field = self.ctx.field();
-        let check = self.links.get_or_init(|| {
-            let p = self.ctx.params();
-            let rule = super::linked::LinkRule {
-                link: f64::from(p.link_length),
-                theta_max: f64::from(p.theta_max),
-                // The regions' radius: what the planner's own checks keep at the least.
-                radius: self.lattice.radius_min(),
-            };
-            super::linked::LinkCheck::new(field.grid().resolution(), rule)
-        });
+        let check = &self.links;
         let refine_at = refine.then_some(route.narrowest);
         let flood = super::linked::LinkFlood::new(field, check, refine_at);
         let proof = flood.separated(&route.points, query.ends().1, query.goal_tol, deadline)?;

@@ -90,7 +90,14 @@ pub struct LinkRule {
 struct Closure {
     /// A stored bound below this proves `n <= n*`.
     below: f64,
-    stencil: Vec<[i32; 3]>,
+    /// A stored bound above this (`R + l`) proves a voxel open: a unit at its centre and
+    /// one a link away in any level direction are both free.
+    open_above: f64,
+    /// Made when first asked: with the planner for its map, at the first voxel the
+    /// bound above cannot settle for a refined one (open space needs none).
+    stencil: std::sync::OnceLock<Vec<[i32; 3]>>,
+    r: f64,
+    rule: LinkRule,
 }
 
 impl Closure {
@@ -103,7 +110,10 @@ impl Closure {
         };
         Self {
             below,
-            stencil: stencil(r, rule),
+            open_above: rule.radius + rule.link,
+            stencil: std::sync::OnceLock::new(),
+            r,
+            rule: *rule,
         }
     }
 
@@ -117,11 +127,19 @@ impl Closure {
         }
     }
 
+    /// The stencil, made at the first call.
+    fn stencil(&self) -> &[[i32; 3]] {
+        self.stencil.get_or_init(|| stencil(self.r, &self.rule))
+    }
+
     /// No point of voxel `i` of `field` holds a unit with its link.
     fn closed(&self, field: &DistanceField, i: [i32; 3]) -> bool {
+        if field.grid().local(i).is_some() && field.voxel_clearance(i) > self.open_above {
+            return false;
+        }
         self.within(field, i)
             || self
-                .stencil
+                .stencil()
                 .iter()
                 .all(|k| self.within(field, [i[0] + k[0], i[1] + k[1], i[2] + k[2]]))
     }
@@ -264,9 +282,11 @@ impl LinkCheck {
     /// runs in cells of about a third of the radius too: its cost follows the cells,
     /// and a cut thinner than a cell only goes unseen.
     pub fn new(r: f64, rule: LinkRule) -> Self {
+        let closure = Closure::new(r, &rule);
+        closure.stencil();
         Self {
             rule,
-            closure: Closure::new(r, &rule),
+            closure,
             scale: (3.0 * r / rule.radius - 1e-9).ceil().max(1.0) as i32,
             cell: ((rule.radius / (3.0 * r)).floor() as usize).max(1),
         }
