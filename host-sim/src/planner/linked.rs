@@ -10,7 +10,8 @@
 //!
 //! # The rule
 //! Call a voxel LINK-BLOCKED when no point of its closed cube can hold the centre of a
-//! unit (radius `R`: `r_u` plus the smallest clearance) with a free neighbour at
+//! unit (radius `R`: `r_u` plus the smallest clearance and the checks' tolerance, the
+//! regions' radius) with a free neighbour at
 //! distance `l` in a direction whose pitch is at most `theta_max`. Every unit of a
 //! chain of two or more always holds such a neighbour, so the head's centre never
 //! enters a link-blocked voxel; as it moves, the voxels holding it change only to
@@ -27,7 +28,8 @@
 //! corners line up). The distance field stores `r G(n)` for the squared distance `n`
 //! (voxel units) to the nearest obstacle centre, with `G` non-decreasing, so
 //! `n <= (R / r)^2` holds whenever the stored value is below `r G(n* + 1)`: one
-//! comparison per voxel ([`Within`]).
+//! comparison per voxel (`Closure::within`). A stored value above `R + l` settles
+//! the other way at once: a unit at the centre and one a level link away are free.
 //!
 //! The neighbour of a unit in voxel `v` lies in a voxel `v + k` for `k` in a STENCIL:
 //! the offsets whose cube, grown by a voxel (the unit's own extent), meets the zone
@@ -35,16 +37,25 @@
 //! itself (no free centre), or when every voxel of its stencil is (no free
 //! neighbour). Every step only leaves out what could be free (the link's capsule, the
 //! bend limits, the other units), so a voxel the test blocks is blocked; a voxel it
-//! does not block may still be. The stencil is scanned level links first, so in open
-//! space the first offset settles it.
+//! does not block may still be. The stencil is scanned level links first, so near
+//! walls the first offsets settle it.
+//!
+//! A voxel's extent costs the test up to a voxel of margin on each side; on a map
+//! coarser than a third of `R` (0.087-0.1 m scans against 0.15 m) that hides what the
+//! test needs. There the map is cut finer (each voxel's cube into `scale^3`, to a third
+//! of `R` or less) over a box around the route's narrowest point, the box counted free
+//! outside, which only opens voxels; a voxel in the box is blocked when every one of
+//! its fine voxels is ([`LinkFlood::new`]).
 //!
 //! # The flood
 //! Only a route that crosses link-blocked voxels can be cut; the head route is checked
 //! first (a route whose every voxel holds a link joins start and goal). Then the
-//! voxels that hold a link are flooded from both ends at once, one voxel from each
-//! side in turn, testing each as it is reached: the side that runs out first is the
-//! proof (its size is reported); the sides meeting means no proof. The flood stays in
-//! the grid (unit centres lie inside the map's box).
+//! voxels that may hold a link are flooded from both ends at once, in cells of about
+//! a third of `R` (a cell is open when one of its voxels is; a cut thinner than a
+//! cell only goes unseen), one cell from each side in turn, testing each as it is
+//! reached: the side that runs out first is the proof (its size is reported); the
+//! sides meeting means no proof. The flood stays in the grid (unit centres lie inside
+//! the map's box).
 
 use std::collections::VecDeque;
 use std::time::Instant;
