@@ -270,10 +270,18 @@ fn spread(k: &[i32; 3]) -> u8 {
     sector.reverse_bits() >> 4
 }
 
+/// Most voxels a link may span for the rule to be asked: its stencil holds about
+/// `27 (l / r)^2` offsets, made from `(2 l / r)^3` candidates and scanned for every
+/// voxel it tests, so a map finer than this (4 mm voxels for a 0.5 m link) would pay
+/// more for the proof than it saves.
+pub const MAX_LINK_VOXELS: f64 = 128.0;
+
 /// The rule for one map's resolution and one chain, made once for all queries.
 #[derive(Clone, Debug)]
 pub struct LinkCheck {
     rule: LinkRule,
+    /// Whether the map is coarse enough for the rule ([`MAX_LINK_VOXELS`]).
+    asked: bool,
     closure: Closure,
     /// How many times finer the map is cut where it is refined (1: never).
     scale: i32,
@@ -291,12 +299,17 @@ impl LinkCheck {
     /// radius (its extent would hide the margins the rule needs), a refined flood cuts
     /// the map finer, to a third of the radius or less ([`LinkFlood::new`]). The flood
     /// runs in cells of about a third of the radius too: its cost follows the cells,
-    /// and a cut thinner than a cell only goes unseen.
+    /// and a cut thinner than a cell only goes unseen. On a map finer than
+    /// [`MAX_LINK_VOXELS`] voxels a link, the rule is not asked.
     pub fn new(r: f64, rule: LinkRule) -> Self {
         let closure = Closure::new(r, &rule);
-        closure.stencil();
+        let asked = rule.link / r <= MAX_LINK_VOXELS;
+        if asked {
+            closure.stencil();
+        }
         Self {
             rule,
+            asked,
             closure,
             scale: (3.0 * r / rule.radius - 1e-9).ceil().max(1.0) as i32,
             cell: ((rule.radius / (3.0 * r)).floor() as usize).max(1),
@@ -380,6 +393,9 @@ impl<'a> LinkFlood<'a> {
         tol: f64,
         deadline: Option<Instant>,
     ) -> Option<LinkProof> {
+        if !self.check.asked {
+            return None;
+        }
         let stretch = self.blocked_stretch(route)?;
         let g = self.field.grid();
         let start = g.lattice_index(*route.first()?);

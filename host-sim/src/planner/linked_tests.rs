@@ -218,3 +218,12 @@ proptest::proptest! {
         }
     }
 }
+
+#[test]
+fn a_map_finer_than_the_rule_allows_is_not_asked() {
+    let r = RULE.link / MAX_LINK_VOXELS / 2.0;
+    let check = LinkCheck::new(r, RULE);
+    assert!(!check.asked);
+    assert!(check.closure.stencil.get().is_none(), "no stencil made");
+    assert!(LinkCheck::new(0.05, RULE).asked);
+}
