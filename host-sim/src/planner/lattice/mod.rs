@@ -363,16 +363,28 @@ impl HeadLattice {
         /// ties only.
         const GREEDY: f64 = 1e6;
         let field = ctx_min.field();
-        let regions = self.regions(field, deadline)?;
-        let mut nodes = Nodes::new(self, field);
-        let starts = self.anchors(&mut nodes, start, 1);
-        let goals = self.anchors(&mut nodes, goal, 1);
-        let guide = guide::Guide::new(self, regions, &starts, &goals, goal).weighted(GREEDY);
+        let (mut nodes, guide) = self.guided_by(field, self.regions(field, deadline)?, start, goal);
+        let guide = guide.weighted(GREEDY);
         let limit = Limit {
             budget: self.budget,
             deadline,
         };
         self.centres_route(ctx_min, &mut nodes, (start, goal), &limit, &guide)
+    }
+
+    /// A search's points and the regions' guide from `start` to `goal`.
+    fn guided_by<'a>(
+        &'a self,
+        field: &'a DistanceField,
+        regions: &'a Regions,
+        start: [f64; 3],
+        goal: [f64; 3],
+    ) -> (Nodes<'a>, guide::Guide<'a>) {
+        let mut nodes = Nodes::new(self, field);
+        let starts = self.anchors(&mut nodes, start, 1);
+        let goals = self.anchors(&mut nodes, goal, 1);
+        let guide = guide::Guide::new(self, regions, &starts, &goals, goal);
+        (nodes, guide)
     }
 
     /// The search guided by the labelled regions' coarse graph ([`guide`]): first
@@ -391,10 +403,7 @@ impl HeadLattice {
         let Some(regions) = self.regions(field, deadline) else {
             return LatticeOutcome::Budget;
         };
-        let mut nodes = Nodes::new(self, field);
-        let starts = self.anchors(&mut nodes, start, 1);
-        let goals = self.anchors(&mut nodes, goal, 1);
-        let guide = guide::Guide::new(self, regions, &starts, &goals, goal);
+        let (mut nodes, guide) = self.guided_by(field, regions, start, goal);
         match self.search(&mut nodes, start, goal, 2, &limit, &guide) {
             Search::Found(keys, n) => {
                 return self.finish(ctx_min, &mut nodes, start, goal, keys, n)
