@@ -312,6 +312,12 @@ impl Grid {
         Some(l)
     }
 
+    /// The lattice index of grid-local voxel `l` ([`Self::local`]'s inverse).
+    #[inline]
+    pub fn index_of_local(&self, l: [usize; 3]) -> [i32; 3] {
+        [0, 1, 2].map(|a| self.origin[a] + l[a] as i32)
+    }
+
     /// Linear index of a grid-local voxel (x fastest).
     #[inline]
     pub fn linear(&self, l: [usize; 3]) -> usize {

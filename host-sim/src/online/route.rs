@@ -172,7 +172,7 @@ pub fn search(
     let Some(start) = grid.local(grid.lattice_index(from)) else {
         return Found::Sealed { reached: 0 };
     };
-    let (dims, o, r_v) = (grid.dims(), grid.origin(), grid.resolution());
+    let (dims, r_v) = (grid.dims(), grid.resolution());
     let reach = tol + 3f64.sqrt() / 2.0 * r_v;
     let unlinear = |k: usize| {
         [
@@ -181,8 +181,7 @@ pub fn search(
             k / (dims[0] * dims[1]),
         ]
     };
-    let lattice = |l: [usize; 3]| [0, 1, 2].map(|a| o[a] + l[a] as i32);
-    let centre = |l: [usize; 3]| grid.voxel_center(lattice(l));
+    let centre = |l: [usize; 3]| grid.voxel_center(grid.index_of_local(l));
     let h = |l: [usize; 3]| ((centre(l) - goal).norm() - reach).max(0.0);
     let voxels = dims.iter().product();
     let narrow = narrow_cost(voxels);
@@ -205,7 +204,7 @@ pub fn search(
         for d in NEIGHBOURS {
             let Some(m) = step(l, d, dims) else { continue };
             let km = grid.linear(m);
-            let bound = field.voxel_clearance(lattice(m));
+            let bound = field.voxel_clearance(grid.index_of_local(m));
             if bound < radii.proof {
                 continue;
             }

@@ -192,9 +192,7 @@ impl Fine {
             for y in lo[1]..hi[1] {
                 for x in lo[0]..hi[0] {
                     if g.is_obstacle([x, y, z]) {
-                        for k in 0..scale.pow(3) {
-                            let d = [k % scale, (k / scale) % scale, k / (scale * scale)];
-                            let j = [x * scale + d[0], y * scale + d[1], z * scale + d[2]];
+                        for j in finer([x, y, z], scale) {
                             fine.set(j, Cell::Occupied);
                         }
                     }
@@ -216,13 +214,16 @@ impl Fine {
 
     /// Every fine voxel of coarse voxel `i` is closed.
     fn closed(&self, i: [i32; 3]) -> bool {
-        let s = self.scale;
-        (0..s.pow(3)).all(|k| {
-            let d = [k % s, (k / s) % s, k / (s * s)];
-            let j = [i[0] * s + d[0], i[1] * s + d[1], i[2] * s + d[2]];
-            self.closure.closed(&self.field, j)
-        })
+        finer(i, self.scale).all(|j| self.closure.closed(&self.field, j))
     }
+}
+
+/// The `scale^3` voxels, `scale` times finer, that voxel `i` is cut into.
+fn finer(i: [i32; 3], scale: i32) -> impl Iterator<Item = [i32; 3]> {
+    (0..scale.pow(3)).map(move |k| {
+        let d = [k % scale, (k / scale) % scale, k / (scale * scale)];
+        [0, 1, 2].map(|a| i[a] * scale + d[a])
+    })
 }
 
 /// The voxel offsets a unit's neighbour may lie in, level links first.
@@ -321,9 +322,11 @@ impl LinkCheck {
 pub struct LinkFlood<'a> {
     field: &'a DistanceField,
     check: &'a LinkCheck,
-    /// The map finer around the head route's narrowest point, where its voxels are
-    /// coarse against the radius.
-    fine: Option<Fine>,
+    /// Where the map may be cut finer: the head route's narrowest point, where its
+    /// voxels are coarse against the radius.
+    refine_at: Option<[f64; 3]>,
+    /// The finer map, made at the first voxel that needs it ([`Self::fine`]).
+    fine: std::cell::OnceCell<Option<Fine>>,
 }
 
 impl<'a> LinkFlood<'a> {
@@ -337,21 +340,37 @@ impl<'a> LinkFlood<'a> {
         check: &'a LinkCheck,
         refine_at: Option<[f64; 3]>,
     ) -> Self {
-        let (rule, r) = (&check.rule, field.grid().resolution());
-        let fine = refine_at.filter(|_| check.scale > 1).and_then(|at| {
-            let half = 2.0 * (rule.link + rule.radius) + 2.0 * r;
-            Fine::around(field, rule, check.scale, at, half)
-        });
-        Self { field, check, fine }
+        Self {
+            field,
+            check,
+            refine_at: refine_at.filter(|_| check.scale > 1),
+            fine: std::cell::OnceCell::new(),
+        }
+    }
+
+    /// The finer map where it covers voxel `i` and could close it. A voxel whose centre
+    /// keeps more than `R + l` and its half diagonal from the map holds a unit with a
+    /// level link at every point, however finely cut: the map is cut (a distance field
+    /// over the box) only when a voxel nearer the map asks.
+    fn fine(&self, i: [i32; 3]) -> Option<&Fine> {
+        let at = self.refine_at?;
+        let g = self.field.grid();
+        let r = g.resolution();
+        let rule = &self.check.rule;
+        let far = rule.radius + rule.link + r * 3f64.sqrt() / 2.0;
+        if g.local(i).is_some() && self.field.voxel_clearance(i) > far {
+            return None;
+        }
+        let half = 2.0 * (rule.link + rule.radius) + 2.0 * r;
+        self.fine
+            .get_or_init(|| Fine::around(self.field, rule, self.check.scale, at, half))
+            .as_ref()
+            .filter(|f| f.covers(i))
     }
 
     /// No point of voxel `i` holds a unit with its link (see the module docs).
     pub fn blocked(&self, i: [i32; 3]) -> bool {
-        self.check.closure.closed(self.field, i)
-            || self
-                .fine
-                .as_ref()
-                .is_some_and(|f| f.covers(i) && f.closed(i))
+        self.check.closure.closed(self.field, i) || self.fine(i).is_some_and(|f| f.closed(i))
     }
 
     /// No unit with its link holds the point `p`: its voxel is closed, or where the
@@ -359,9 +378,9 @@ impl<'a> LinkFlood<'a> {
     fn blocked_at(&self, p: Point3<f64>) -> bool {
         let i = self.field.grid().lattice_index(p);
         self.check.closure.closed(self.field, i)
-            || self.fine.as_ref().is_some_and(|f| {
-                f.covers(i) && f.closure.closed(&f.field, f.field.grid().lattice_index(p))
-            })
+            || self
+                .fine(i)
+                .is_some_and(|f| f.closure.closed(&f.field, f.field.grid().lattice_index(p)))
     }
 
     /// The stretch of `route` (sampled every half voxel) in link-blocked voxels: its
@@ -406,12 +425,15 @@ impl<'a> LinkFlood<'a> {
         flood.seed(Side::Start, self.cell_of(g.local(start)?));
         for v in self.near_goal(goal, tol) {
             let c = self.cell_of(v);
-            match flood.state(c) {
-                UNSEEN if !self.blocked(to_index(g.origin(), v)) => flood.seed(Side::Goal, c),
-                s if s == Side::Start as u8 && !self.blocked(to_index(g.origin(), v)) => {
-                    return None
+            let state = flood.state(c);
+            let asked = state == UNSEEN || state == Side::Start as u8;
+            if asked && !self.blocked(g.index_of_local(v)) {
+                if state == UNSEEN {
+                    flood.seed(Side::Goal, c);
+                } else {
+                    // The goal's voxel is in the start's cell: nothing to cut.
+                    return None;
                 }
-                _ => {}
             }
         }
         let mut turn = 0usize;
@@ -449,9 +471,8 @@ impl<'a> LinkFlood<'a> {
         let g = self.field.grid();
         let dims = g.dims();
         let span = |a: usize| c[a] * self.check.cell..((c[a] + 1) * self.check.cell).min(dims[a]);
-        span(2).any(|z| {
-            span(1).any(|y| span(0).any(|x| !self.blocked(to_index(g.origin(), [x, y, z]))))
-        })
+        span(2)
+            .any(|z| span(1).any(|y| span(0).any(|x| !self.blocked(g.index_of_local([x, y, z])))))
     }
 
     /// Grid voxels (local) whose cube lies within `tol` of `goal`.
@@ -509,11 +530,6 @@ impl<'a> LinkFlood<'a> {
         }
         false
     }
-}
-
-/// The lattice index of local voxel `l`.
-fn to_index(origin: [i32; 3], l: [usize; 3]) -> [i32; 3] {
-    [0, 1, 2].map(|a| origin[a] + l[a] as i32)
 }
 
 /// Which end a flooded voxel was reached from.

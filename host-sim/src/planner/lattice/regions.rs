@@ -469,7 +469,6 @@ fn row_runs(field: &DistanceField, [y, z]: [usize; 2], radius: f64) -> Vec<[u32;
     // too narrow along an axis; one whose centre is surely far enough never is.
     let sure = radius as f32;
     let need = gap_voxels(radius, r);
-    let origin = g.origin();
     let mut runs = Vec::new();
     let mut open: Option<u32> = None;
     let row = g.obstacle_row(y, z).zip(field.row_bounds(y, z));
@@ -477,7 +476,7 @@ fn row_runs(field: &DistanceField, [y, z]: [usize; 2], radius: f64) -> Vec<[u32;
         // The gap test (and its lattice index) only where the bound leaves doubt.
         let free = !obstacle
             && lb > bar
-            && (lb >= sure || !too_narrow(g, lattice(origin, [x, y, z]), need));
+            && (lb >= sure || !too_narrow(g, g.index_of_local([x, y, z]), need));
         match (free, open) {
             (true, None) => open = Some(x as u32),
             (false, Some(x0)) => {
@@ -491,12 +490,6 @@ fn row_runs(field: &DistanceField, [y, z]: [usize; 2], radius: f64) -> Vec<[u32;
         runs.push([x0, g.dims()[0] as u32 - 1]);
     }
     runs
-}
-
-/// The lattice index of the voxel at grid-local `local`, the grid's lowest voxel at
-/// `origin`.
-fn lattice(origin: [i32; 3], local: [usize; 3]) -> [i32; 3] {
-    [0, 1, 2].map(|a| origin[a] + local[a] as i32)
 }
 
 /// The fewest voxels in a row, between two obstacle voxels, that can hold a centre

@@ -135,11 +135,10 @@ impl HeadLattice {
     }
 
     /// One A* over the stride-`stride` sub-lattice, its heuristic `guide`'s. With
-    /// stride 1, a flood from the
-    /// goal runs beside it (one expansion each), and when the A* runs dry a flood from
-    /// the start confirms it (the A* takes long steps in open space, so its running dry
-    /// alone proves nothing): either flood exhausting its region without meeting the
-    /// other side proves the two are separate.
+    /// stride 1, a flood from the goal runs beside it (one expansion each), and when
+    /// the A* runs dry a flood from the start confirms it (the A* takes long steps in
+    /// open space, so its running dry alone proves nothing): either flood exhausting
+    /// its region without meeting the other side proves the two are separate.
     pub(super) fn search(
         &self,
         nodes: &mut Nodes,

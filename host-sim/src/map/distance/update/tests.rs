@@ -29,12 +29,6 @@ fn assert_same_as_rebuilt(f: &DistanceField) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-/// Lattice index of local voxel `l` of `g`.
-fn lattice(g: &Grid, l: [usize; 3]) -> [i32; 3] {
-    let o = g.origin();
-    [0, 1, 2].map(|a| o[a] + l[a] as i32)
-}
-
 /// Turns raw draws into changes inside a grid of `dims`: `mode` 0 scatters, 1 puts the
 /// voxel on a face of the grid, 2 next to the previous change (clusters). Each batch
 /// ends by changing its first voxel a second time, to another state.
@@ -58,7 +52,7 @@ fn changes_of(dims: [usize; 3], raw: &[(u8, [u8; 3], u8)], g: &Grid) -> Vec<([i3
             _ => {}
         }
         prev = l;
-        out.push((lattice(g, l), state(s)));
+        out.push((g.index_of_local(l), state(s)));
     }
     if let Some(&(i, s)) = out.first() {
         let again = match s {
