@@ -80,14 +80,18 @@ impl ShaftSpec {
 
     /// The hatch's side as built (m): `w` widened to whole voxels.
     pub fn side(&self) -> f64 {
-        (self.w / self.res - 1e-9).ceil() * self.res
+        self.voxels() * self.res
+    }
+
+    /// How many voxels the hatch spans across.
+    fn voxels(&self) -> f64 {
+        (self.w / self.res - 1e-9).ceil()
     }
 
     /// The hatch's corners (x, y): whole voxels, at least `w` across, centred as near
     /// `(AXIS_X, SIZE[1] / 2)` as the voxels allow.
     fn hatch(&self) -> ([f64; 2], [f64; 2]) {
-        let r = self.res;
-        let n = (self.side() / r).round();
+        let (r, n) = (self.res, self.voxels());
         let corner = |c: f64| {
             (
                 (c / r - n / 2.0).round() * r,
