@@ -36,6 +36,7 @@
 //! from `aerial_chain_core::validity::check_transition`.
 
 pub(crate) mod exact;
+pub(crate) mod point_clearance;
 pub(crate) mod verify;
 
 use std::cell::RefCell;
@@ -353,10 +354,19 @@ impl CollisionContext {
         if c > need || c + self.field_loss < need {
             return c;
         }
+        self.measured_bound(p, need, c)
+    }
+
+    /// [`Self::bound`] where the field's bound `c` falls just short of `need`: the
+    /// obstacle cubes nearby measured. Kept out of line (it is rare next to the
+    /// one-lookup common case, and its frame would burden every call).
+    #[cold]
+    #[inline(never)]
+    fn measured_bound(&self, p: Point3<f64>, need: f64, c: f64) -> f64 {
         let r_v = self.field.grid().resolution();
         // Below `need`, `exact_clearance` may give a cube that is not the nearest: only
         // a value above `need` is a proven distance.
-        exact::exact_clearance_above(&self.field, p, need, need + r_v).unwrap_or(c)
+        point_clearance::exact_clearance_above(&self.field, p, need, need + r_v).unwrap_or(c)
     }
 
     /// Whether the head's unit sphere (grown by the clearance margin) is free at `p`
@@ -402,6 +412,7 @@ impl CollisionContext {
     }
 
     /// Unit centres for `head` and `shape`.
+    #[inline]
     fn points(&self, head: Point3<f64>, shape: &Shape) -> WorldPoints {
         let o = offsets(&self.params, shape);
         let mut p = [Point3::origin(); MAX_UNITS];

@@ -387,7 +387,7 @@ proptest! {
     ) {
         let (p, cap) = (Point3::from(p), stop.max(0.0) + reach);
         let every = nearest_by_every_voxel(&grid, p, p, cap).map_or(cap, |n| n.distance);
-        let fast = exact::exact_clearance(&DistanceField::new(grid), p, stop, cap);
+        let fast = point_clearance::exact_clearance(&DistanceField::new(grid), p, stop, cap);
         if every <= stop {
             prop_assert!(fast <= stop, "{fast} > stop {stop} ({every})");
         } else if every >= cap {
@@ -413,8 +413,8 @@ proptest! {
     ) {
         let (p, cap) = (Point3::from(p), stop.max(0.0) + reach);
         let field = DistanceField::new(grid);
-        let e = exact::exact_clearance(&field, p, stop, cap);
-        let above = exact::exact_clearance_above(&field, p, stop, cap);
+        let e = point_clearance::exact_clearance(&field, p, stop, cap);
+        let above = point_clearance::exact_clearance_above(&field, p, stop, cap);
         prop_assert_eq!(above.map(f64::to_bits), (e > stop).then_some(e.to_bits()));
     }
 }
@@ -429,12 +429,12 @@ fn exact_clearance_above_reads_rows_whose_gaps_saturate() {
     let field = DistanceField::new(g);
     let p = Point3::new(2.905, 0.015, 0.015);
     for (stop, cap) in [(0.0, 3.0), (0.0, 0.05), (2.9, 3.0), (0.1, 2.0)] {
-        let e = exact::exact_clearance(&field, p, stop, cap);
-        let above = exact::exact_clearance_above(&field, p, stop, cap);
+        let e = point_clearance::exact_clearance(&field, p, stop, cap);
+        let above = point_clearance::exact_clearance_above(&field, p, stop, cap);
         assert_eq!(above, (e > stop).then_some(e), "stop {stop} cap {cap}");
     }
     // The cube at x = 299 is 0.085 m along x and a voxel across in y and z.
-    let d = exact::exact_clearance_above(&field, p, 0.0, 0.2).unwrap();
+    let d = point_clearance::exact_clearance_above(&field, p, 0.0, 0.2).unwrap();
     assert!(
         (d - (0.085f64.powi(2) + 2.0 * 0.005f64.powi(2)).sqrt()).abs() < 1e-12,
         "{d}"

@@ -140,6 +140,10 @@ pub struct DistanceField {
     /// The grid's dimensions as `f64`, which every query compares against (the
     /// conversion costs more than the comparison).
     extent: [f64; 3],
+    /// `1 / r`, which every query multiplies by: a division costs several times a
+    /// product, and a coordinate a rounding apart only picks a neighbouring centre,
+    /// whose bound holds as well.
+    inv_r: f64,
     /// What [`Self::update`] keeps between updates (the EDT's x and y passes), built on
     /// the first update or by [`Self::prepare_updates`]; `None` until then, since it
     /// takes 8 bytes a voxel that a finished map never needs.
@@ -170,6 +174,7 @@ impl DistanceField {
             lb,
             row_gaps,
             extent,
+            inv_r: 1.0 / r,
             kept: None,
         }
     }
@@ -193,12 +198,12 @@ impl DistanceField {
         }
     }
 
-    /// Coordinate `x` along axis `a` in voxels from the grid's lower face (`x / r - origin`),
+    /// Coordinate `x` along axis `a` in voxels from the grid's lower face (`x (1 / r) - origin`),
     /// or `None` where the clearance is 0: `x` is NaN, or outside the grid while unknown
     /// space is occupied.
     #[inline]
     fn grid_coordinate(&self, x: f64, a: usize) -> Option<f64> {
-        let q = x / self.grid.resolution();
+        let q = x * self.inv_r;
         if q.is_nan() {
             return None;
         }
@@ -313,8 +318,7 @@ impl DistanceField {
 
     /// [`Self::clearance_coarse`] when it exceeds `need`, else [`Self::clearance`]: a
     /// proven lower bound, as tight as the fine query wherever it matters for `need`.
-    /// Both read the grid coordinates of `p` computed once (three divisions, which cost
-    /// about as much as the rest of the coarse query).
+    /// Both read the grid coordinates of `p`, computed once.
     #[inline]
     pub fn clearance_above(&self, p: impl Into<Point3<f64>>, need: f64) -> f64 {
         let p = p.into();

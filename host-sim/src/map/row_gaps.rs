@@ -1,5 +1,5 @@
 //! How far along its x-row each voxel's nearest obstacle voxel lies: what lets the exact
-//! clearance of a point ([`crate::collision::exact::exact_clearance`]) read one or two
+//! clearance of a point ([`crate::collision::point_clearance::exact_clearance`]) read one or two
 //! voxels per row instead of every voxel of a ball.
 //!
 //! For a point `p` in voxel `x0` of a row, the distance to the row's obstacle cubes

@@ -29,7 +29,8 @@ use super::numeric::{TIE, TINY, TINY_F32};
 use super::plan_ops::{differs, head_route};
 use super::widen::{distance, gradient, zeta};
 use super::{follow, Checker, Step, ThreadSettings};
-use crate::collision::exact::{exact_clearance, positions_f64};
+use crate::collision::exact::positions_f64;
+use crate::collision::point_clearance::exact_clearance;
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
 use crate::collision::CollisionContext;
 

@@ -3,7 +3,7 @@
 //! ([`exact_clearance`]).
 
 use super::HeadLattice;
-use crate::collision::exact::exact_clearance;
+use crate::collision::point_clearance::exact_clearance;
 use crate::collision::FK_TOLERANCE;
 use crate::map::distance::DistanceField;
 

@@ -6,7 +6,8 @@
 use nalgebra::{Point3, Vector3};
 
 use super::CAP;
-use crate::collision::exact::{exact_clearance, positions_f64};
+use crate::collision::exact::positions_f64;
+use crate::collision::point_clearance::exact_clearance;
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
 use crate::collision::CollisionContext;
 use crate::planner::numeric::{TIE, TINY};
