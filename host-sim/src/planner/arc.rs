@@ -398,9 +398,10 @@ impl ArcPlanner {
 
     /// The online construction along the lattice's head route in `built` alone (no
     /// sampled vertices): `Ok(None)` when there is no route or the chain cannot
-    /// follow it. A plan that gives way below the preferred clearance where the head's
-    /// route itself keeps it is refused too: the uniform roadmap may hold a route on
-    /// which the whole chain keeps it.
+    /// follow it. Where the head's route itself keeps the preferred clearance, the
+    /// chain may not give way below it (the uniform roadmap may hold a route on which
+    /// the whole chain keeps it): the construction ends at the first edge that asks,
+    /// rather than flying the rest of the route for a plan that would be refused.
     fn solve_on_route(
         &self,
         query: &Query,
@@ -413,14 +414,13 @@ impl ArcPlanner {
         };
         let mut roadmap = self.sampled_roadmap(0, stop.deadline(began));
         let inner = &route.points[1..route.points.len() - 1];
-        let construction = Construction::new(self, &mut roadmap, query, Some(inner), stop, began);
-        match construction.without_replans().run() {
-            Ok((_, stats))
-                if stats.min_margin < self.ctx.clearance_margin() - super::numeric::TIE
-                    && route.narrowest_margin >= self.ctx.clearance_margin() =>
-            {
-                Ok(None)
-            }
+        let mut construction =
+            Construction::new(self, &mut roadmap, query, Some(inner), stop, began)
+                .without_replans();
+        if route.narrowest_margin >= self.ctx.clearance_margin() {
+            construction = construction.without_giving_way();
+        }
+        match construction.run() {
             Ok(solved) => Ok(Some(solved)),
             Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. }) => Ok(None),
             Err(e) => Err(e),

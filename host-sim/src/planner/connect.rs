@@ -24,7 +24,8 @@ impl Construction<'_> {
         }
         let p = self.planner;
         let (c_min, c_pref) = (p.ctx_min.clearance_margin(), p.ctx.clearance_margin());
-        if !(c_min < c_pref && self.roadmap.is_query(v) && self.roadmap.is_query(u)) {
+        let on_route = self.roadmap.is_query(v) && self.roadmap.is_query(u);
+        if !(c_min < c_pref && self.may_give_way && on_route) {
             return None;
         }
         // Give way step by step: first to `give_way_share` of the head's own margin along the

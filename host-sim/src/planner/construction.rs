@@ -50,6 +50,9 @@ pub(super) struct Construction<'p> {
     pub(super) relaxed: Vec<(usize, f64, [f64; 3])>,
     /// Replans allowed without progress (`Settings::max_replans` unless set).
     max_replans: usize,
+    /// Whether an edge of the head route may be flown below the preferred clearance
+    /// where it fails at it ([`Self::connect`]).
+    pub(super) may_give_way: bool,
 }
 
 impl<'p> Construction<'p> {
@@ -97,6 +100,7 @@ impl<'p> Construction<'p> {
             goal_tol: tol,
             relaxed: Vec::new(),
             max_replans: planner.settings.max_replans,
+            may_give_way: true,
         }
     }
 
@@ -105,6 +109,13 @@ impl<'p> Construction<'p> {
     /// retries the same shapes.
     pub(super) fn without_replans(mut self) -> Self {
         self.max_replans = 0;
+        self
+    }
+
+    /// This construction, failing at the first edge that does not pass at the
+    /// preferred clearance instead of giving way on it.
+    pub(super) fn without_giving_way(mut self) -> Self {
+        self.may_give_way = false;
         self
     }
 

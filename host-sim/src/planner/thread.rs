@@ -413,25 +413,27 @@ impl Router<'_> {
         let pitch0 = guess.z.clamp(-1.0, 1.0).asin();
         let s = self.s;
         let (n, deg) = (s.grid_steps, DEGREE);
+        // Every ray starts at `c`: its first step is the same for all.
+        let at_c = self.ctx.clearance(c);
+        let in_cone = (s.cone_deg * deg).cos();
+        let yaws: Vec<(f64, f64)> = (-n..=n)
+            .map(|i| (yaw0 + s.grid_step_deg * deg * i as f64).sin_cos())
+            .collect();
         let mut sum = Vector3::zeros();
         for j in -n..=n {
             let pitch = pitch0 + s.grid_step_deg * deg * j as f64;
             if pitch.abs() > s.max_pitch_deg * deg {
                 continue;
             }
-            for i in -n..=n {
-                let yaw = yaw0 + s.grid_step_deg * deg * i as f64;
-                let u = Vector3::new(
-                    yaw.cos() * pitch.cos(),
-                    yaw.sin() * pitch.cos(),
-                    pitch.sin(),
-                );
-                if u.dot(&guess) > (s.cone_deg * deg).cos()
-                    && self.runs_free(c, u)
-                    && self.runs_free(c, -u)
+            let (sin_p, cos_p) = (pitch.sin(), pitch.cos());
+            for &(sin_y, cos_y) in &yaws {
+                let u = Vector3::new(cos_y * cos_p, sin_y * cos_p, sin_p);
+                if u.dot(&guess) > in_cone
+                    && self.runs_free(c, u, at_c)
+                    && self.runs_free(c, -u, at_c)
                 {
                     // Weighted by the grid's cell size on the sphere.
-                    sum += u * pitch.cos();
+                    sum += u * cos_p;
                 }
             }
         }
@@ -489,12 +491,17 @@ impl Router<'_> {
     }
 
     /// A ray from `c` along `u` runs `escape` without coming within half a voxel of
-    /// the map (the distance field's bound, sphere tracing).
-    fn runs_free(&self, c: Point3<f64>, u: Vector3<f64>) -> bool {
+    /// the map (the distance field's bound, sphere tracing); `at_c` is the bound at
+    /// `c`.
+    fn runs_free(&self, c: Point3<f64>, u: Vector3<f64>, at_c: f64) -> bool {
         let stop = self.res() / 2.0;
         let mut t = 0.0;
         while t < self.s.escape {
-            let d = self.ctx.clearance(c + u * t);
+            let d = if t == 0.0 {
+                at_c
+            } else {
+                self.ctx.clearance(c + u * t)
+            };
             if d < stop {
                 return false;
             }
