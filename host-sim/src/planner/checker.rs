@@ -30,6 +30,11 @@ impl Checker {
         }
     }
 
+    /// Whether the deadline has passed (every check fails from then on).
+    pub(super) fn expired(&self) -> bool {
+        expired(self.deadline)
+    }
+
     fn timed(&mut self, f: impl FnOnce(&CollisionContext) -> bool) -> bool {
         if expired(self.deadline) {
             return false;

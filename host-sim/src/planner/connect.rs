@@ -220,6 +220,7 @@ impl Construction<'_> {
         // G_Val holds the random shapes only, as in the paper: the library was tried in (c).
         srs_connect::connect(
             &mut self.checker,
+            &mut self.srs_memo,
             a,
             b,
             &cur,

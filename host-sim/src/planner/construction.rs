@@ -50,6 +50,8 @@ pub(super) struct Construction<'p> {
     pub(super) relaxed: Vec<(usize, f64, [f64; 3])>,
     /// Replans allowed without progress (`Settings::max_replans` unless set).
     max_replans: usize,
+    /// What SRSConnect learnt at the last head position it was asked from.
+    pub(super) srs_memo: super::srs_connect::Memo,
     /// Whether an edge of the head route may be flown below the preferred clearance
     /// where it fails at it ([`Self::connect`]).
     pub(super) may_give_way: bool,
@@ -101,6 +103,7 @@ impl<'p> Construction<'p> {
             relaxed: Vec::new(),
             max_replans: planner.settings.max_replans,
             may_give_way: true,
+            srs_memo: Default::default(),
         }
     }
 
