@@ -233,13 +233,16 @@ impl Construction<'_> {
     }
 
     /// The first candidate that fits at `a`, flies `a -> b`, and is reachable from the
-    /// current shape by one shape change at `a`.
+    /// current shape by one shape change at `a`. The change is checked before the
+    /// flight: where the chain is boxed in (unknown space all round at the start of an
+    /// online piece) the changes fail for most candidates, and edge after edge would
+    /// sweep every one of them along the edge first (same answer either way).
     fn first_direct(&mut self, a: [f64; 3], b: [f64; 3], cands: &[Candidate]) -> Option<Candidate> {
         let cur = self.current.shape;
         cands.iter().copied().find(|c| {
             self.checker.placement(a, &c.shape)
-                && self.checker.translation(a, b, &c.shape)
                 && self.checker.shape_change(a, &cur, &c.shape)
+                && self.checker.translation(a, b, &c.shape)
         })
     }
 }
