@@ -65,6 +65,32 @@ impl Memo {
     }
 }
 
+/// A shape change whose answer [`Memo`] keeps: from the current shape to a random
+/// shape, or between two random shapes (SRS indices).
+#[derive(Clone, Copy)]
+enum Change {
+    FromCurrent(usize),
+    Between(u16, u16),
+}
+
+impl Memo {
+    fn change(&self, key: Change) -> Option<bool> {
+        match key {
+            Change::FromCurrent(to) => self.from_current[to],
+            Change::Between(from, to) => self.changes.get(&(from, to)).copied(),
+        }
+    }
+
+    fn remember(&mut self, key: Change, ok: bool) {
+        match key {
+            Change::FromCurrent(to) => self.from_current[to] = Some(ok),
+            Change::Between(from, to) => {
+                self.changes.insert((from, to), ok);
+            }
+        }
+    }
+}
+
 /// The SRS index of a node whose answers [`Memo`] keeps (an unturned random shape).
 fn kept(nodes: &[Candidate], v: usize) -> Option<usize> {
     match nodes[v].source {
@@ -103,31 +129,21 @@ impl Oracle<'_> {
 
     /// The shape change from node `via` to node `v` at `xi_i` passes.
     fn change(&mut self, via: usize, v: usize, nodes: &[Candidate]) -> bool {
-        let Some(to) = kept(nodes, v) else {
-            return self.check_change(via, v, nodes);
-        };
-        let known = match (via, kept(nodes, via)) {
-            (0, _) => self.memo.from_current[to],
-            (_, Some(from)) => self.memo.changes.get(&(from as u16, to as u16)).copied(),
-            _ => return self.check_change(via, v, nodes),
-        };
+        let key = kept(nodes, v).and_then(|to| match via {
+            0 => Some(Change::FromCurrent(to)),
+            _ => kept(nodes, via).map(|from| Change::Between(from as u16, to as u16)),
+        });
+        let known = key.and_then(|k| self.memo.change(k));
         if let Some(ok) = known.filter(|_| !self.checker.expired()) {
             return ok;
         }
-        let ok = self.check_change(via, v, nodes);
-        match (via, kept(nodes, via)) {
-            (0, _) => self.memo.from_current[to] = Some(ok),
-            (_, Some(from)) => {
-                self.memo.changes.insert((from as u16, to as u16), ok);
-            }
-            _ => {}
+        let ok = self
+            .checker
+            .shape_change(self.from, &nodes[via].shape, &nodes[v].shape);
+        if let Some(k) = key {
+            self.memo.remember(k, ok);
         }
         ok
-    }
-
-    fn check_change(&mut self, via: usize, v: usize, nodes: &[Candidate]) -> bool {
-        self.checker
-            .shape_change(self.from, &nodes[via].shape, &nodes[v].shape)
     }
 
     fn admissible(&mut self, v: usize, nodes: &[Candidate]) -> bool {
