@@ -14,6 +14,7 @@ use kiddo::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 use rand::Rng;
 use rand_pcg::Pcg64;
+use rayon::prelude::*;
 
 use super::dist;
 use super::graph::{Edge, EdgeState, LazyGraph};
@@ -94,20 +95,32 @@ impl Roadmap {
         let tree = ImmutableKdTree::new_from_slice(&points);
         // The k nearest within r_T (k + 1: the query finds the vertex itself), then
         // made symmetric, in vertex order for determinism.
-        let mut adjacent: Vec<Vec<usize>> = vec![Vec::new(); points.len()];
         let k1 = std::num::NonZero::new(k.saturating_add(1)).expect("k + 1 > 0");
-        for (i, p) in points.iter().enumerate() {
-            if late(i) {
-                break; // later vertices keep only the edges found so far
-            }
-            // The k nearest, then the radius: a bounded heap of k, cheaper than
-            // collecting every point within r_T first.
-            for n in tree.nearest_n::<SquaredEuclidean>(p, k1) {
-                let j = n.item as usize;
-                if j != i && n.distance <= r_t * r_t {
-                    adjacent[i].push(j);
-                    adjacent[j].push(i);
+        // Each vertex's neighbours on its own, on as many threads as there are (most of
+        // the roadmap's time); past the deadline a vertex keeps only the edges the
+        // others give it.
+        let nearest: Vec<Vec<usize>> = points
+            .par_iter()
+            .enumerate()
+            .map(|(i, p)| {
+                if deadline.is_some_and(|d| Instant::now() > d) {
+                    return Vec::new();
                 }
+                // The k nearest, then the radius: a bounded heap of k, cheaper than
+                // collecting every point within r_T first.
+                tree.nearest_n::<SquaredEuclidean>(p, k1)
+                    .into_iter()
+                    .map(|n| (n.item as usize, n.distance))
+                    .filter(|&(j, d)| j != i && d <= r_t * r_t)
+                    .map(|(j, _)| j)
+                    .collect()
+            })
+            .collect();
+        let mut adjacent: Vec<Vec<usize>> = vec![Vec::new(); points.len()];
+        for (i, near) in nearest.iter().enumerate() {
+            for &j in near {
+                adjacent[i].push(j);
+                adjacent[j].push(i);
             }
         }
         let edges: Vec<Vec<Edge>> = adjacent

@@ -23,6 +23,7 @@ use std::time::{Duration, Instant};
 use aerial_chain_core::kinematics::{link_direction, offsets};
 use aerial_chain_core::Shape;
 use nalgebra::{Point3, Vector3};
+use rayon::prelude::*;
 
 use super::candidates::Source;
 use super::numeric::{TIE, TINY, TINY_F32};
@@ -321,7 +322,7 @@ impl Router<'_> {
     /// stretch (neither the start's nor the goal's) and its axis where it has one.
     fn pinches(&self, dense: &[Point3<f64>], narrow: &[bool]) -> Vec<(usize, usize, Pinch)> {
         let n = dense.len();
-        let mut out = Vec::new();
+        let mut stretches = Vec::new();
         let mut i = 0;
         while i < n {
             if !narrow[i] {
@@ -335,11 +336,18 @@ impl Router<'_> {
             if first == 0 || i >= n {
                 continue; // the start or the goal in the pinch: leave it.
             }
-            if let Some(pinch) = self.axis(&dense[first..i]) {
-                out.push((first, i - 1, pinch));
-            }
+            stretches.push(first..i);
         }
-        out
+        // Each stretch's axis is found on its own (a millisecond or more each, on a
+        // forest's route a dozen of them): on as many threads as there are, in order.
+        stretches
+            .into_par_iter()
+            .filter_map(|r| {
+                let last = r.end - 1;
+                self.axis(&dense[r.clone()])
+                    .map(|pinch| (r.start, last, pinch))
+            })
+            .collect()
     }
 
     /// Of the route samples `ks` (within `join_reach`, on the far side of `end` from
