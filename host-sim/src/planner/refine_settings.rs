@@ -11,6 +11,73 @@ use serde::{Deserialize, Serialize};
 
 use super::settings::{check, positive, SettingError, MAX_BUDGET, MAX_REACH, MAX_ROUNDS};
 
+/// The defaults, one per field (each documented on its field).
+mod defaults {
+    pub const CHECK_BUDGET: u64 = 20_000;
+    pub const KEEP_SLACK: f64 = 0.005;
+    pub const KEEP_GAIN: f64 = 0.025;
+    pub const KEEP_MOTION: f64 = 1.02;
+    pub const PARTIAL_SHARES: [f32; 3] = [0.25, 0.5, 0.75];
+    pub const SHORTEN_SAVING: f64 = 1e-4;
+    pub const SHORTEN_PASSES: usize = 4;
+
+    pub const WIDEN_BUDGET: usize = 150;
+    pub const WIDEN_STEPS: [f64; 3] = [0.4, 0.15, 0.05];
+    pub const WIDEN_DIRECTIONS: usize = 3;
+    pub const WIDEN_MAX_SPLITS: usize = 2;
+    pub const WIDEN_CENTRED: f64 = 0.93;
+    pub const WIDEN_SAME_PINCH: f64 = 0.15;
+    pub const WIDEN_PLATEAU: f64 = 0.003;
+    pub const WIDEN_GAIN: f64 = 1e-4;
+    pub const WIDEN_SEPARATE: f64 = 0.8;
+    pub const WIDEN_OTHER_CANDIDATES: usize = 3;
+    pub const WIDEN_TARGET_SHARE: f64 = 0.9;
+    pub const WIDEN_SPLIT_MARGIN: f64 = 0.25;
+    pub const WIDEN_PROBE_SHIFTS: [f64; 7] = [0.0, 0.05, -0.05, 0.1, -0.1, 0.2, -0.2];
+
+    pub const THREAD_OPENING: f64 = 0.9;
+    pub const THREAD_GAIN: f64 = 0.01;
+    pub const THREAD_SHARE: f64 = 0.8;
+    pub const THREAD_MOTION: f64 = std::f64::consts::FRAC_PI_4;
+    pub const THREAD_IN_PINCH: f64 = 0.5;
+    pub const THREAD_OFF_TRACK: f64 = 0.1;
+    pub const THREAD_MIN_STEP: f64 = 0.04;
+    pub const THREAD_ESCAPE: f64 = 1.0;
+    pub const THREAD_ALIGNED: f32 = 0.52;
+    pub const THREAD_ALIGN_SHARES: [f32; 3] = [1.0, 0.75, 0.5];
+    pub const THREAD_TUNNEL: f64 = 0.4;
+    pub const THREAD_TUNNEL_ENDS: f64 = 0.8;
+    pub const THREAD_TUNNEL_ALIGNED: f64 = 0.9;
+    pub const THREAD_MAX_STEPS: usize = 40_000;
+    pub const THREAD_BAND_ROUNDS: usize = 40;
+    pub const THREAD_JOIN_REACH: usize = 200;
+    pub const THREAD_ALONGSIDE: f64 = 1.0;
+    pub const THREAD_MEASURE_SLACK: f64 = 0.01;
+    pub const THREAD_AXIS_REACH: f64 = 4.0;
+    pub const THREAD_AXIS_ROUNDS: usize = 3;
+    pub const THREAD_NARROWEST_REACH: i32 = 20;
+    pub const THREAD_GRID_STEP_DEG: f64 = 5.0;
+    pub const THREAD_GRID_STEPS: i32 = 16;
+    pub const THREAD_MAX_PITCH_DEG: f64 = 85.0;
+    pub const THREAD_CONE_DEG: f64 = 80.0;
+    pub const THREAD_CENTRE_STEPS: [f64; 5] = [0.4, 0.2, 0.1, 0.05, 0.025];
+    pub const THREAD_CENTRE_ROUNDS: usize = 12;
+
+    pub const CARRY_MIN_CHANGES: usize = 3;
+    pub const CARRY_HEADINGS: usize = 8;
+    pub const CARRY_SEARCH_POINTS: usize = 25_000;
+    pub const CARRY_TOTAL_POINTS: usize = 80_000;
+    pub const CARRY_TUBE: f64 = 1.0;
+    pub const CARRY_SPACINGS: [f64; 2] = [2.0, 1.0];
+    pub const CARRY_GREED: f64 = 2.0;
+    pub const CARRY_FIT_SPACING: f64 = 0.3;
+    pub const CARRY_SAVING: f64 = 1e-3;
+    pub const CARRY_DETOUR_M: f64 = 1.0;
+    pub const CARRY_DETOUR_SHARE: f64 = 1.25;
+}
+
+use defaults as d;
+
 /// Most directions widening may try per step: the lattice's axis and face-diagonal
 /// directions (6 + 12). A bound of the setting, not tuning.
 const LATTICE_DIRECTIONS: f64 = 18.0;
@@ -61,11 +128,11 @@ pub struct RefineSettings {
 impl Default for RefineSettings {
     fn default() -> Self {
         Self {
-            check_budget: 20_000,
-            keep_slack: 0.005,
-            keep_gain: 0.025,
-            keep_motion: 1.02,
-            partial_shares: [0.25, 0.5, 0.75],
+            check_budget: d::CHECK_BUDGET,
+            keep_slack: d::KEEP_SLACK,
+            keep_gain: d::KEEP_GAIN,
+            keep_motion: d::KEEP_MOTION,
+            partial_shares: d::PARTIAL_SHARES,
             shorten: ShortenSettings::default(),
             widen: WidenSettings::default(),
             thread: ThreadSettings::default(),
@@ -89,8 +156,8 @@ pub struct ShortenSettings {
 impl Default for ShortenSettings {
     fn default() -> Self {
         Self {
-            saving: 1e-4,
-            max_passes: 4,
+            saving: d::SHORTEN_SAVING,
+            max_passes: d::SHORTEN_PASSES,
         }
     }
 }
@@ -160,19 +227,19 @@ pub struct WidenSettings {
 impl Default for WidenSettings {
     fn default() -> Self {
         Self {
-            budget: 150,
-            steps: [0.4, 0.15, 0.05],
-            directions: 3,
-            max_splits: 2,
-            centred: 0.93,
-            same_pinch: 0.15,
-            plateau: 0.003,
-            gain: 1e-4,
-            separate: 0.8,
-            other_candidates: 3,
-            target_share: 0.9,
-            split_margin: 0.25,
-            probe_shifts: [0.0, 0.05, -0.05, 0.1, -0.1, 0.2, -0.2],
+            budget: d::WIDEN_BUDGET,
+            steps: d::WIDEN_STEPS,
+            directions: d::WIDEN_DIRECTIONS,
+            max_splits: d::WIDEN_MAX_SPLITS,
+            centred: d::WIDEN_CENTRED,
+            same_pinch: d::WIDEN_SAME_PINCH,
+            plateau: d::WIDEN_PLATEAU,
+            gain: d::WIDEN_GAIN,
+            separate: d::WIDEN_SEPARATE,
+            other_candidates: d::WIDEN_OTHER_CANDIDATES,
+            target_share: d::WIDEN_TARGET_SHARE,
+            split_margin: d::WIDEN_SPLIT_MARGIN,
+            probe_shifts: d::WIDEN_PROBE_SHIFTS,
         }
     }
 }
@@ -286,33 +353,33 @@ pub struct ThreadSettings {
 impl Default for ThreadSettings {
     fn default() -> Self {
         Self {
-            opening: 0.9,
-            gain: 0.01,
-            share: 0.8,
-            motion: std::f64::consts::FRAC_PI_4,
-            in_pinch: 0.5,
-            off_track: 0.1,
-            min_step: 0.04,
-            escape: 1.0,
-            aligned: 0.52,
-            align_shares: [1.0, 0.75, 0.5],
-            tunnel: 0.4,
-            tunnel_ends: 0.8,
-            tunnel_aligned: 0.9,
-            max_steps: 40_000,
-            join_reach: 200,
-            alongside: 1.0,
-            measure_slack: 0.01,
-            axis_reach: 4.0,
-            axis_rounds: 3,
-            narrowest_reach: 20,
-            grid_step_deg: 5.0,
-            grid_steps: 16,
-            max_pitch_deg: 85.0,
-            cone_deg: 80.0,
-            centre_steps: [0.4, 0.2, 0.1, 0.05, 0.025],
-            centre_rounds: 12,
-            band_rounds: 40,
+            opening: d::THREAD_OPENING,
+            gain: d::THREAD_GAIN,
+            share: d::THREAD_SHARE,
+            motion: d::THREAD_MOTION,
+            in_pinch: d::THREAD_IN_PINCH,
+            off_track: d::THREAD_OFF_TRACK,
+            min_step: d::THREAD_MIN_STEP,
+            escape: d::THREAD_ESCAPE,
+            aligned: d::THREAD_ALIGNED,
+            align_shares: d::THREAD_ALIGN_SHARES,
+            tunnel: d::THREAD_TUNNEL,
+            tunnel_ends: d::THREAD_TUNNEL_ENDS,
+            tunnel_aligned: d::THREAD_TUNNEL_ALIGNED,
+            max_steps: d::THREAD_MAX_STEPS,
+            join_reach: d::THREAD_JOIN_REACH,
+            alongside: d::THREAD_ALONGSIDE,
+            measure_slack: d::THREAD_MEASURE_SLACK,
+            axis_reach: d::THREAD_AXIS_REACH,
+            axis_rounds: d::THREAD_AXIS_ROUNDS,
+            narrowest_reach: d::THREAD_NARROWEST_REACH,
+            grid_step_deg: d::THREAD_GRID_STEP_DEG,
+            grid_steps: d::THREAD_GRID_STEPS,
+            max_pitch_deg: d::THREAD_MAX_PITCH_DEG,
+            cone_deg: d::THREAD_CONE_DEG,
+            centre_steps: d::THREAD_CENTRE_STEPS,
+            centre_rounds: d::THREAD_CENTRE_ROUNDS,
+            band_rounds: d::THREAD_BAND_ROUNDS,
         }
     }
 }
@@ -358,17 +425,17 @@ pub struct CarrySettings {
 impl Default for CarrySettings {
     fn default() -> Self {
         Self {
-            min_changes: 3,
-            headings: 8,
-            search_points: 25_000,
-            total_points: 80_000,
-            tube: 1.0,
-            spacings: [2.0, 1.0],
-            greed: 2.0,
-            fit_spacing: 0.3,
-            saving: 1e-3,
-            detour_m: 1.0,
-            detour_share: 1.25,
+            min_changes: d::CARRY_MIN_CHANGES,
+            headings: d::CARRY_HEADINGS,
+            search_points: d::CARRY_SEARCH_POINTS,
+            total_points: d::CARRY_TOTAL_POINTS,
+            tube: d::CARRY_TUBE,
+            spacings: d::CARRY_SPACINGS,
+            greed: d::CARRY_GREED,
+            fit_spacing: d::CARRY_FIT_SPACING,
+            saving: d::CARRY_SAVING,
+            detour_m: d::CARRY_DETOUR_M,
+            detour_share: d::CARRY_DETOUR_SHARE,
         }
     }
 }

@@ -5,6 +5,25 @@
 
 use serde::{Deserialize, Serialize};
 
+/// The defaults of the numbers below, one per field (each documented on its field).
+mod defaults {
+    pub const R_T: f64 = 1.5;
+    pub const FOLLOW_STEP: f64 = 0.1;
+    pub const CLEARANCE_WEIGHT: f64 = 2.0;
+    pub const GIVE_WAY_SHARE: f64 = 0.9;
+    pub const BACKTRACK_AFTER: usize = 4;
+    pub const NARROW_SURCHARGE: f64 = 4.0;
+    pub const CLEARANCE_REF: f64 = 0.5;
+    pub const HEURISTIC_WEIGHT: f64 = 2.5;
+    pub const MAX_JUMP: f64 = 16.0;
+    pub const QUICK_BUDGET: usize = 10_000;
+    pub const BUDGET: usize = 60_000_000;
+    pub const KEEP_CAP: f64 = 0.3;
+    pub const CENTRE_REACH: f64 = 4.0;
+    pub const ACROSS: f64 = 0.35;
+    pub const MIN_BLOCK: f64 = 0.4;
+}
+
 /// Which shape sources the planner may use (the paper's ablation).
 #[derive(
     Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
@@ -113,7 +132,7 @@ impl Default for Settings {
     fn default() -> Self {
         Self {
             vertices: 1500,
-            r_t: 1.5,
+            r_t: defaults::R_T,
             max_neighbours: 30,
             n_psi: 8,
             d_c: None,
@@ -122,12 +141,12 @@ impl Default for Settings {
             seed: 1,
             max_replans: 200,
             max_growth: 3,
-            clearance_weight: 2.0,
-            follow_step: 0.1,
+            clearance_weight: defaults::CLEARANCE_WEIGHT,
+            follow_step: defaults::FOLLOW_STEP,
             clearance_min: 0.0,
             head_lattice: true,
-            give_way_share: 0.9,
-            backtrack_after: 4,
+            give_way_share: defaults::GIVE_WAY_SHARE,
+            backtrack_after: defaults::BACKTRACK_AFTER,
             lattice: LatticeSettings::default(),
         }
     }
@@ -175,16 +194,16 @@ pub struct LatticeSettings {
 impl Default for LatticeSettings {
     fn default() -> Self {
         Self {
-            narrow_surcharge: 4.0,
-            clearance_ref: 0.5,
-            heuristic_weight: 2.5,
-            max_jump: 16.0,
-            quick_budget: 10_000,
-            budget: 60_000_000,
-            keep_cap: 0.3,
-            centre_reach: 4.0,
-            across: 0.35,
-            min_block: 0.4,
+            narrow_surcharge: defaults::NARROW_SURCHARGE,
+            clearance_ref: defaults::CLEARANCE_REF,
+            heuristic_weight: defaults::HEURISTIC_WEIGHT,
+            max_jump: defaults::MAX_JUMP,
+            quick_budget: defaults::QUICK_BUDGET,
+            budget: defaults::BUDGET,
+            keep_cap: defaults::KEEP_CAP,
+            centre_reach: defaults::CENTRE_REACH,
+            across: defaults::ACROSS,
+            min_block: defaults::MIN_BLOCK,
         }
     }
 }

@@ -54,6 +54,17 @@ pub const MAX_DT: f64 = 0.1;
 /// number of samples up to rounding counts as whole. Not tuning.
 pub(crate) const TICK_GUARD: f64 = 1e-9;
 
+/// The defaults of the blending tuning, one per field of [`Settings`].
+mod defaults {
+    pub const RUN_TOLERANCE: f64 = 0.02;
+    pub const STEP_RUN_TOLERANCE: f64 = 0.06;
+    pub const SHORT_STEP: f64 = 0.2;
+    pub const MAX_RUN: usize = 64;
+    pub const MIN_PIECE: f64 = 0.1;
+    pub const SHRINKS: u8 = 2;
+    pub const FIT_ROUNDS: usize = 200;
+}
+
 /// The limits a trajectory keeps at every sample (docs/model.md, "Trajectories").
 /// The defaults are `arc sim`'s.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -163,13 +174,13 @@ impl Default for Settings {
             dt: DEFAULT_DT,
             blend: true,
             clearance: crate::collision::DEFAULT_CLEARANCE,
-            run_tolerance: 0.02,
-            step_run_tolerance: 0.06,
-            short_step: 0.2,
-            max_run: 64,
-            min_piece: 0.1,
-            shrinks: 2,
-            fit_rounds: 200,
+            run_tolerance: defaults::RUN_TOLERANCE,
+            step_run_tolerance: defaults::STEP_RUN_TOLERANCE,
+            short_step: defaults::SHORT_STEP,
+            max_run: defaults::MAX_RUN,
+            min_piece: defaults::MIN_PIECE,
+            shrinks: defaults::SHRINKS,
+            fit_rounds: defaults::FIT_ROUNDS,
         }
     }
 }
