@@ -65,9 +65,18 @@ use nalgebra::Point3;
 use crate::map::distance::{cube_distance_bound, DistanceField};
 use crate::map::grid::{Cell, Grid};
 use crate::planner::expired;
+use crate::planner::numeric::{TIE, TINY};
 
 /// Relative allowance for the field's rounding to `f32` (and of `r G` in `f64`).
 const ROUND_REL: f64 = 1e-6;
+
+/// Voxels of a refined cut, and cells of the flood, per unit radius: a voxel a third
+/// of the radius or less loses at most `r sqrt(3) / 2` of it, which leaves the margins
+/// the rule needs.
+const CUTS_PER_RADIUS: f64 = 3.0;
+
+/// Compass sectors of [`spread`] (a power of two: their order is bit-reversed).
+const SECTORS: u8 = 16;
 
 /// What the flood proved: the side whose region ran out, and the stretch of the head
 /// route where no unit holds a link.
@@ -113,7 +122,7 @@ struct Closure {
 
 impl Closure {
     fn new(r: f64, rule: &LinkRule) -> Self {
-        let n_star = ((rule.radius - 1e-9) / r).powi(2).floor().max(-1.0);
+        let n_star = ((rule.radius - TIE) / r).powi(2).floor().max(-1.0);
         let below = if n_star < 0.0 {
             0.0
         } else {
@@ -229,7 +238,7 @@ fn finer(i: [i32; 3], scale: i32) -> impl Iterator<Item = [i32; 3]> {
 /// The voxel offsets a unit's neighbour may lie in, level links first.
 fn stencil(r: f64, rule: &LinkRule) -> Vec<[i32; 3]> {
     // A hair wider than the rule: the chain's own measures are `f32`.
-    let (l, h) = (rule.link, rule.link * rule.theta_max.sin() + 1e-6);
+    let (l, h) = (rule.link, rule.link * rule.theta_max.sin() + TINY);
     let m = (l / r).ceil() as i32 + 2;
     let mut out = Vec::new();
     for z in -m..=m {
@@ -253,7 +262,7 @@ fn stencil(r: f64, rule: &LinkRule) -> Vec<[i32; 3]> {
                     .map(|a| lo[a].abs().max(hi[a].abs()).powi(2))
                     .sum::<f64>()
                     .sqrt();
-                if near <= l + 1e-6 && far >= l - 1e-6 {
+                if near <= l + TINY && far >= l - TINY {
                     out.push(k);
                 }
             }
@@ -267,8 +276,9 @@ fn stencil(r: f64, rule: &LinkRule) -> Vec<[i32; 3]> {
 /// A key that interleaves compass directions: sixteen sectors in bit-reversed order.
 fn spread(k: &[i32; 3]) -> u8 {
     let a = (k[1] as f64).atan2(k[0] as f64);
-    let sector = (((a + std::f64::consts::PI) / std::f64::consts::TAU * 16.0) as u8).min(15);
-    sector.reverse_bits() >> 4
+    let turn = (a + std::f64::consts::PI) / std::f64::consts::TAU;
+    let sector = ((turn * SECTORS as f64) as u8).min(SECTORS - 1);
+    sector.reverse_bits() >> (8 - SECTORS.trailing_zeros())
 }
 
 /// Most voxels a link may span for the rule to be asked: its stencil holds about
@@ -312,8 +322,8 @@ impl LinkCheck {
             rule,
             asked,
             closure,
-            scale: (3.0 * r / rule.radius - 1e-9).ceil().max(1.0) as i32,
-            cell: ((rule.radius / (3.0 * r)).floor() as usize).max(1),
+            scale: (CUTS_PER_RADIUS * r / rule.radius - TIE).ceil().max(1.0) as i32,
+            cell: ((rule.radius / (CUTS_PER_RADIUS * r)).floor() as usize).max(1),
         }
     }
 }
