@@ -198,9 +198,9 @@ impl DistanceField {
         }
     }
 
-    /// Coordinate `x` along axis `a` in voxels from the grid's lower face (`x (1 / r) - origin`),
-    /// or `None` where the clearance is 0: `x` is NaN, or outside the grid while unknown
-    /// space is occupied.
+    /// Coordinate `x` along axis `a` in voxels from the grid's lower face
+    /// (`x (1 / r) - origin`), or `None` where the clearance is 0: `x` is NaN, or outside
+    /// the grid while unknown space is occupied.
     #[inline]
     fn grid_coordinate(&self, x: f64, a: usize) -> Option<f64> {
         let q = x * self.inv_r;

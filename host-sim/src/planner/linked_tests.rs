@@ -190,9 +190,9 @@ proptest::proptest! {
         let field = DistanceField::new(g.clone());
         let check = LinkCheck::new(field.grid().resolution(), rule);
         proptest::prop_assert_eq!(check.scale, 3);
-        let (o, dims) = (g.origin(), g.dims());
-        let v = [0, 1, 2].map(|a| o[a] + (pick[a] % dims[a]) as i32);
-        let at = g.voxel_center([0, 1, 2].map(|a| o[a] + (refine[a] % dims[a]) as i32));
+        let dims = g.dims();
+        let v = g.index_of_local([0, 1, 2].map(|a| pick[a] % dims[a]));
+        let at = g.voxel_center(g.index_of_local([0, 1, 2].map(|a| refine[a] % dims[a])));
         let flood = LinkFlood::new(&field, &check, Some([at.x, at.y, at.z]));
         if flood.blocked(v) {
             let (c, r) = (g.voxel_center(v), g.resolution());

@@ -110,9 +110,8 @@ impl Roadmap {
                 // collecting every point within r_T first.
                 tree.nearest_n::<SquaredEuclidean>(p, k1)
                     .into_iter()
-                    .map(|n| (n.item as usize, n.distance))
-                    .filter(|&(j, d)| j != i && d <= r_t * r_t)
-                    .map(|(j, _)| j)
+                    .filter(|n| n.item as usize != i && n.distance <= r_t * r_t)
+                    .map(|n| n.item as usize)
                     .collect()
             })
             .collect();

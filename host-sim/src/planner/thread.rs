@@ -503,19 +503,17 @@ impl Router<'_> {
     /// `c`.
     fn runs_free(&self, c: Point3<f64>, u: Vector3<f64>, at_c: f64) -> bool {
         let stop = self.res() / 2.0;
-        let mut t = 0.0;
-        while t < self.s.escape {
-            let d = if t == 0.0 {
-                at_c
-            } else {
-                self.ctx.clearance(c + u * t)
-            };
+        let (mut t, mut d) = (0.0, at_c);
+        loop {
             if d < stop {
                 return false;
             }
             t += d;
+            if t >= self.s.escape {
+                return true;
+            }
+            d = self.ctx.clearance(c + u * t);
         }
-        true
     }
 
     /// `c` moved across `u` (in the plane normal to it) to where the distance to the
