@@ -25,15 +25,24 @@ impl Construction<'_> {
         let p = self.planner;
         let (c_min, c_pref) = (p.ctx_min.clearance_margin(), p.ctx.clearance_margin());
         let on_route = self.roadmap.is_query(v) && self.roadmap.is_query(u);
-        if !(c_min < c_pref && self.may_give_way && on_route) {
+        // A start within the clearance cannot be left at it: an edge from there keeps
+        // what the start keeps.
+        let from_start = self.start_margin.filter(|_| v == self.start);
+        if !(c_min < c_pref && (self.may_give_way && on_route || from_start.is_some())) {
             return None;
         }
         // Give way step by step: first to `give_way_share` of the head's own margin along the
-        // edge (what the passage leaves on its narrowest side), then to the floor.
+        // edge (what the passage leaves on its narrowest side), or to what the start keeps,
+        // then to the floor.
         let (a, b) = (self.roadmap.point(v), self.roadmap.point(u));
-        let head = head_margin(&p.ctx, a, b);
-        let share = p.settings.give_way_share;
-        let mid = ((share * head * PER_MILLIMETRE).floor() / PER_MILLIMETRE).clamp(c_min, c_pref);
+        let mid = match from_start {
+            Some(m) => m,
+            None => {
+                let head = head_margin(&p.ctx, a, b);
+                (p.settings.give_way_share * head * PER_MILLIMETRE).floor() / PER_MILLIMETRE
+            }
+        }
+        .clamp(c_min, c_pref);
         let mut levels = vec![(mid, None)];
         if mid > c_min {
             levels.push((c_min, Some(p.ctx_min.clone())));

@@ -14,10 +14,15 @@
 use std::collections::BTreeSet;
 use std::time::Instant;
 
+use aerial_chain_core::Shape;
+
 use super::arc::{ArcPlanner, Stats};
 use super::candidates::{Candidate, Source};
+use super::numeric::PER_MILLIMETRE;
 use super::roadmap::{Roadmap, RouteError, VertexId};
 use super::{Checker, PlanError, Query, Step, Termination};
+use crate::collision::point_clearance::exact_clearance;
+use crate::collision::{CollisionContext, FK_TOLERANCE};
 
 /// One leg of a head edge: shape changes where the head is, then a translation.
 pub(super) struct Leg {
@@ -32,7 +37,7 @@ pub(super) struct Construction<'p> {
     pub(super) planner: &'p ArcPlanner,
     pub(super) roadmap: &'p mut Roadmap,
     pub(super) checker: Checker,
-    start: VertexId,
+    pub(super) start: VertexId,
     goals: Vec<VertexId>,
     /// Cost-to-go of every vertex: the routes' heuristic.
     to_go: Vec<f64>,
@@ -55,6 +60,9 @@ pub(super) struct Construction<'p> {
     /// Whether an edge of the head route may be flown below the preferred clearance
     /// where it fails at it ([`Self::connect`]).
     pub(super) may_give_way: bool,
+    /// The margin the start's units keep, rounded down to a millimetre, where it is
+    /// below the preferred clearance: an edge leaving the start may keep only that.
+    pub(super) start_margin: Option<f64>,
 }
 
 impl<'p> Construction<'p> {
@@ -104,6 +112,7 @@ impl<'p> Construction<'p> {
             max_replans: planner.settings.max_replans,
             may_give_way: true,
             srs_memo: Default::default(),
+            start_margin: start_margin(&planner.ctx, start, &shape),
         }
     }
 
@@ -277,4 +286,23 @@ pub(super) fn count_sources(steps: &[Step], stats: &mut Stats) {
             Source::Start | Source::Sampled | Source::Goal => {}
         }
     }
+}
+
+/// The margin the units of the chain at `head` with `shape` keep on `ctx`'s map
+/// (exactly, less the checks' [`FK_TOLERANCE`], rounded down to a millimetre), where
+/// it is below `ctx`'s clearance; `None` where the start keeps the clearance.
+fn start_margin(ctx: &CollisionContext, head: [f64; 3], shape: &Shape) -> Option<f64> {
+    let (r_u, c) = (ctx.params().unit_radius as f64, ctx.clearance_margin());
+    let offsets = aerial_chain_core::kinematics::offsets(ctx.params(), shape);
+    let margin = offsets
+        .iter()
+        .take(ctx.params().n())
+        .map(|o| {
+            let p = [0, 1, 2].map(|k| head[k] + o[k] as f64);
+            exact_clearance(ctx.field(), p, 0.0, r_u + c) - r_u
+        })
+        .fold(f64::INFINITY, f64::min);
+    let kept = (margin - FK_TOLERANCE).max(0.0);
+    let floored = (kept * PER_MILLIMETRE).floor() / PER_MILLIMETRE;
+    (floored < c).then_some(floored)
 }

@@ -1,6 +1,6 @@
 //! The facade's tests: the same plan as the steps it stands for, and its errors.
 
-use aerial_chain_core::ChainParams;
+use aerial_chain_core::{ChainParams, Shape};
 use nalgebra::Point3;
 
 use super::*;
@@ -137,5 +137,68 @@ fn tuning_settings_reach_the_search_post_processing_and_the_trajectory() {
     assert!(
         err.is_input() && err.to_string().contains("refine.widen.centred"),
         "{err}"
+    );
+}
+
+/// A room 4 x 4 x 2 m at 0.05 m whose wall at `y = 0` is `gap` from a chain of 4 at
+/// rest whose links point straight at it, the head 1.5 m into the room: the start's
+/// units keep less than the clearance, its head far more.
+fn tail_at_a_wall(gap: f64) -> Request {
+    use crate::map::grid::Cell;
+    let params = ChainParams::new(4);
+    let eta = [
+        0.0f32,
+        0.0,
+        std::f32::consts::FRAC_PI_2,
+        0.0,
+        std::f32::consts::FRAC_PI_2,
+        0.0,
+        std::f32::consts::FRAC_PI_2,
+    ];
+    let shape = Shape::from_slice(4, &eta).unwrap();
+    let offsets = aerial_chain_core::kinematics::offsets(&params, &shape);
+    let reach = offsets
+        .iter()
+        .take(4)
+        .map(|o| -o.y as f64)
+        .fold(0.0, f64::max);
+    let mut grid = Grid::new(0.05, [0, 0, 0], [80, 80, 40], Cell::Free, false).unwrap();
+    for x in 0..80 {
+        for z in 0..40 {
+            grid.set([x, 0, z], Cell::Occupied);
+        }
+    }
+    // The wall's face is at y = 0.05; the tail's centre `r_u + gap` from it.
+    let head_y = 0.05 + params.unit_radius as f64 + gap + reach;
+    let query = Query::new(
+        Point3::new(1.0, head_y, 1.0),
+        shape,
+        Point3::new(2.5, head_y, 1.0),
+    );
+    Request::new(grid, params, query)
+}
+
+#[test]
+fn a_start_within_the_clearance_is_left_keeping_what_it_keeps() {
+    let request = tail_at_a_wall(0.02);
+    let options = PlanOptions {
+        srs: 60,
+        ..PlanOptions::default()
+    };
+    assert!(request
+        .query
+        .check(&CollisionContext::new(request.field.clone(), request.params, 0.0).unwrap())
+        .is_ok());
+    let planned = plan(&request, None, &options).unwrap();
+    // The head route from the start keeps the clearance, so the chain leaves along it:
+    // no uniform roadmap is sampled for another way out.
+    assert_eq!(planned.stats.roadmap_vertices, 0);
+    let report = verify_plan(request.grid(), &planned.plan);
+    assert!(report.ok, "{:?}", report.violation);
+    assert!(report.min_clearance >= 0.019, "{}", report.min_clearance);
+    assert!(
+        planned.stats.min_margin >= 0.019,
+        "{}",
+        planned.stats.min_margin
     );
 }
