@@ -1,7 +1,8 @@
 //! Shape connection for one head edge of the online construction: the legs that
 //! fly the chain from `v` to `u`, tried in order: keep the shape, turn it, a library
-//! shape, follow-the-leader steps, SRSConnect; on the head route, at a smaller
-//! clearance where the preferred one fails.
+//! shape, follow-the-leader steps, SRSConnect; on the head route, and out of a start
+//! that keeps less than the clearance, at a smaller clearance where the preferred one
+//! fails.
 
 use aerial_chain_core::lsc::LscKind;
 use aerial_chain_core::Shape;
@@ -16,8 +17,8 @@ use crate::collision::CollisionContext;
 
 impl Construction<'_> {
     /// The legs that take the chain from `v` to `u`, or None. On the head route (both
-    /// ends query vertices) the planner gives way to the smallest clearance when the
-    /// preferred one fails.
+    /// ends query vertices), and from a start that keeps less than the clearance, the
+    /// planner gives way to the smallest clearance when the preferred one fails.
     pub(super) fn connect(&mut self, v: VertexId, u: VertexId) -> Option<Vec<Leg>> {
         if let Some(legs) = self.connect_at(v, u) {
             return Some(legs);
