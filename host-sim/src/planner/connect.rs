@@ -28,7 +28,7 @@ impl Construction<'_> {
         let on_route = self.roadmap.is_query(v) && self.roadmap.is_query(u);
         // A start within the clearance cannot be left at it: an edge from there keeps
         // what the start keeps.
-        let from_start = self.start_margin.filter(|_| v == self.start);
+        let from_start = self.start_margin_at(v);
         if !(c_min < c_pref && (self.may_give_way && on_route || from_start.is_some())) {
             return None;
         }

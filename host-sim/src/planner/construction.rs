@@ -15,13 +15,14 @@ use std::collections::BTreeSet;
 use std::time::Instant;
 
 use aerial_chain_core::Shape;
+use nalgebra::Point3;
 
 use super::arc::{ArcPlanner, Stats};
 use super::candidates::{Candidate, Source};
 use super::numeric::PER_MILLIMETRE;
 use super::roadmap::{Roadmap, RouteError, VertexId};
+use super::widen::distance_below;
 use super::{Checker, PlanError, Query, Step, Termination};
-use crate::collision::point_clearance::exact_clearance;
 use crate::collision::{CollisionContext, FK_TOLERANCE};
 
 /// One leg of a head edge: shape changes where the head is, then a translation.
@@ -37,7 +38,7 @@ pub(super) struct Construction<'p> {
     pub(super) planner: &'p ArcPlanner,
     pub(super) roadmap: &'p mut Roadmap,
     pub(super) checker: Checker,
-    pub(super) start: VertexId,
+    start: VertexId,
     goals: Vec<VertexId>,
     /// Cost-to-go of every vertex: the routes' heuristic.
     to_go: Vec<f64>,
@@ -62,7 +63,7 @@ pub(super) struct Construction<'p> {
     pub(super) may_give_way: bool,
     /// The margin the start's units keep, rounded down to a millimetre, where it is
     /// below the preferred clearance: an edge leaving the start may keep only that.
-    pub(super) start_margin: Option<f64>,
+    start_margin: Option<f64>,
 }
 
 impl<'p> Construction<'p> {
@@ -129,6 +130,12 @@ impl<'p> Construction<'p> {
     pub(super) fn without_giving_way(mut self) -> Self {
         self.may_give_way = false;
         self
+    }
+
+    /// Where `v` is the start and the start keeps less than the preferred clearance,
+    /// the margin it keeps (what an edge leaving it may give way to).
+    pub(super) fn start_margin_at(&self, v: VertexId) -> Option<f64> {
+        self.start_margin.filter(|_| v == self.start)
     }
 
     fn route(&self, from: VertexId) -> Result<Vec<VertexId>, PlanError> {
@@ -298,8 +305,8 @@ fn start_margin(ctx: &CollisionContext, head: [f64; 3], shape: &Shape) -> Option
         .iter()
         .take(ctx.params().n())
         .map(|o| {
-            let p = [0, 1, 2].map(|k| head[k] + o[k] as f64);
-            exact_clearance(ctx.field(), p, 0.0, r_u + c) - r_u
+            let p = Point3::from([0, 1, 2].map(|k| head[k] + o[k] as f64));
+            distance_below(ctx, p, r_u + c) - r_u
         })
         .fold(f64::INFINITY, f64::min);
     let kept = (margin - FK_TOLERANCE).max(0.0);

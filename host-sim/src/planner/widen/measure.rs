@@ -255,7 +255,7 @@ pub(in crate::planner) fn distance(ctx: &CollisionContext, p: Point3<f64>) -> f6
 
 /// Distance from `p` to the nearest obstacle cube, capped at `cap`: the distance
 /// field's bound first, and the search for the nearest cube stops at `cap`.
-pub(super) fn distance_below(ctx: &CollisionContext, p: Point3<f64>, cap: f64) -> f64 {
+pub(in crate::planner) fn distance_below(ctx: &CollisionContext, p: Point3<f64>, cap: f64) -> f64 {
     let f = ctx.field();
     if f.clearance_above(p, cap) >= cap {
         return cap;

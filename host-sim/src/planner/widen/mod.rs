@@ -46,7 +46,7 @@ mod passage;
 #[cfg(test)]
 mod tests;
 
-pub(super) use measure::{distance, gradient, zeta};
+pub(super) use measure::{distance, distance_below, gradient, zeta};
 
 /// Clearances at or above this (m) are wide enough: widening leaves them alone.
 ///
