@@ -28,6 +28,14 @@ use super::candidates::{Candidate, Source};
 use super::graph::{path_to, Open};
 use super::Checker;
 
+/// A shape change whose answer [`Memo`] keeps: from the current shape to a random
+/// shape, or between two random shapes (SRS indices).
+#[derive(Clone, Copy)]
+enum Change {
+    FromCurrent(usize),
+    Between(u16, u16),
+}
+
 /// The answers one call learns at `xi_i` that do not depend on the edge, kept for
 /// the next call from the same head position, shape and clearance: where edge after
 /// edge fails from one vertex (a chain boxed in at its start), every call would
@@ -63,17 +71,8 @@ impl Memo {
             self.from_current = vec![None; shapes];
         }
     }
-}
 
-/// A shape change whose answer [`Memo`] keeps: from the current shape to a random
-/// shape, or between two random shapes (SRS indices).
-#[derive(Clone, Copy)]
-enum Change {
-    FromCurrent(usize),
-    Between(u16, u16),
-}
-
-impl Memo {
+    /// The kept answer to the change `key`, if any.
     fn change(&self, key: Change) -> Option<bool> {
         match key {
             Change::FromCurrent(to) => self.from_current[to],
@@ -81,6 +80,7 @@ impl Memo {
         }
     }
 
+    /// Keeps the answer `ok` to the change `key`.
     fn remember(&mut self, key: Change, ok: bool) {
         match key {
             Change::FromCurrent(to) => self.from_current[to] = Some(ok),
