@@ -264,7 +264,7 @@ pub fn explore(
         truth,
         prior,
         online,
-        settings.survey.sensor.fov_h_deg,
+        &settings.survey.sensor,
     )?;
     planner.keep_maps(settings.audit);
     let cfg = settings.fly.sim_config();

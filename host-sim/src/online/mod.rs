@@ -25,6 +25,7 @@
 
 pub mod belief;
 pub mod explore;
+mod look;
 pub mod planner;
 pub mod record;
 pub mod route;

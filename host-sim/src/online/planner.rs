@@ -7,6 +7,7 @@ use aerial_chain_core::{ChainParams, Shape};
 use nalgebra::Point3;
 
 use super::belief::{Belief, Fused};
+use super::look;
 use super::record::{Outcome, ReplanRecord, Trigger};
 use super::route::{self, Found, Radii, Route};
 use super::settings::{check_settings, OnlineError, OnlineSettings};
@@ -16,7 +17,7 @@ use crate::map::Grid;
 use crate::plan_file::{MapSection, Plan};
 use crate::planner::Query;
 use crate::planning::{plan, Request};
-use crate::sensing::PointCloud;
+use crate::sensing::{DepthSensor, PointCloud};
 use crate::tables::ShapeTables;
 use crate::trajectory::Trajectory;
 
@@ -41,7 +42,7 @@ pub struct OnlinePlanner {
     goal: Point3<f64>,
     goal_tol: f64,
     radii: Radii,
-    fov_h: f64,
+    sensor: DepthSensor,
     end: Vec<f64>,
     pieces: Vec<Piece>,
     route: Option<Route>,
@@ -53,6 +54,7 @@ pub struct OnlinePlanner {
     failed_on: Option<usize>,
     keep_maps: bool,
     records: Vec<ReplanRecord>,
+    looked_at_hull: bool,
 }
 
 impl OnlinePlanner {
@@ -61,8 +63,8 @@ impl OnlinePlanner {
     /// box of `bounds` (its contents are not read), knowing `prior` if given. The start
     /// must be valid with the clearance of `settings` (every body grown by it, on the
     /// true map): the space within that reach of its bodies counts as seen free. The
-    /// sensors' horizontal field of view `fov_h_deg` decides when the chain turns to
-    /// look along its route.
+    /// units' `sensor` (every unit's the same) decides where the chain turns to look:
+    /// along its route, and at its own hull when no piece is found.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         params: ChainParams,
@@ -73,9 +75,10 @@ impl OnlinePlanner {
         bounds: &Grid,
         prior: Option<&Grid>,
         settings: OnlineSettings,
-        fov_h_deg: f64,
+        sensor: &DepthSensor,
     ) -> Result<Self, OnlineError> {
         check_settings(&settings)?;
+        sensor.validate()?;
         if let Some(p) = prior {
             if p.resolution() != bounds.resolution() {
                 return Err(OnlineError::Map(format!(
@@ -97,7 +100,7 @@ impl OnlinePlanner {
             belief,
             goal,
             goal_tol,
-            fov_h: fov_h_deg.to_radians(),
+            sensor: sensor.clone(),
             end: as_written(start),
             pieces: Vec::new(),
             route: None,
@@ -109,6 +112,7 @@ impl OnlinePlanner {
             failed_on: None,
             keep_maps: false,
             records: Vec::new(),
+            looked_at_hull: false,
         })
     }
 
@@ -303,6 +307,7 @@ impl OnlinePlanner {
             if let Some(piece) = self.plan_piece(goal, tol, look, deadline) {
                 let m = piece.trajectory.head_path_m();
                 self.push(piece);
+                self.looked_at_hull = false;
                 self.reached = final_piece;
                 // The route goes on from where the piece ended (within a voxel of
                 // route point `k`).
@@ -312,7 +317,11 @@ impl OnlinePlanner {
                 return (Outcome::Committed, m);
             }
         }
-        // The route lies in view (looked at above): the chain waits to see more.
+        // The route lies in view (looked at above): the chain looks at what it has not
+        // seen of its own hull, once where it rests, or waits to see more.
+        if !self.looked_at_hull && self.look_at_hull() {
+            return (Outcome::Looked, 0.0);
+        }
         (Outcome::NoRoom, 0.0)
     }
 
@@ -407,7 +416,7 @@ impl OnlinePlanner {
     /// middle half of the sensors' view.
     fn turn_needed(&self, yaw: f32, look: f32) -> bool {
         let d = crate::collision::verify::wrap((look - yaw) as f64);
-        d.abs() > self.fov_h / 4.0
+        d.abs() > self.sensor.fov_h_deg.to_radians() / 4.0
     }
 
     /// Commits a turn in place of the head yaw toward the route, when the route leaves
@@ -417,11 +426,31 @@ impl OnlinePlanner {
         if !self.turn_needed(self.end[3] as f32, look) {
             return false;
         }
-        let to = turned(&self.end, look);
+        self.commit_turn(look, "turn_to_look")
+    }
+
+    /// Commits a turn of the head yaw toward where the units' sensors see most of the
+    /// unseen part of the chain's hull (the module docs of `look` say why), when some
+    /// heading sees any of it; marks the hull looked at until the chain moves.
+    fn look_at_hull(&mut self) -> bool {
+        self.looked_at_hull = true;
+        let centres = unit_centres(&self.params, &self.end);
+        let reach = self.params.unit_radius as f64 + self.settings.plan.clearance;
+        let unseen = look::unseen_hull(&self.belief, &centres, reach);
+        let Some(yaw) = look::best_view(&self.sensor, &centres, self.end[3], &unseen) else {
+            return false;
+        };
+        self.commit_turn(yaw as f32, "look_at_hull")
+    }
+
+    /// Commits a turn of the head yaw to `yaw` in place (a head yaw moves no body, so
+    /// the turn is valid wherever the chain rests), its plan marked `why`.
+    fn commit_turn(&mut self, yaw: f32, why: &str) -> bool {
+        let to = turned(&self.end, yaw);
         let field = self.belief.commit_field().clone();
         let map = MapSection::of(field.grid());
         let mut plan = Plan::from_zetas(&self.params, map, vec![self.end.clone(), to]);
-        plan.stats.insert("turn_to_look".into(), true.into());
+        plan.stats.insert(why.into(), true.into());
         let Some(piece) = self.timed(plan, field.grid(), None) else {
             return false;
         };
@@ -517,6 +546,15 @@ fn eta(zeta: &[f64]) -> Vec<f32> {
     zeta[3..].iter().map(|&v| v as f32).collect()
 }
 
+/// The unit centres of configuration `zeta`, head first.
+fn unit_centres(params: &ChainParams, zeta: &[f64]) -> Vec<Point3<f64>> {
+    let head = crate::sim::V3::new(zeta[0], zeta[1], zeta[2]);
+    crate::sim::dynamics::unit_positions(params.link_length as f64, head, &zeta[3..])
+        .into_iter()
+        .map(Point3::from)
+        .collect()
+}
+
 /// The chain's bodies in configuration `zeta`, each as a segment and a radius grown
 /// by `grow`: a ball per unit, a capsule per link.
 pub(super) fn bodies(
@@ -524,12 +562,7 @@ pub(super) fn bodies(
     zeta: &[f64],
     grow: f64,
 ) -> Vec<(Point3<f64>, Point3<f64>, f64)> {
-    let head = crate::sim::V3::new(zeta[0], zeta[1], zeta[2]);
-    let centres: Vec<Point3<f64>> =
-        crate::sim::dynamics::unit_positions(params.link_length as f64, head, &zeta[3..])
-            .into_iter()
-            .map(Point3::from)
-            .collect();
+    let centres = unit_centres(params, zeta);
     let r_u = params.unit_radius as f64 + grow;
     let r_l = params.link_radius as f64 + grow;
     let mut out: Vec<_> = centres.iter().map(|c| (*c, *c, r_u)).collect();

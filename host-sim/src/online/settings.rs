@@ -48,6 +48,9 @@ pub enum OnlineError {
     /// A fusion argument was refused.
     #[error("sensing: {0}")]
     Fusion(#[from] FusionError),
+    /// The units' sensor settings were refused.
+    #[error("sensor: {0}")]
+    Sensor(#[from] crate::sensing::SensorError),
     /// A planning input was refused (tables, settings).
     #[error("planning: {0}")]
     Planning(PlanningError),

@@ -118,7 +118,7 @@ fn a_due_piece_is_tried_even_when_a_route_search_took_in_what_was_seen() {
         &sc.grid,
         None,
         OnlineSettings::default(),
-        87.0,
+        &crate::sensing::DepthSensor::default(),
     )
     .unwrap();
     planner.replan(0.0, Trigger::Start);
@@ -221,4 +221,42 @@ fn a_goal_behind_a_wall_across_the_box_is_proven_sealed_from_an_empty_map() {
     assert!(why.contains("no route"), "{why}");
     assert!(*t < 300.0);
     assert!(!ex.flight.report.contact);
+}
+
+/// A straight chain at rest in a square tunnel, looking along itself, cannot move its
+/// last unit through the waist ahead of it, which no sensor looking forward sees: it
+/// turns to look at its own hull (back along itself), then flies down the tunnel.
+#[test]
+fn a_chain_looking_along_itself_looks_back_at_its_hull_then_flies_along_itself() {
+    let mut world = Grid::new(0.05, [0; 3], [100, 20, 20], Cell::Occupied, true).unwrap();
+    fill(&mut world, [0.1, 0.2, 0.2], [4.9, 0.8, 0.8], Cell::Free);
+    let (params, tables) = chain(4);
+    let start = Waypoint::new([2.0, 0.5, 0.5], &aerial_chain_core::Shape::line(4, 0.0)).zeta;
+    let goal = Point3::new(4.2, 0.5, 0.5);
+    let settings = ExploreSettings {
+        time_limit_s: 120.0,
+        audit: true,
+        ..ExploreSettings::default()
+    };
+    let ex = explore(&world, params, tables, &start, goal, 0.3, None, &settings).unwrap();
+    assert!(ex.end.reached(), "{:?}", ex.end);
+    assert!(!ex.flight.report.contact);
+    for (i, v) in ex.audit.as_ref().unwrap().iter().enumerate() {
+        assert!(v.is_none(), "piece {i}: {v:?}");
+    }
+    assert!(verify_plan(&world, &ex.plan).ok);
+    // Before the chain first moved, it turned its head yaw round, back along itself.
+    let zetas: Vec<&[f64]> = ex.plan.waypoints.iter().map(|w| &w.zeta[..]).collect();
+    let moved = zetas
+        .iter()
+        .position(|z| (z[0] - 2.0).abs() > 1e-3)
+        .expect("the chain moved");
+    let turned = zetas[..moved]
+        .iter()
+        .map(|z| crate::collision::verify::wrap(z[3]).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        turned > 2.5,
+        "the head yaw turned at most {turned} rad at rest"
+    );
 }

@@ -239,6 +239,22 @@ impl DepthSensor {
         pose.position + pose.attitude * Vector3::from(self.mount.offset)
     }
 
+    /// Whether point `p` (W) lies in the view of the sensor of a unit at `pose`: within
+    /// the angles its rays span (to the outermost ray) and at a distance in
+    /// `[min_range, max_range]`. Nothing in the way is considered: a prediction of
+    /// what a scan may see, not a scan.
+    pub fn in_view(&self, pose: &UnitPose, p: &Point3<f64>) -> bool {
+        let d = (pose.attitude * self.mount_rotation()).inverse() * (p - self.origin(pose));
+        let range = d.norm();
+        if d.x <= 0.0 || range < self.min_range || range > self.max_range {
+            return false;
+        }
+        // The outermost rays themselves are in view, rounding aside.
+        let half = |n: usize| (n as f64 - 1.0) / 2.0 * self.resolution_deg.to_radians();
+        let within = |slope: f64, n: usize| slope.abs() <= half(n).tan() + 1e-12;
+        within(d.y / d.x, self.columns()) && within(d.z / d.x, self.rows())
+    }
+
     /// The unit ray directions in W for a unit at `pose` (in [`Self::body_rays`]'s order).
     pub fn world_rays(&self, pose: &UnitPose) -> Vec<Vector3<f64>> {
         self.body_rays()
@@ -375,5 +391,41 @@ mod tests {
             DepthSensor::default().world_rays(&level),
             DepthSensor::default().body_rays()
         );
+    }
+
+    #[test]
+    fn in_view_holds_the_points_along_the_rays_and_no_others() {
+        let half = std::f64::consts::FRAC_PI_4;
+        let s = DepthSensor {
+            mount: Mount {
+                rotation: [half.cos(), 0.0, half.sin(), 0.0],
+                offset: [0.1, 0.0, -0.05],
+            },
+            ..Default::default()
+        };
+        let pose = UnitPose {
+            position: Point3::new(1.0, 2.0, 3.0),
+            attitude: UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.7)
+                * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 0.3),
+        };
+        let o = s.origin(&pose);
+        let rays = s.world_rays(&pose);
+        // Every ray, at the near and far ends of the range and between, is in view.
+        for d in &rays {
+            for r in [0.2 + 1e-9, 1.0, 5.0 - 1e-9] {
+                assert!(s.in_view(&pose, &(o + d * r)), "{d} at {r} m");
+            }
+            assert!(!s.in_view(&pose, &(o + d * 0.19)), "nearer than min_range");
+            assert!(!s.in_view(&pose, &(o + d * 5.01)), "beyond max_range");
+            assert!(!s.in_view(&pose, &(o - d * 1.0)), "behind the sensor");
+        }
+        // Just outside the corner rays, horizontally and vertically.
+        let mount = pose.attitude * s.mount_rotation();
+        let beyond = |h: f64, v: f64| {
+            o + mount * Vector3::new(1.0, h.to_radians().tan(), v.to_radians().tan())
+        };
+        assert!(s.in_view(&pose, &beyond(43.4, 28.4)));
+        assert!(!s.in_view(&pose, &beyond(43.6, 0.0)));
+        assert!(!s.in_view(&pose, &beyond(0.0, -28.6)));
     }
 }
