@@ -19,6 +19,16 @@ use super::blocks::ObstacleBlocks;
 /// field). Larger maps are refused with [`GridError::TooLarge`] rather than exhausting memory.
 pub const MAX_CELLS: usize = 400_000_000;
 
+/// The six face neighbours of a voxel, as lattice index steps.
+pub const FACE_NEIGHBOURS: [[i32; 3]; 6] = [
+    [1, 0, 0],
+    [-1, 0, 0],
+    [0, 1, 0],
+    [0, -1, 0],
+    [0, 0, 1],
+    [0, 0, -1],
+];
+
 /// The state of one voxel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u8)]

@@ -9,5 +9,5 @@ pub(crate) mod random_grids;
 pub(crate) mod row_gaps;
 
 pub use distance::{DistanceField, UpdateError, UpdateStats};
-pub use grid::{Cell, Grid, GridError};
+pub use grid::{Cell, Grid, GridError, FACE_NEIGHBOURS};
 pub use octomap::{MapFileError, OcTree};

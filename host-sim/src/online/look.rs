@@ -17,7 +17,7 @@
 use nalgebra::Point3;
 
 use super::belief::Belief;
-use crate::map::Cell;
+use crate::map::{Cell, FACE_NEIGHBOURS};
 use crate::sensing::{DepthSensor, UnitPose};
 
 /// The unknown voxels at the edge of what is known in the chain's hull: inside the box,
@@ -43,7 +43,7 @@ pub(super) fn unseen_hull(
             .any(|(a, b)| segment_distance(p, a, b) <= reach)
     };
     let frontier = |i: [i32; 3]| {
-        NEIGHBOURS.iter().any(|d| {
+        FACE_NEIGHBOURS.iter().any(|d| {
             let j = [i[0] + d[0], i[1] + d[1], i[2] + d[2]];
             seen.state(j) == Cell::Free
         })
@@ -75,16 +75,6 @@ pub(super) fn unseen_hull(
     }
     out
 }
-
-/// The six face neighbours of a voxel.
-const NEIGHBOURS: [[i32; 3]; 6] = [
-    [1, 0, 0],
-    [-1, 0, 0],
-    [0, 1, 0],
-    [0, -1, 0],
-    [0, 0, 1],
-    [0, 0, -1],
-];
 
 /// The head yaw, turned from `yaw` by a multiple of half the horizontal field of view
 /// (rounded down so that an even number of turns divide the circle: looking straight

@@ -157,25 +157,40 @@ fn two_lanes() -> Grid {
     g
 }
 
-#[test]
-fn a_dead_end_seen_late_is_left_the_way_the_chain_came() {
-    let world = two_lanes();
-    let (params, tables) = chain(4);
-    let line = aerial_chain_core::Shape::line(4, 0.0);
-    let start = Waypoint::new([2.2, 1.5, 1.3], &line).zeta;
-    let goal = Point3::new(11.0, 4.5, 1.3);
+/// Explores `world` with a chain of `units` units from `start` toward `goal` (within
+/// 0.3 m) in at most `time_limit_s` simulated s, auditing every piece; checks that it
+/// reached the goal without contact, every piece valid on the map it was committed on
+/// and the joined plan valid on the world.
+fn explore_audited(
+    world: &Grid,
+    units: u8,
+    start: &[f64],
+    goal: Point3<f64>,
+    time_limit_s: f64,
+) -> Exploration {
+    let (params, tables) = chain(units);
     let settings = ExploreSettings {
-        time_limit_s: 400.0,
+        time_limit_s,
         audit: true,
         ..ExploreSettings::default()
     };
-    let ex = explore(&world, params, tables, &start, goal, 0.3, None, &settings).unwrap();
+    let ex = explore(world, params, tables, start, goal, 0.3, None, &settings).unwrap();
     assert!(ex.end.reached(), "{:?}", ex.end);
     assert!(!ex.flight.report.contact);
     for (i, v) in ex.audit.as_ref().unwrap().iter().enumerate() {
         assert!(v.is_none(), "piece {i}: {v:?}");
     }
-    assert!(verify_plan(&world, &ex.plan).ok);
+    assert!(verify_plan(world, &ex.plan).ok);
+    ex
+}
+
+#[test]
+fn a_dead_end_seen_late_is_left_the_way_the_chain_came() {
+    let world = two_lanes();
+    let line = aerial_chain_core::Shape::line(4, 0.0);
+    let start = Waypoint::new([2.2, 1.5, 1.3], &line).zeta;
+    let goal = Point3::new(11.0, 4.5, 1.3);
+    let ex = explore_audited(&world, 4, &start, goal, 400.0);
     // The route first led down lane A (unknown space is free to the route); the chain
     // went in, saw its end, and came back out to take lane B.
     let heads: Vec<[f64; 2]> = ex
@@ -230,21 +245,8 @@ fn a_goal_behind_a_wall_across_the_box_is_proven_sealed_from_an_empty_map() {
 fn a_chain_looking_along_itself_looks_back_at_its_hull_then_flies_along_itself() {
     let mut world = Grid::new(0.05, [0; 3], [100, 20, 20], Cell::Occupied, true).unwrap();
     fill(&mut world, [0.1, 0.2, 0.2], [4.9, 0.8, 0.8], Cell::Free);
-    let (params, tables) = chain(4);
     let start = Waypoint::new([2.0, 0.5, 0.5], &aerial_chain_core::Shape::line(4, 0.0)).zeta;
-    let goal = Point3::new(4.2, 0.5, 0.5);
-    let settings = ExploreSettings {
-        time_limit_s: 120.0,
-        audit: true,
-        ..ExploreSettings::default()
-    };
-    let ex = explore(&world, params, tables, &start, goal, 0.3, None, &settings).unwrap();
-    assert!(ex.end.reached(), "{:?}", ex.end);
-    assert!(!ex.flight.report.contact);
-    for (i, v) in ex.audit.as_ref().unwrap().iter().enumerate() {
-        assert!(v.is_none(), "piece {i}: {v:?}");
-    }
-    assert!(verify_plan(&world, &ex.plan).ok);
+    let ex = explore_audited(&world, 4, &start, Point3::new(4.2, 0.5, 0.5), 120.0);
     // Before the chain first moved, it turned its head yaw round, back along itself.
     let zetas: Vec<&[f64]> = ex.plan.waypoints.iter().map(|w| &w.zeta[..]).collect();
     let moved = zetas

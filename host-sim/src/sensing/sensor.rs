@@ -346,17 +346,23 @@ mod tests {
         assert!(serde_json::from_str::<DepthSensor>(r#"{"fov": 3}"#).is_err());
     }
 
-    #[test]
-    fn world_rays_follow_the_tilted_body_and_the_mount() {
-        // Looking down: the mount pitches the optical axis by +90 deg about body y.
+    /// The default sensor mounted pitched by +90 degrees about body y (looking down),
+    /// 0.1 m ahead of and 0.05 m below the unit's centre.
+    fn looking_down() -> DepthSensor {
         let half = std::f64::consts::FRAC_PI_4;
-        let s = DepthSensor {
+        DepthSensor {
             mount: Mount {
                 rotation: [half.cos(), 0.0, half.sin(), 0.0],
                 offset: [0.1, 0.0, -0.05],
             },
             ..Default::default()
-        };
+        }
+    }
+
+    #[test]
+    fn world_rays_follow_the_tilted_body_and_the_mount() {
+        // Looking down: the mount pitches the optical axis by +90 deg about body y.
+        let s = looking_down();
         let axis = s.body_rays()[19 * 59 + 29];
         assert!((axis - Vector3::new(0.0, 0.0, -1.0)).norm() < 1e-12);
         // The unit yawed by 90 deg and rolled by 90 deg (tilt): body x -> W y, body z -> W x.
@@ -395,14 +401,7 @@ mod tests {
 
     #[test]
     fn in_view_holds_the_points_along_the_rays_and_no_others() {
-        let half = std::f64::consts::FRAC_PI_4;
-        let s = DepthSensor {
-            mount: Mount {
-                rotation: [half.cos(), 0.0, half.sin(), 0.0],
-                offset: [0.1, 0.0, -0.05],
-            },
-            ..Default::default()
-        };
+        let s = looking_down();
         let pose = UnitPose {
             position: Point3::new(1.0, 2.0, 3.0),
             attitude: UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.7)

@@ -5,7 +5,7 @@
 use std::collections::{BTreeMap, HashSet};
 
 use aerial_chain::flying::{self, FlyOptions};
-use aerial_chain::map::{Cell, Grid};
+use aerial_chain::map::{Cell, Grid, FACE_NEIGHBOURS};
 use aerial_chain::plan_file::Plan;
 use aerial_chain_core::kinematics::positions_into;
 use nalgebra::Vector3;
@@ -284,15 +284,7 @@ pub fn boxes(grid: &Grid, region: &Region<'_>, max_boxes: usize) -> Boxes {
 
 /// Whether a 6-neighbour of voxel `v` inside the grid is not an obstacle.
 fn touches_free(grid: &Grid, v: [i32; 3]) -> bool {
-    const STEPS: [[i32; 3]; 6] = [
-        [1, 0, 0],
-        [-1, 0, 0],
-        [0, 1, 0],
-        [0, -1, 0],
-        [0, 0, 1],
-        [0, 0, -1],
-    ];
-    STEPS.iter().any(|s| {
+    FACE_NEIGHBOURS.iter().any(|s| {
         let w = [v[0] + s[0], v[1] + s[1], v[2] + s[2]];
         grid.local(w).is_some() && !grid.is_obstacle(w)
     })
