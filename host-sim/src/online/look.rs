@@ -76,11 +76,11 @@ pub(super) fn unseen_hull(
     out
 }
 
-/// The head yaw, turned from `yaw` by a multiple of half the horizontal field of view
-/// (rounded down so that an even number of turns divide the circle: looking straight
-/// back along the chain is one), from which the sensors of the units
-/// at `centres` (level, holding that yaw) see the most of `unseen`; the smaller turn
-/// on a tie. `None` when no such yaw sees any of it.
+/// The head yaw, turned from `yaw` by a multiple of a step of at most half the
+/// horizontal field of view (an even number of steps round the circle, so that looking
+/// straight back along the chain is one), from which the sensors of the units at
+/// `centres` (level, holding that yaw) see the most of `unseen`; the smaller turn on a
+/// tie. `None` when no such yaw sees any of it.
 pub(super) fn best_view(
     sensor: &DepthSensor,
     centres: &[Point3<f64>],
@@ -179,8 +179,8 @@ mod tests {
     #[test]
     fn a_chain_looking_along_itself_turns_round_to_see_its_last_waist() {
         let (belief, centres) = chain_at_rest(4);
-        // Only the waist ahead of the last unit is unseen (the others were seen from
-        // two units behind).
+        // The waist ahead of the last unit alone, as sensors looking along the chain
+        // leave it (they see the others from two units behind).
         let last_waist: Vec<_> = unseen_hull(&belief, &centres, 0.2)
             .into_iter()
             .filter(|p| p.x < 1.0)
@@ -206,7 +206,7 @@ mod tests {
 
     #[test]
     fn nothing_to_see_is_no_view() {
-        let (belief, centres) = chain_at_rest(3);
+        let (_, centres) = chain_at_rest(3);
         assert_eq!(best_view(&DepthSensor::default(), &centres, 0.0, &[]), None);
         // A point no sensor reaches from any heading: far above the chain.
         let above = [Point3::new(1.5, 1.0, 1.0 + 6.0)];
@@ -214,6 +214,5 @@ mod tests {
             best_view(&DepthSensor::default(), &centres, 0.0, &above),
             None
         );
-        let _ = belief;
     }
 }
