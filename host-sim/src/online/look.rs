@@ -17,6 +17,7 @@
 use nalgebra::Point3;
 
 use super::belief::Belief;
+use crate::collision::exact::point_segment_distance;
 use crate::map::{Cell, FACE_NEIGHBOURS};
 use crate::sensing::{DepthSensor, UnitPose};
 
@@ -40,7 +41,7 @@ pub(super) fn unseen_hull(
     let near = |p: &Point3<f64>| {
         links
             .iter()
-            .any(|(a, b)| segment_distance(p, a, b) <= reach)
+            .any(|(a, b)| point_segment_distance(*p, *a, *b) <= reach)
     };
     let frontier = |i: [i32; 3]| {
         FACE_NEIGHBOURS.iter().any(|d| {
@@ -116,17 +117,6 @@ pub(super) fn best_view(
         }
     }
     best.map(|(_, heading)| heading)
-}
-
-/// Distance from `p` to the segment `a b`.
-fn segment_distance(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = match len2 > 0.0 {
-        true => ((p - a).dot(&ab) / len2).clamp(0.0, 1.0),
-        false => 0.0,
-    };
-    (p - (a + ab * t)).norm()
 }
 
 #[cfg(test)]
