@@ -1,4 +1,4 @@
-//! Where the chain looks when no piece is found at rest: at the unseen part of its own
+//! Where the chain looks before it moves from a rest: at the unseen part of its own
 //! hull.
 //!
 //! Any motion along the chain takes each unit through the space between it and its
@@ -8,7 +8,7 @@
 //! units behind it, 0.75 m on, but the waist ahead of the last unit only from the last
 //! unit itself, 0.25 m on, where a depth camera's vertical view (58 degrees: 0.14 m each
 //! side of its axis) is narrower than a unit. So a straight chain at rest looking along
-//! itself cannot move its tail forward, and no piece is found. Turning the head yaw
+//! itself cannot move its tail forward, and no piece would be found. Turning the head yaw
 //! (which moves no body; every unit holds it, so every sensor turns) to where the units'
 //! sensors see most of the unseen hull lets them see it: looking back along the chain,
 //! the unit two ahead of the last sees that waist. A prediction by the sensors' view

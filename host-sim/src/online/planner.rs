@@ -55,6 +55,7 @@ pub struct OnlinePlanner {
     keep_maps: bool,
     records: Vec<ReplanRecord>,
     looked_at_hull: bool,
+    searches: usize,
 }
 
 impl OnlinePlanner {
@@ -64,7 +65,7 @@ impl OnlinePlanner {
     /// must be valid with the clearance of `settings` (every body grown by it, on the
     /// true map): the space within that reach of its bodies counts as seen free. The
     /// units' `sensor` (every unit's the same) decides where the chain turns to look:
-    /// along its route, and at its own hull when no piece is found.
+    /// along its route, and at the unseen part of its own hull before it moves.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         params: ChainParams,
@@ -113,6 +114,7 @@ impl OnlinePlanner {
             keep_maps: false,
             records: Vec::new(),
             looked_at_hull: false,
+            searches: 0,
         })
     }
 
@@ -277,6 +279,12 @@ impl OnlinePlanner {
         if self.turn_to_look(&route) {
             return (Outcome::Looked, 0.0);
         }
+        // Any motion along the chain passes through its hull: where part of it is
+        // unseen, no piece that moves the tail can be found, so the chain looks at it
+        // first, once where it rests, rather than spend the deadline finding nothing.
+        if !self.looked_at_hull && self.look_at_hull() {
+            return (Outcome::Looked, 0.0);
+        }
         let known = self.known_prefix(&route);
         let last = route.points.len() - 1;
         let mut candidates: Vec<usize> = [1.0, 2.0 / 3.0, 1.0 / 3.0]
@@ -317,11 +325,7 @@ impl OnlinePlanner {
                 return (Outcome::Committed, m);
             }
         }
-        // The route lies in view (looked at above): the chain looks at what it has not
-        // seen of its own hull, once where it rests, or waits to see more.
-        if !self.looked_at_hull && self.look_at_hull() {
-            return (Outcome::Looked, 0.0);
-        }
+        // The route and the hull were looked at above: the chain waits to see more.
         (Outcome::NoRoom, 0.0)
     }
 
@@ -361,12 +365,13 @@ impl OnlinePlanner {
     /// piece ends by turning the head yaw to it (a head yaw moves no body); timed and
     /// checked on that map.
     fn plan_piece(
-        &self,
+        &mut self,
         goal: Point3<f64>,
         tol: f64,
         look: Option<f32>,
         deadline: f64,
     ) -> Option<Piece> {
+        self.searches += 1;
         let stop = Instant::now().checked_add(Duration::from_secs_f64(deadline));
         let shape = Shape::from_slice(self.params.units, &eta(&self.end)).ok()?;
         let mut query = Query::new(head(&self.end), shape, goal);
@@ -431,7 +436,8 @@ impl OnlinePlanner {
 
     /// Commits a turn of the head yaw toward where the units' sensors see most of the
     /// unseen part of the chain's hull (the module docs of `look` say why), when some
-    /// heading sees any of it; marks the hull looked at until the chain moves.
+    /// heading sees any of it (false when all of it is seen or no heading sees any);
+    /// marks the hull looked at until the chain moves.
     fn look_at_hull(&mut self) -> bool {
         self.looked_at_hull = true;
         let centres = unit_centres(&self.params, &self.end);
@@ -469,6 +475,12 @@ impl OnlinePlanner {
     /// The committed pieces, in order.
     pub fn pieces(&self) -> &[Piece] {
         &self.pieces
+    }
+
+    /// How many pieces were searched (every candidate end of every commit, found or
+    /// not): a commit that only turns to look searches none.
+    pub fn pieces_searched(&self) -> usize {
+        self.searches
     }
 
     /// The configuration where the committed motion ends (at rest).

@@ -238,13 +238,60 @@ fn a_goal_behind_a_wall_across_the_box_is_proven_sealed_from_an_empty_map() {
     assert!(!ex.flight.report.contact);
 }
 
+/// A square tunnel 0.6 m across along x, from x = 0.1 to 4.9, at 0.05 m.
+fn tunnel() -> Grid {
+    let mut world = Grid::new(0.05, [0; 3], [100, 20, 20], Cell::Occupied, true).unwrap();
+    fill(&mut world, [0.1, 0.2, 0.2], [4.9, 0.8, 0.8], Cell::Free);
+    world
+}
+
+/// A chain at rest whose hull is partly unseen looks at it before it searches a piece:
+/// any piece would pass through that hull, so a search could only spend its deadline.
+#[test]
+fn a_chain_looks_at_its_unseen_hull_before_it_searches_a_piece() {
+    let world = tunnel();
+    let (params, tables) = chain(4);
+    let start = Waypoint::new([2.0, 0.5, 0.5], &aerial_chain_core::Shape::line(4, 0.0)).zeta;
+    let mut planner = OnlinePlanner::new(
+        params,
+        tables,
+        &start,
+        Point3::new(4.2, 0.5, 0.5),
+        0.3,
+        &world,
+        None,
+        OnlineSettings::default(),
+        &crate::sensing::DepthSensor::default(),
+    )
+    .unwrap();
+    // The space ahead of the head is marked seen free, so pieces along the route could
+    // be searched; the waists between the units are not seen.
+    let ahead: Vec<_> = (1..=10)
+        .map(|k| Point3::new(2.0 + 0.1 * f64::from(k), 0.5, 0.5))
+        .collect();
+    planner.observe_flown(&ahead, 0.45).unwrap();
+    let first = planner.replan(0.0, Trigger::Start);
+    assert_eq!(first.outcome, Outcome::Looked);
+    assert_eq!(planner.pieces_searched(), 0);
+    let look = &planner.pieces()[0].plan;
+    assert!(look.stats.contains_key("look_at_hull"), "{:?}", look.stats);
+    // The next commit turns back to the route; the hull is looked at once where the
+    // chain rests, so the one after searches pieces.
+    planner.replan(0.1, Trigger::CommitShort);
+    let back = &planner.pieces()[1].plan;
+    assert!(back.stats.contains_key("turn_to_look"), "{:?}", back.stats);
+    assert_eq!(planner.pieces_searched(), 0);
+    let third = planner.replan(0.2, Trigger::CommitShort);
+    assert_ne!(third.outcome, Outcome::Looked);
+    assert!(planner.pieces_searched() > 0);
+}
+
 /// A straight chain at rest in a square tunnel, looking along itself, cannot move its
 /// last unit through the waist ahead of it, which no sensor looking forward sees: it
 /// turns to look at its own hull (back along itself), then flies down the tunnel.
 #[test]
 fn a_chain_looking_along_itself_looks_back_at_its_hull_then_flies_along_itself() {
-    let mut world = Grid::new(0.05, [0; 3], [100, 20, 20], Cell::Occupied, true).unwrap();
-    fill(&mut world, [0.1, 0.2, 0.2], [4.9, 0.8, 0.8], Cell::Free);
+    let world = tunnel();
     let start = Waypoint::new([2.0, 0.5, 0.5], &aerial_chain_core::Shape::line(4, 0.0)).zeta;
     let ex = explore_audited(&world, 4, &start, Point3::new(4.2, 0.5, 0.5), 120.0);
     // Before the chain first moved, it turned its head yaw round, back along itself.
