@@ -255,6 +255,21 @@ proptest! {
             }
         }
     }
+
+    /// A shape change's answer is the map sweep's and the walk's together: looking at
+    /// the shape halfway first refuses no change that both accept.
+    #[test]
+    fn a_shape_change_is_the_map_and_the_walk_together(
+        (b, unknown_occ, n, raw) in scene(),
+        raw2 in proptest::collection::vec(-1.0f32..1.0, 31),
+        head in proptest::array::uniform3(0.0f64..1.0),
+    ) {
+        let (_, p, ctx) = context(&b, unknown_occ, n);
+        let (s, s2, h) = (shape(n, &raw), shape(n, &raw2), head_at(head));
+        let walk = check_transition(&p, &s, &s2, TRANSITION_MARGIN).is_ok();
+        let both = walk && ctx.shape_change_map(h.into(), &s, &s2).is_ok();
+        prop_assert_eq!(ctx.check_shape_change(h, &s, &s2).is_ok(), both);
+    }
 }
 
 #[test]
