@@ -106,11 +106,12 @@ impl Roadmap {
                 if deadline.is_some_and(|d| Instant::now() > d) {
                     return Vec::new();
                 }
-                // The k nearest, then the radius: a bounded heap of k, cheaper than
-                // collecting every point within r_T first.
-                tree.nearest_n::<SquaredEuclidean>(p, k1)
+                // The k nearest within r_T: a bounded heap of k that only points
+                // within r_T enter, and the tree's branches beyond r_T pruned from the
+                // start (unbounded, the heap fills with far points first).
+                tree.nearest_n_within::<SquaredEuclidean>(p, r_t * r_t, k1, false)
                     .into_iter()
-                    .filter(|n| n.item as usize != i && n.distance <= r_t * r_t)
+                    .filter(|n| n.item as usize != i)
                     .map(|n| n.item as usize)
                     .collect()
             })
