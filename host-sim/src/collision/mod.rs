@@ -672,7 +672,9 @@ impl CollisionContext {
         // The shape halfway first (one look at every pair of bodies: a change that
         // folds the chain through itself is mostly caught there), then the map (in
         // clutter it refuses most changes, for less than the walk below), then the walk
-        // that proves limits and self-collision all along.
+        // that proves limits and self-collision all along. `check_shape` itself, not
+        // the per-thread memo of `shape_validity`: a halfway shape is seldom asked
+        // twice, and would push out the shape the planner does ask again.
         check_shape(&self.params, &from.lerp(to, 0.5)).map_err(|v| EdgeCollision {
             t: 0.5,
             collision: Collision::Shape(v),

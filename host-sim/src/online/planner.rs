@@ -280,8 +280,9 @@ impl OnlinePlanner {
             return (Outcome::Looked, 0.0);
         }
         // Any motion along the chain passes through its hull: where part of it is
-        // unseen, no piece that moves the tail can be found, so the chain looks at it
-        // first, once where it rests, rather than spend the deadline finding nothing.
+        // unseen, no piece that moves a unit through that part can be found, so the
+        // chain looks at it first, once where it rests, rather than spend the deadline
+        // finding nothing.
         if !self.looked_at_hull && self.look_at_hull() {
             return (Outcome::Looked, 0.0);
         }
