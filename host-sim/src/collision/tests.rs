@@ -2,8 +2,9 @@
 
 use std::sync::Arc;
 
-use aerial_chain_core::validity::Body;
+use aerial_chain_core::validity::{check_transition, Body};
 use aerial_chain_core::{ChainParams, Shape};
+use nalgebra::Vector3;
 use proptest::prelude::*;
 
 use super::exact::check_config_exact;
