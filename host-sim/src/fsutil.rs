@@ -13,7 +13,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| in_directory(dir, e))?;
     tmp.write_all(bytes)?;
     // Temporary files are created private (0600); the result is an ordinary file.
     #[cfg(unix)]
@@ -25,6 +25,17 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+/// The error of creating the temporary file in `dir`, told in terms of `dir` (the
+/// temporary file's own name means nothing to the user).
+fn in_directory(dir: &Path, e: std::io::Error) -> std::io::Error {
+    let what = match e.kind() {
+        std::io::ErrorKind::NotFound => "does not exist".to_string(),
+        std::io::ErrorKind::PermissionDenied => "is not writable".to_string(),
+        kind => format!("cannot take a new file ({kind})"),
+    };
+    std::io::Error::new(e.kind(), format!("the directory {} {what}", dir.display()))
 }
 
 /// Whether `path` is `-`: standard input or output rather than a file.
@@ -122,7 +133,9 @@ mod tests {
     }
 
     #[test]
-    fn missing_directory_is_an_error_not_a_panic() {
-        assert!(write_atomic(Path::new("/nonexistent-dir-arc/x"), b"x").is_err());
+    fn missing_directory_is_an_error_that_names_it() {
+        let e = write_atomic(Path::new("/nonexistent-dir-arc/x"), b"x").unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::NotFound);
+        assert_eq!(e.to_string(), "the directory /nonexistent-dir-arc does not exist");
     }
 }
