@@ -100,15 +100,13 @@ impl ChainArgs {
     }
 }
 
-/// Where the map comes from: an OctoMap file or a built-in scenario.
+/// Where the map comes from: an OctoMap file or a built-in scenario (one of the two;
+/// a missing map names both).
 #[derive(Args, Debug, Clone)]
+#[command(group(clap::ArgGroup::new("map_source").required(true).args(["map", "scenario"])))]
 pub struct MapArgs {
     /// OctoMap binary tree (.bt) to work on.
-    #[arg(
-        long,
-        conflicts_with = "scenario",
-        required_unless_present = "scenario"
-    )]
+    #[arg(long, conflicts_with = "scenario")]
     pub map: Option<PathBuf>,
     /// Built-in scenario: window, maze, silos, corridor, corridor:LENGTH, a family instance
     /// (passage:, forest:, slot:, pipe: or shaft:KEY=VALUE,...) or the large generated maps
