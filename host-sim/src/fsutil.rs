@@ -92,10 +92,26 @@ where
     T: serde::de::DeserializeOwned,
     E: std::fmt::Display,
 {
-    let file: T =
-        serde_json::from_str(text).map_err(|e| format!("not an {format} JSON file: {e}"))?;
+    let file: T = serde_json::from_str(text).map_err(|e| not_of_format(text, format, &e))?;
     check(&file).map_err(|e| e.to_string())?;
     Ok(file)
+}
+
+/// Why `text` did not parse as a JSON file of `format` (`e`, serde's error): where
+/// its `format` field names another format, that (a plan given where a trajectory is
+/// asked for fails on some field deep inside, which says nothing of the mistake);
+/// else serde's error.
+pub fn not_of_format(text: &str, format: &str, e: &serde_json::Error) -> String {
+    #[derive(serde::Deserialize)]
+    struct Tagged {
+        format: String,
+    }
+    match serde_json::from_str::<Tagged>(text) {
+        Ok(t) if t.format != format => {
+            format!("this is an {:?} file; an {format} file is expected here", t.format)
+        }
+        _ => format!("not an {format} JSON file: {e}"),
+    }
 }
 
 /// Writes `bytes` to standard output when `path` is `-`, else atomically to the file.
@@ -130,6 +146,27 @@ mod tests {
             1,
             "no temporary file left"
         );
+    }
+
+    #[test]
+    fn a_file_of_another_format_is_named_by_its_format() {
+        #[derive(serde::Deserialize, Debug)]
+        #[allow(dead_code)]
+        struct Wanted {
+            format: String,
+            samples: Vec<f64>,
+        }
+        let check = |_: &Wanted| Ok::<(), String>(());
+        let other = r#"{"format": "arc-plan/1", "waypoints": []}"#;
+        let e = parse_checked::<Wanted, _, _>(other, "arc-trajectory/1", check).unwrap_err();
+        assert_eq!(
+            e,
+            r#"this is an "arc-plan/1" file; an arc-trajectory/1 file is expected here"#
+        );
+        // The right format with a bad field still says which field.
+        let bad = r#"{"format": "arc-trajectory/1", "samples": "x"}"#;
+        let e = parse_checked::<Wanted, _, _>(bad, "arc-trajectory/1", check).unwrap_err();
+        assert!(e.starts_with("not an arc-trajectory/1 JSON file: invalid type"), "{e}");
     }
 
     #[test]

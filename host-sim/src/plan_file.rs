@@ -211,12 +211,13 @@ pub enum PlanError {
         source: std::io::Error,
     },
     /// The file is not valid JSON of the plan's shape.
-    #[error("{path}: not an arc-plan/1 JSON file: {source}")]
+    #[error("{path}: {what}")]
     Json {
         /// The file.
         path: String,
-        /// The cause.
-        source: serde_json::Error,
+        /// What is wrong: the file's own format where it names another, else serde's
+        /// error (`fsutil::not_of_format`).
+        what: String,
     },
     /// The content breaks the format's rules.
     #[error("{path}: {what}")]
@@ -424,9 +425,9 @@ impl Plan {
 
     /// Parses and checks a plan's text (as [`Self::read`]); `name` names it in errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, PlanError> {
-        let plan: Plan = serde_json::from_str(text).map_err(|source| PlanError::Json {
+        let plan: Plan = serde_json::from_str(text).map_err(|e| PlanError::Json {
             path: name.to_string(),
-            source,
+            what: crate::fsutil::not_of_format(text, FORMAT, &e),
         })?;
         plan.check().map_err(|what| PlanError::Invalid {
             path: name.to_string(),

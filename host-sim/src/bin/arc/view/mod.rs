@@ -77,8 +77,10 @@ fn read_flight(path: &std::path::Path, units: usize) -> Result<scene::Flown, Cli
         std::fs::read_to_string(path)
     }
     .map_err(|e| CliError::input(format!("{name}: cannot read the file: {e}")))?;
-    let file: FlightFile = serde_json::from_str(&text)
-        .map_err(|e| CliError::input(format!("{name}: not an arc-sim/1 JSON file: {e}")))?;
+    let file: FlightFile = serde_json::from_str(&text).map_err(|e| {
+        let what = crate::fsutil::not_of_format(&text, aerial_chain::sim::FLIGHT_FORMAT, &e);
+        CliError::input(format!("{name}: {what}"))
+    })?;
     scene::flown(file, units).map_err(|e| CliError::input(format!("{name}: {e}")))
 }
 
