@@ -108,7 +108,10 @@ pub fn not_of_format(text: &str, format: &str, e: &serde_json::Error) -> String 
     }
     match serde_json::from_str::<Tagged>(text) {
         Ok(t) if t.format != format => {
-            format!("this is an {:?} file; an {format} file is expected here", t.format)
+            format!(
+                "this is an {:?} file; an {format} file is expected here",
+                t.format
+            )
         }
         _ => format!("not an {format} JSON file: {e}"),
     }
@@ -166,13 +169,19 @@ mod tests {
         // The right format with a bad field still says which field.
         let bad = r#"{"format": "arc-trajectory/1", "samples": "x"}"#;
         let e = parse_checked::<Wanted, _, _>(bad, "arc-trajectory/1", check).unwrap_err();
-        assert!(e.starts_with("not an arc-trajectory/1 JSON file: invalid type"), "{e}");
+        assert!(
+            e.starts_with("not an arc-trajectory/1 JSON file: invalid type"),
+            "{e}"
+        );
     }
 
     #[test]
     fn missing_directory_is_an_error_that_names_it() {
         let e = write_atomic(Path::new("/nonexistent-dir-arc/x"), b"x").unwrap_err();
         assert_eq!(e.kind(), std::io::ErrorKind::NotFound);
-        assert_eq!(e.to_string(), "the directory /nonexistent-dir-arc does not exist");
+        assert_eq!(
+            e.to_string(),
+            "the directory /nonexistent-dir-arc does not exist"
+        );
     }
 }

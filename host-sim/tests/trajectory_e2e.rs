@@ -82,6 +82,27 @@ fn a_long_corridor_at_seven_units_is_threaded_along_a_band_within_twice_its_path
     assert!(ratio <= 2.0, "{ratio}");
 }
 
+/// Eight units in `maze`: the chain follows its head round three wall ends, along the
+/// route eased out to the middle of each gap, and the trajectory, verified exactly,
+/// lasts at most twice head path / speed (issue 38; 2.5x before easing).
+#[test]
+fn eight_units_follow_an_eased_route_round_the_maze_within_twice_their_path() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let plan = dir.path().join("plan.json");
+    let tr = dir.path().join("t.json");
+    plan_scenario("maze", 8, &["--trajectory", s(&tr)], &plan).expect("a plan");
+    arc_ok(&["verify", "--scenario", "maze", "--trajectory", s(&tr)])
+        .unwrap_or_else(|e| panic!("trajectory not verified: {e}"));
+    let read = |p: &std::path::Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).expect("file")).expect("JSON")
+    };
+    assert_eq!(read(&plan)["stats"]["refinement"]["threaded"], true);
+    let st = read(&tr)["stats"].clone();
+    let f = |k: &str| st[k].as_f64().unwrap_or_else(|| panic!("stats.{k}"));
+    let ratio = f("duration_s") / (f("head_path_m") / 0.5);
+    assert!(ratio <= 2.0, "{ratio}");
+}
+
 #[test]
 fn trajectory_command_csv_and_refusals() {
     let dir = tempfile::tempdir().expect("temporary directory");

@@ -25,6 +25,7 @@ mod carry;
 mod checker;
 pub(crate) mod connect;
 pub(crate) mod construction;
+mod ease;
 mod error;
 pub(crate) mod follow;
 mod goal_pose;

@@ -7,7 +7,9 @@ use std::sync::Arc;
 use super::{Budget, Context, Draft, Stage, Unit};
 use crate::collision::CollisionContext;
 use crate::planner::checker::{Checker, Counted};
-use crate::planner::thread::Threading;
+use crate::planner::numeric::TIE;
+use crate::planner::plan_ops::Quality;
+use crate::planner::thread::{Passing, Threading};
 use crate::planner::widen::{widen, Widening};
 use crate::planner::{carry, refine, shorten, Step};
 
@@ -255,19 +257,28 @@ impl Stage for Thread {
         };
         // Where the plan's own route cannot be followed (it wanders where the search
         // tried shape after shape, or hugs corners), the route pulled into a band.
-        let mut r = threading.follow(&draft.ctx, &draft.steps[0], cx.follow_step, cx.deadline);
+        let start = &draft.steps[0];
+        let mut r = threading.follow(&draft.ctx, start, cx.follow_step, cx.deadline);
         if r.is_err() {
             if let Some(banded) = Threading::banded(&draft.ctx, &draft.steps, &cx.s.thread) {
-                let again = banded.follow(&draft.ctx, &draft.steps[0], cx.follow_step, cx.deadline);
+                let again = banded.follow(&draft.ctx, start, cx.follow_step, cx.deadline);
                 if again.is_ok() {
                     (threading, r) = (banded, again);
                 }
             }
         }
+        let mut r = r.map(|(steps, _)| {
+            let p = threading.measure(&draft.ctx, &steps, true);
+            (steps, p)
+        });
+        if let Ok((steps, passing)) = &r {
+            if let Some((t, e)) = eased_if_better(&threading, steps, passing, &draft.ctx, cx) {
+                (threading, r) = (t, Ok(e));
+            }
+        }
         match r {
-            Ok((steps, _)) => {
+            Ok((steps, passing)) => {
                 budget.used = steps.len() as u64;
-                let passing = threading.measure(&draft.ctx, &steps, true);
                 draft.notes.threading = Some(Arc::new((threading, passing)));
                 draft.steps = steps;
             }
@@ -278,4 +289,36 @@ impl Stage for Thread {
         }
         (draft, budget)
     }
+}
+
+/// The route `threading` the chain followed in `steps` (passing as `passing`), eased
+/// (`super::super::ease`: its bends opened, as a follower turns every link through
+/// each), and the chain following that, where: the route bends tighter than easing's
+/// reach (else easing leaves it as it is); the eased route turns no more than
+/// `thread.motion` beyond it, seen a link at a time (a follower turns each link by
+/// about that; else it is not followed at all); and the chain following it moves its
+/// angles no more, and passes the pinches and the map at least as well.
+fn eased_if_better(
+    threading: &Threading,
+    steps: &[Step],
+    passing: &Passing,
+    ctx: &CollisionContext,
+    cx: &Context,
+) -> Option<(Threading, (Vec<Step>, Passing))> {
+    let l = ctx.params().link_length as f64;
+    if threading.tightest_bend(l) >= crate::planner::ease::reach(ctx) {
+        return None;
+    }
+    let start = &steps[0];
+    let eased = threading.eased(ctx, start, cx.follow_step, cx.deadline);
+    if eased.turning(l) > threading.turning(l) + cx.s.thread.motion {
+        return None;
+    }
+    let (followed, _) = eased.follow(ctx, start, cx.follow_step, cx.deadline).ok()?;
+    let after = eased.measure(ctx, &followed, true);
+    let motion = |s: &[Step]| Quality::of(s).shape_motion_rad;
+    let better = motion(&followed) <= motion(steps) + TIE
+        && after.share + TIE >= passing.share
+        && after.narrowest + TIE >= passing.narrowest;
+    better.then_some((eased, (followed, after)))
 }
