@@ -48,6 +48,10 @@ const COARSEST: f64 = 2.0;
 /// Levels, each with its segments halved: from two links to half a link.
 const LEVELS: usize = 3;
 
+/// A level's rounds of a kind stop once no point moves this share of a voxel:
+/// derived, a hundredth, far below what the field resolves.
+const SETTLED: f64 = 0.01;
+
 /// The route `route` (start first) eased, for a chain whose link next to the head
 /// points along `lead` at the start (a unit vector from the head back along the body:
 /// the route leaves the start the other way); at most `rounds` rounds of each kind at
@@ -62,8 +66,7 @@ pub(super) fn eased(
     let l = ctx.params().link_length as f64;
     let late = || deadline.is_some_and(|d| Instant::now() >= d);
     let mut band = Band::along(ctx, route, COARSEST * l, lead);
-    // A level's rounds of a kind stop once no point moves a hundredth of a voxel.
-    let settled = ctx.field().grid().resolution() / 100.0;
+    let settled = ctx.field().grid().resolution() * SETTLED;
     for level in 0..LEVELS {
         if level > 0 {
             band.halve();
