@@ -97,6 +97,36 @@ pub(super) fn reach(ctx: &CollisionContext) -> f64 {
     params.unit_radius as f64 + ctx.clearance_margin() + params.link_length as f64
 }
 
+/// How much `route` turns, seen a link at a time: the sum of the angles between the
+/// consecutive segments of the route resampled every link length `l` (rad; a follower
+/// turns each link by about that, and wiggles shorter than a link turn no link).
+pub(super) fn turning(route: &[Point3<f64>], l: f64) -> f64 {
+    let dirs: Vec<Vector3<f64>> = resampled(route, l)
+        .windows(2)
+        .filter_map(|w| (w[1] - w[0]).try_normalize(TIE))
+        .collect();
+    dirs.windows(2)
+        .map(|d| d[0].dot(&d[1]).clamp(-1.0, 1.0).acos())
+        .sum()
+}
+
+/// The tightest bend of `route` seen a link at a time: the least radius of the circles
+/// through three consecutive points of the route resampled every link length `l` (m;
+/// infinite for a straight route).
+pub(super) fn tightest_bend(route: &[Point3<f64>], l: f64) -> f64 {
+    resampled(route, l)
+        .windows(3)
+        .map(|w| {
+            let (u, v) = (w[0] - w[1], w[2] - w[1]);
+            let area2 = u.cross(&v).norm();
+            match area2 > TIE {
+                true => u.norm() * v.norm() * (u - v).norm() / (2.0 * area2),
+                false => f64::INFINITY,
+            }
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Points of a route being eased, each with its clearance floor.
 struct Band<'a> {
     ctx: &'a CollisionContext,

@@ -115,35 +115,9 @@ impl Threading {
         }
     }
 
-    /// How much the route turns, seen a link at a time: the sum of the angles between
-    /// the consecutive segments of the route resampled every link length `l` (rad;
-    /// a follower turns each link by about that, and wiggles shorter than a link
-    /// turn no link).
-    pub(super) fn turning(&self, l: f64) -> f64 {
-        let dirs: Vec<Vector3<f64>> = super::ease::resampled(&self.route, l)
-            .windows(2)
-            .filter_map(|w| (w[1] - w[0]).try_normalize(TINY))
-            .collect();
-        dirs.windows(2)
-            .map(|d| d[0].dot(&d[1]).clamp(-1.0, 1.0).acos())
-            .sum()
-    }
-
-    /// The tightest bend of the route seen a link at a time: the least radius of the
-    /// circles through three consecutive points of the route resampled every link
-    /// length `l` (m; infinite for a straight route).
-    pub(super) fn tightest_bend(&self, l: f64) -> f64 {
-        super::ease::resampled(&self.route, l)
-            .windows(3)
-            .map(|w| {
-                let (u, v) = (w[0] - w[1], w[2] - w[1]);
-                let area2 = u.cross(&v).norm();
-                match area2 > TINY {
-                    true => u.norm() * v.norm() * (u - v).norm() / (2.0 * area2),
-                    false => f64::INFINITY,
-                }
-            })
-            .fold(f64::INFINITY, f64::min)
+    /// The route the head follows (start first).
+    pub(super) fn route(&self) -> &[Point3<f64>] {
+        &self.route
     }
 
     /// The head route `route` (start first) as it is, with no pinch straightened: for a

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use super::{Budget, Context, Draft, Stage, Unit};
 use crate::collision::CollisionContext;
 use crate::planner::checker::{Checker, Counted};
+use crate::planner::ease;
 use crate::planner::numeric::TIE;
 use crate::planner::plan_ops::Quality;
 use crate::planner::thread::{Passing, Threading};
@@ -306,12 +307,12 @@ fn eased_if_better(
     cx: &Context,
 ) -> Option<(Threading, (Vec<Step>, Passing))> {
     let l = ctx.params().link_length as f64;
-    if threading.tightest_bend(l) >= crate::planner::ease::reach(ctx) {
+    if ease::tightest_bend(threading.route(), l) >= ease::reach(ctx) {
         return None;
     }
     let start = &steps[0];
     let eased = threading.eased(ctx, start, cx.follow_step, cx.deadline);
-    if eased.turning(l) > threading.turning(l) + cx.s.thread.motion {
+    if ease::turning(eased.route(), l) > ease::turning(threading.route(), l) + cx.s.thread.motion {
         return None;
     }
     let (followed, _) = eased.follow(ctx, start, cx.follow_step, cx.deadline).ok()?;
