@@ -18,18 +18,20 @@ fn u_turn() -> CollisionContext {
     CollisionContext::new(Arc::new(DistanceField::new(g)), ChainParams::new(6), 0.05).unwrap()
 }
 
+/// The route through `points`.
+fn route_of(points: &[[f64; 3]]) -> Vec<Point3<f64>> {
+    points.iter().map(|&p| p.into()).collect()
+}
+
 /// A head route hugging the wall's end (0.35 m from it), as the search finds them.
 fn hugging() -> Vec<Point3<f64>> {
-    [
+    route_of(&[
         [1.0, 0.5, 1.0],
         [1.6, 3.0, 1.0],
         [2.0, 3.35, 1.0],
         [2.4, 3.0, 1.0],
         [3.0, 0.5, 1.0],
-    ]
-    .iter()
-    .map(|&p| p.into())
-    .collect()
+    ])
 }
 
 /// The tightest bend of `route`: the least radius of the circles through points
@@ -92,10 +94,7 @@ fn a_route_down_a_passage_keeps_to_its_middle() {
     g.fill_box([1.0, 1.45, 0.0], [3.0, 2.0, 2.0], Cell::Occupied);
     let ctx =
         CollisionContext::new(Arc::new(DistanceField::new(g)), ChainParams::new(4), 0.05).unwrap();
-    let route: Vec<Point3<f64>> = [[0.3, 0.9, 1.0], [3.7, 1.0, 1.0]]
-        .iter()
-        .map(|&p| p.into())
-        .collect();
+    let route = route_of(&[[0.3, 0.9, 1.0], [3.7, 1.0, 1.0]]);
     let eased = eased(&ctx, &route, None, 100, None);
     assert!(nearest(&ctx, &eased) + BETWEEN / 2.0 >= nearest(&ctx, &route));
     for p in resampled(&eased, 0.05) {
@@ -117,10 +116,7 @@ fn past_its_deadline_the_route_keeps_its_ends_and_its_clearance() {
 
 #[test]
 fn resampling_steps_evenly_and_keeps_the_ends() {
-    let route: Vec<Point3<f64>> = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.33, 0.0]]
-        .iter()
-        .map(|&p| p.into())
-        .collect();
+    let route = route_of(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.33, 0.0]]);
     let r = resampled(&route, 0.05);
     assert_eq!(r[0], route[0]);
     assert_eq!(r[r.len() - 1], route[2]);
@@ -138,10 +134,7 @@ fn resampling_steps_evenly_and_keeps_the_ends() {
 
 #[test]
 fn densifying_keeps_every_vertex() {
-    let route: Vec<Point3<f64>> = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.7, 0.0]]
-        .iter()
-        .map(|&p| p.into())
-        .collect();
+    let route = route_of(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.7, 0.0]]);
     let r = densified(&route, 0.5);
     assert_eq!(r.len(), 5);
     assert_eq!(r[2], route[1]);
