@@ -292,14 +292,10 @@ impl<'a> Band<'a> {
     }
 }
 
-/// `route` with every segment split into equal pieces of at most `h` (its vertices
-/// kept).
+/// `route` sampled every `h` at most, its vertices kept (threading's densifying),
+/// with repeated points (a route's zero-length segments) left out.
 fn densified(route: &[Point3<f64>], h: f64) -> Vec<Point3<f64>> {
-    let mut out = vec![route[0]];
-    for w in route.windows(2) {
-        let n = ((w[1] - w[0]).norm() / h).ceil().max(1.0) as usize;
-        out.extend((1..=n).map(|k| w[0] + (w[1] - w[0]) * (k as f64 / n as f64)));
-    }
+    let (mut out, _) = super::thread::densify(route, h);
     out.dedup();
     out
 }

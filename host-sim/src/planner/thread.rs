@@ -573,7 +573,7 @@ impl Router<'_> {
 
 /// The route sampled every `h` (m) at most, each vertex kept; with each sample,
 /// whether it is a vertex of the route.
-fn densify(route: &[Point3<f64>], h: f64) -> (Vec<Point3<f64>>, Vec<bool>) {
+pub(super) fn densify(route: &[Point3<f64>], h: f64) -> (Vec<Point3<f64>>, Vec<bool>) {
     let mut pts = vec![route[0]];
     let mut vertex = vec![true];
     for w in route.windows(2) {

@@ -34,22 +34,6 @@ fn hugging() -> Vec<Point3<f64>> {
     ])
 }
 
-/// The tightest bend of `route`: the least radius of the circles through points
-/// `0.25` m apart along it (m).
-fn tightest(route: &[Point3<f64>]) -> f64 {
-    let p = resampled(route, 0.25);
-    p.windows(3)
-        .map(|w| {
-            let (u, v) = (w[0] - w[1], w[2] - w[1]);
-            let area2 = u.cross(&v).norm();
-            match area2 > 1e-12 {
-                true => u.norm() * v.norm() * (u - v).norm() / (2.0 * area2),
-                false => f64::INFINITY,
-            }
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
 /// Between the samples the floors are kept at (every half voxel), a segment may pass
 /// up to a quarter voxel nearer (the distance is 1-Lipschitz); the follower's exact
 /// checks hold the clearance margin.
@@ -73,7 +57,7 @@ fn a_bend_round_a_walls_end_opens_and_keeps_its_clearance() {
     assert_eq!(eased[eased.len() - 1], route[4]);
     // Round the wall's end the bend opens from a corner to a radius of the reach
     // (r_u + c + l = 0.7 m) or more, within the 1.5 m beyond it.
-    let (before, after) = (tightest(&route), tightest(&eased));
+    let (before, after) = (tightest_bend(&route, 0.25), tightest_bend(&eased, 0.25));
     assert!(
         before < 0.3,
         "the search's route turns on corners: {before}"
