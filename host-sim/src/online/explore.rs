@@ -19,6 +19,7 @@ use aerial_chain_core::ChainParams;
 use nalgebra::Point3;
 use serde::{Deserialize, Serialize};
 
+use super::belief::Belief;
 use super::planner::OnlinePlanner;
 use super::record::{Outcome, ReplanRecord, Trigger};
 use super::settings::{OnlineError, OnlineSettings};
@@ -119,7 +120,8 @@ pub struct Exploration {
     /// committed on (unknown space occupied), `None` when valid.
     pub audit: Option<Vec<Option<String>>>,
     /// Time to build both fields (the commit and the route field) from scratch on the
-    /// final seen map (s), with `audit`: what an update of both is compared with.
+    /// final seen map (s; the median of five builds), with `audit`: what an update of
+    /// both is compared with.
     pub rebuild_s: Option<f64>,
 }
 
@@ -508,21 +510,7 @@ impl Loop<'_> {
                 })
                 .collect()
         });
-        let rebuild_s = self.settings.audit.then(|| {
-            let belief = planner.belief();
-            let grids = [belief.commit_field().grid(), belief.route_field().grid()];
-            grids
-                .map(|g| {
-                    let grid = g.clone();
-                    let began = Instant::now();
-                    let field = DistanceField::new(grid);
-                    let s = began.elapsed().as_secs_f64();
-                    drop(field);
-                    s
-                })
-                .iter()
-                .sum()
-        });
+        let rebuild_s = self.settings.audit.then(|| rebuild_time(planner.belief()));
         let mut sensing = self.sensing;
         sensing.known = planner.belief().seen().known();
         Ok(Exploration {
@@ -537,6 +525,33 @@ impl Loop<'_> {
             rebuild_s,
         })
     }
+}
+
+/// Rebuilds of the audit: the median of this many is compared with the median update,
+/// so that one slow or fast build (a page fault, a busy core) does not make the ratio.
+const REBUILDS: usize = 5;
+
+/// Median time to build both fields (the commit and the route field) from scratch on
+/// `belief`'s grids (s), over [`REBUILDS`] builds.
+fn rebuild_time(belief: &Belief) -> f64 {
+    let grids = [belief.commit_field().grid(), belief.route_field().grid()];
+    let mut times: Vec<f64> = (0..REBUILDS)
+        .map(|_| {
+            grids
+                .map(|g| {
+                    let grid = g.clone();
+                    let began = Instant::now();
+                    let field = DistanceField::new(grid);
+                    let s = began.elapsed().as_secs_f64();
+                    drop(field);
+                    s
+                })
+                .iter()
+                .sum()
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[REBUILDS / 2]
 }
 
 /// How a flight that ended by itself ended.
