@@ -119,6 +119,9 @@ pub struct Exploration {
     /// With `audit`: per piece, the exact test's first violation on the map it was
     /// committed on (unknown space occupied), `None` when valid.
     pub audit: Option<Vec<Option<String>>>,
+    /// Simulated time the chain spent turning in place to look (s): the durations of
+    /// the committed pieces that only turn the head yaw ([`super::Piece::is_look`]).
+    pub looking_s: f64,
     /// Time to build both fields (the commit and the route field) from scratch on the
     /// final seen map (s; the median of five builds), with `audit`: what an update of
     /// both is compared with.
@@ -511,6 +514,12 @@ impl Loop<'_> {
                 .collect()
         });
         let rebuild_s = self.settings.audit.then(|| rebuild_time(planner.belief()));
+        let looking_s = planner
+            .pieces()
+            .iter()
+            .filter(|p| p.is_look())
+            .map(|p| p.trajectory.duration())
+            .sum();
         let mut sensing = self.sensing;
         sensing.known = planner.belief().seen().known();
         Ok(Exploration {
@@ -522,6 +531,7 @@ impl Loop<'_> {
             seen: planner.belief().seen().clone(),
             sensing,
             audit,
+            looking_s,
             rebuild_s,
         })
     }

@@ -33,6 +33,21 @@ pub struct Piece {
     pub map: Option<Grid>,
 }
 
+/// The plan stat that marks a turn in place toward the route (look before moving).
+const TURN_TO_LOOK: &str = "turn_to_look";
+/// The plan stat that marks a turn in place toward the chain's unseen hull.
+const LOOK_AT_HULL: &str = "look_at_hull";
+
+impl Piece {
+    /// Whether the piece is a turn in place to look (toward the route, or at the
+    /// chain's unseen hull), not a motion toward the goal.
+    pub fn is_look(&self) -> bool {
+        [TURN_TO_LOOK, LOOK_AT_HULL]
+            .iter()
+            .any(|why| self.plan.stats.contains_key(*why))
+    }
+}
+
 /// Plans a chain's motion toward a goal while the map grows (see the module docs).
 pub struct OnlinePlanner {
     params: ChainParams,
@@ -432,7 +447,7 @@ impl OnlinePlanner {
         if !self.turn_needed(self.end[3] as f32, look) {
             return false;
         }
-        self.commit_turn(look, "turn_to_look")
+        self.commit_turn(look, TURN_TO_LOOK)
     }
 
     /// Commits a turn of the head yaw toward where the units' sensors see most of the
@@ -447,7 +462,7 @@ impl OnlinePlanner {
         let Some(yaw) = look::best_view(&self.sensor, &centres, self.end[3], &unseen) else {
             return false;
         };
-        self.commit_turn(yaw as f32, "look_at_hull")
+        self.commit_turn(yaw as f32, LOOK_AT_HULL)
     }
 
     /// Commits a turn of the head yaw to `yaw` in place (a head yaw moves no body, so

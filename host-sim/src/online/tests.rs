@@ -281,9 +281,13 @@ fn a_chain_looks_at_its_unseen_hull_before_it_searches_a_piece() {
     let back = &planner.pieces()[1].plan;
     assert!(back.stats.contains_key("turn_to_look"), "{:?}", back.stats);
     assert_eq!(planner.pieces_searched(), 0);
+    assert!(planner.pieces().iter().all(|p| p.is_look()));
     let third = planner.replan(0.2, Trigger::CommitShort);
     assert_ne!(third.outcome, Outcome::Looked);
     assert!(planner.pieces_searched() > 0);
+    if third.outcome == Outcome::Committed {
+        assert!(!planner.pieces()[2].is_look());
+    }
 }
 
 /// A straight chain at rest in a square tunnel, looking along itself, cannot move its
@@ -307,5 +311,16 @@ fn a_chain_looking_along_itself_looks_back_at_its_hull_then_flies_along_itself()
     assert!(
         turned > 2.5,
         "the head yaw turned at most {turned} rad at rest"
+    );
+    // Those turns are counted as looking: 2.5 rad at the angular-rate limit at least,
+    // and less than the whole time to the goal.
+    let rate = crate::trajectory::Limits::default().angular_rate;
+    let ExploreEnd::Reached { t } = ex.end else {
+        panic!("not reached: {:?}", ex.end);
+    };
+    assert!(
+        ex.looking_s >= 2.5 / rate && ex.looking_s < t,
+        "looking {} s of {t} s",
+        ex.looking_s
     );
 }

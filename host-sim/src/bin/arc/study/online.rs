@@ -32,6 +32,8 @@ pub struct OnlineRun {
     pub time_s: f64,
     /// The finished-map flight of the same query (s; NaN when it failed).
     pub finished_s: f64,
+    /// Of the time to goal, the turns in place to look (s).
+    pub looking_s: f64,
     /// Replans.
     pub replans: usize,
     /// Pieces committed.
@@ -58,6 +60,12 @@ impl OnlineRun {
     /// Time to goal over the finished-map flight.
     pub fn ratio(&self) -> f64 {
         self.time_s / self.finished_s
+    }
+
+    /// Time to goal less the turns in place to look, over the finished-map flight:
+    /// what the flying costs, apart from looking.
+    pub fn ratio_without_looks(&self) -> f64 {
+        (self.time_s - self.looking_s) / self.finished_s
     }
 
     /// How many times cheaper the median update of both fields was than rebuilding
@@ -123,6 +131,7 @@ fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
     if !ex.end.reached() {
         run.time_s = f64::NAN;
     }
+    run.looking_s = ex.looking_s;
     run.replans = s.replans;
     run.pieces = ex.pieces;
     run.pieces_invalid = ex
@@ -140,13 +149,17 @@ fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
 }
 
 /// The CSV's columns.
-const CSV_COLUMNS: [Column<OnlineRun>; 19] = [
+const CSV_COLUMNS: [Column<OnlineRun>; 21] = [
     ("scenario", |r| csv_field(&r.scenario)),
     ("units", |r| r.units.to_string()),
     ("end", |r| csv_field(&r.end)),
     ("time_to_goal_s", |r| format!("{:.2}", r.time_s)),
     ("finished_map_s", |r| format!("{:.2}", r.finished_s)),
     ("ratio", |r| format!("{:.3}", r.ratio())),
+    ("looking_s", |r| format!("{:.2}", r.looking_s)),
+    ("ratio_without_looks", |r| {
+        format!("{:.3}", r.ratio_without_looks())
+    }),
     ("replans", |r| r.replans.to_string()),
     ("pieces", |r| r.pieces.to_string()),
     ("pieces_invalid", |r| r.pieces_invalid.to_string()),
@@ -180,23 +193,26 @@ pub fn markdown(runs: &[OnlineRun]) -> String {
     };
     let ok = runs.iter().filter(|r| r.success()).count();
     let ratios = sorted(&|r| r.ratio());
+    let flying = sorted(&|r| r.ratio_without_looks());
     let p95 = sorted(&|r| r.latency_s[1]);
     let max = sorted(&|r| r.latency_s[2]);
     let speedup = sorted(&|r| r.speedup());
     let mut md = String::from(
-        "| scenario | N | end | time to goal (s) | finished map (s) | ratio | replans | pieces (invalid) | latency median / p95 / max (ms) | update (ms) | rebuild / update | min clearance (m) |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| scenario | N | end | time to goal (s) | finished map (s) | ratio | looking (s) | ratio without looks | replans | pieces (invalid) | latency median / p95 / max (ms) | update (ms) | rebuild / update | min clearance (m) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in runs {
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {:.1} | {:.1} | {:.2} | {} | {} ({}) | {:.1} / {:.1} / {:.1} | {:.2} | {:.0}x | {:.3} |",
+            "| {} | {} | {} | {:.1} | {:.1} | {:.2} | {:.1} | {:.2} | {} | {} ({}) | {:.1} / {:.1} / {:.1} | {:.2} | {:.0}x | {:.3} |",
             r.scenario,
             r.units,
             r.end,
             r.time_s,
             r.finished_s,
             r.ratio(),
+            r.looking_s,
+            r.ratio_without_looks(),
             r.replans,
             r.pieces,
             r.pieces_invalid,
@@ -211,13 +227,16 @@ pub fn markdown(runs: &[OnlineRun]) -> String {
     let _ = writeln!(
         md,
         "\n{ok} of {} runs reached the goal without contact, every piece valid on its map; \
-         time to goal over the finished-map flight: median {:.2}, largest {:.2}; replan \
+         time to goal over the finished-map flight: median {:.2}, largest {:.2} (less the \
+         turns in place to look: median {:.2}, largest {:.2}); replan \
          latency p95 over runs: median {:.1} ms, largest {:.1} ms; largest replan {:.1} ms; \
          update of both fields against rebuilding both: median {:.0}x cheaper, least \
          {:.0}x.",
         runs.len(),
         quantile(&ratios, 0.5),
         ratios.last().copied().unwrap_or(f64::NAN),
+        quantile(&flying, 0.5),
+        flying.last().copied().unwrap_or(f64::NAN),
         quantile(&p95, 0.5) * 1e3,
         p95.last().copied().unwrap_or(f64::NAN) * 1e3,
         max.last().copied().unwrap_or(f64::NAN) * 1e3,
