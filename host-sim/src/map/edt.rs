@@ -12,18 +12,17 @@ use super::grid::Grid;
 pub(crate) const NONE: u32 = u32::MAX;
 
 /// One Felzenszwalb-Huttenlocher pass over a row `f` (squared distances, `NONE` for
-/// infinity) with optional virtual obstacle sites just outside both ends. Writes the
-/// result into `out`. `v`, `z` are scratch of length `f.len() + 3`.
-fn edt_1d(f: &[u32], walls: bool, out: &mut [u32], v: &mut [i64], z: &mut [f64]) {
+/// infinity) with optional virtual obstacle sites just outside its start and its end
+/// (`walls`). Writes the result into `out`. `v`, `z` are scratch of length `f.len() + 3`.
+fn edt_1d(f: &[u32], walls: [bool; 2], out: &mut [u32], v: &mut [i64], z: &mut [f64]) {
     let n = f.len() as i64;
     // Sites are positions q in -1..=n (the ends only with walls) and f(q) finite.
+    let wall = |w: bool| if w { 0 } else { NONE };
     let fq = |q: i64| -> u32 {
-        if q < 0 || q >= n {
-            if walls {
-                0
-            } else {
-                NONE
-            }
+        if q < 0 {
+            wall(walls[0])
+        } else if q >= n {
+            wall(walls[1])
         } else {
             f[q as usize]
         }
@@ -168,6 +167,13 @@ impl Scratch {
 
     /// The 1D transform of `row[..n]` into `out[..n]`.
     pub(crate) fn run(&mut self, n: usize, walls: bool) {
+        self.run_part(n, [walls; 2]);
+    }
+
+    /// [`Self::run`] of a part of a line: a wall just before its start and just after
+    /// its end only where `walls` says (the part reaches that end of the line, whose
+    /// walls are on).
+    pub(crate) fn run_part(&mut self, n: usize, walls: [bool; 2]) {
         let (row, out) = (&self.row[..n], &mut self.out[..n]);
         edt_1d(row, walls, out, &mut self.v, &mut self.z);
     }

@@ -15,7 +15,10 @@
 //! the update redoes only the window of cells whose output may change (the `line`
 //! module: a cell further from every changed input than its old output's distance
 //! keeps it, and past the first such cell every one does), each value the exact minimum
-//! the transform computes; the z columns it transforms again in full, with the build's
+//! the transform computes: a narrow window value by value, a wide one by the build's
+//! own 1D transform of the part of the column within reach of it (sites beyond the
+//! reach provably cannot lower its values; `line::window_transform`); the z columns it
+//! transforms again in full, with the build's
 //! own 1D transform (their old values are not kept). Changed EDT values go through the
 //! build's own conversion: equal to a recomputation, which a property test checks to
 //! the bit. The row gaps depend on their row only and are redone for the flipped rows;
@@ -31,7 +34,8 @@
 //! site), and the field must equal a recomputation to the bit.
 //!
 //! # Cost
-//! A row costs two sweeps and its row gaps (`nx` each); a y column its window; a z
+//! A row costs two sweeps and its row gaps (`nx` each); a y column its window and
+//! the window's reach (the root of its largest value) either side; a z
 //! column through a changed `g2` costs `nz`: the reach of the change along each axis
 //! in turn, never the whole map unless the change reaches it (an obstacle added to an
 //! otherwise empty row of an open map changes that whole row's `g1`). The grid does not
@@ -42,7 +46,8 @@ use super::super::grid::{Cell, Grid};
 use super::super::row_gaps::row_gaps_of;
 use super::{stored_bound, DistanceField};
 
-/// Windows of a y column at least this wide are redone by transforming the column.
+/// Windows of a y column at least this wide are redone by transforming the part of
+/// the column within their reach.
 const WIDE_WINDOW: usize = 8;
 
 /// The partial transforms an update starts from: the EDT's x and y passes over the
@@ -224,17 +229,19 @@ impl DistanceField {
             let (g1, g2) = (&kept.g1, &mut kept.g2);
             let (lo, hi) = line::window(ny, a, b, |q| g2[first + nx * q]);
             // A value costs a scan as long as its distance; past a few cells a window
-            // costs less as the whole column's transform (both exact: the same numbers).
-            let whole = hi - lo >= WIDE_WINDOW;
-            if whole {
-                for p in 0..ny {
-                    s.row[p] = g1[first + nx * p];
-                }
-                s.run(ny, walls);
+            // costs less as the transform of the column's part within its reach (both
+            // exact: the same numbers).
+            let wide = hi - lo >= WIDE_WINDOW;
+            // Where the window's values start in `s.out`.
+            let mut at = 0;
+            if wide {
+                let f = |p: usize| g1[first + nx * p];
+                let old_max = (lo..=hi).map(|q| g2[first + nx * q]).max().unwrap_or(NONE);
+                at = line::window_transform(&mut s, ny, walls, (lo, hi), old_max, f);
             }
             for y in lo..=hi {
-                let new = if whole {
-                    s.out[y]
+                let new = if wide {
+                    s.out[y - at]
                 } else {
                     line::value_at(ny, walls, y, |p| g1[first + nx * p])
                 };
