@@ -121,6 +121,16 @@ pub(super) fn window_transform(
     old_max: u32,
     f: impl Fn(usize) -> u32,
 ) -> usize {
+    // Transforms cells `start..=end` into `s.out[..]`; the whole line is `0..=n - 1`.
+    let transform = |s: &mut Scratch, start: usize, end: usize| {
+        for p in start..=end {
+            s.row[p - start] = f(p);
+        }
+        s.run_part(
+            end + 1 - start,
+            [walls && start == 0, walls && end == n - 1],
+        );
+    };
     let mut want = old_max;
     for _ in 0..2 {
         if want == NONE {
@@ -134,13 +144,7 @@ pub(super) fn window_transform(
         if start == 0 && end == n - 1 {
             break;
         }
-        for p in start..=end {
-            s.row[p - start] = f(p);
-        }
-        s.run_part(
-            end + 1 - start,
-            [walls && start == 0, walls && end == n - 1],
-        );
+        transform(s, start, end);
         // The nearest cell left out of the part, either way (none: the line's end).
         let left_out = |q: usize| {
             let before = (start > 0).then(|| q + 1 - start);
@@ -157,10 +161,7 @@ pub(super) fn window_transform(
         }
         want = (lo..=hi).map(|q| values[q - start]).max().unwrap_or(NONE);
     }
-    for p in 0..n {
-        s.row[p] = f(p);
-    }
-    s.run(n, walls);
+    transform(s, 0, n - 1);
     0
 }
 
