@@ -9,6 +9,7 @@ use aerial_chain_core::validity::{check_shape, check_transition, Body};
 use aerial_chain_core::{Shape, MAX_UNITS};
 use nalgebra::{Point3, Vector3};
 
+use super::sweep;
 use super::{
     finite3, shape_validity, Collision, CollisionContext, EdgeCollision, OutOfBounds, FK_TOLERANCE,
     TRANSITION_MARGIN,
@@ -78,7 +79,7 @@ impl CollisionContext {
                         };
                         return Err(EdgeCollision { t: frac, collision });
                     }
-                    horizon[i] = u + m;
+                    horizon[i] = u + self.run_on(m, q, q, dir, self.unit_r, dist - u);
                 }
             }
             for k in 0..n - 1 {
@@ -92,13 +93,39 @@ impl CollisionContext {
                         };
                         return Err(EdgeCollision { t: frac, collision });
                     }
-                    horizon[n + k] = u + m;
+                    horizon[n + k] = u + self.run_on(m, a, b, dir, self.link_r, dist - u);
                 }
             }
             if horizon[..nb].iter().all(|&h| h > dist) {
                 return Ok(());
             }
         }
+    }
+
+    /// How far a body of radius `body_r` (the segment `a b`; a unit when `a == b`) with
+    /// margin `m` is proven free on a translation along `dir` with `left` (m) to go: `m`,
+    /// or, where that is a small part of the way left (beside a wall), as far as the
+    /// cubes near its path let it run ([`sweep::free_run`]) when that is further.
+    fn run_on(
+        &self,
+        m: f64,
+        a: Point3<f64>,
+        b: Point3<f64>,
+        dir: Vector3<f64>,
+        body_r: f64,
+        left: f64,
+    ) -> f64 {
+        if m * RUN_STEPS >= left {
+            return m;
+        }
+        m.max(sweep::free_run(
+            &self.field,
+            a,
+            b,
+            dir,
+            body_r + self.min_step,
+            left,
+        ))
     }
 
     /// Conservative check of a shape-change edge: the head stays at `head`, the shape
@@ -222,6 +249,11 @@ impl CollisionContext {
         }
     }
 }
+
+/// A body is run against the cubes near its path ([`sweep::free_run`]) when its margin
+/// would take more than this many steps to cover the way left: below it, the walk costs
+/// less than reading the cubes.
+const RUN_STEPS: f64 = 4.0;
 
 /// The smallest of `horizons` (infinity when there are none): how far every body is
 /// proven free.

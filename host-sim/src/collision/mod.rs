@@ -32,12 +32,18 @@
 //! bodies whose horizon ends there, with the units at the ends of such a link), so
 //! open space is crossed in a few samples and no collision is ever skipped. A body
 //! whose margin falls below [`CollisionContext::min_step`] is reported as colliding
-//! (conservatively), which also bounds the work per edge. Limits and self-collision along a shape change come
-//! from `aerial_chain_core::validity::check_transition`.
+//! (conservatively), which also bounds the work per edge. On a translation a body whose
+//! margin is a small part of the way left (sliding beside a wall, where each bound proves
+//! only a thin ball) is moved against the obstacle cubes near its path instead (`sweep`:
+//! each cube grown by the body's radius into a box), which proves the rest of its way in
+//! one reading where the walk would measure it again every few millimetres. Limits and
+//! self-collision along a shape change come from
+//! `aerial_chain_core::validity::check_transition`.
 
 mod edges;
 pub(crate) mod exact;
 pub(crate) mod point_clearance;
+mod sweep;
 pub(crate) mod verify;
 
 use std::cell::RefCell;

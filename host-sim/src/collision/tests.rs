@@ -472,3 +472,54 @@ fn nearest_obstacle_sees_voxels_set_after_a_search() {
         exact::nearest_obstacle(&g, q, q, 0.06).is_some_and(|n| (n.distance - 0.05).abs() < 1e-12)
     );
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(500))]
+
+    /// A free run is proven: all along a run that is not empty, from its start to its
+    /// end, the moving point or segment keeps more than its radius from every obstacle
+    /// cube (by reading every voxel), inside the grid, across its faces and beyond.
+    #[test]
+    fn a_free_run_keeps_the_body_clear(
+        grid in small_grid(),
+        a in proptest::array::uniform3(-1.0f64..1.6),
+        along in proptest::array::uniform3(-0.4f64..0.4),
+        point in any::<bool>(),
+        dir in proptest::array::uniform3(-1.0f64..1.0),
+        radius in 0.0f64..0.3,
+        reach in 0.0f64..1.0,
+    ) {
+        let Some(dir) = Vector3::from(dir).try_normalize(1e-3) else {
+            return Ok(());
+        };
+        let a = Point3::from(a);
+        let b = if point { a } else { a + Vector3::from(along) };
+        let field = DistanceField::new(grid);
+        let run = sweep::free_run(&field, a, b, dir, radius, reach);
+        prop_assert!((0.0..=reach).contains(&run), "{run} outside [0, {reach}]");
+        for k in (0..=64).filter(|_| run > 0.0) {
+            let s = run * k as f64 / 64.0;
+            let hit = exact::nearest_obstacle(field.grid(), a + dir * s, b + dir * s, radius);
+            prop_assert!(hit.is_none(), "at {s} of a run of {run}: {hit:?}");
+        }
+    }
+}
+
+#[test]
+fn a_body_beside_a_wall_runs_along_it_and_stops_short_of_it() {
+    // A wall of cubes x in [3.0, 3.2] across the whole box.
+    let f = map(&[([3.05, 0.0, 0.0], [3.15, 4.0, 2.0])], true);
+    let (along, towards) = (Vector3::y(), Vector3::x());
+    let unit = Point3::new(2.75, 0.5, 1.0);
+    // 0.25 m from the wall, radius 0.2: all the way along it.
+    assert_eq!(sweep::free_run(&f, unit, unit, along, 0.2, 3.0), 3.0);
+    // Towards it: stops where the sphere would come within 0.2 m, less rounding.
+    let run = sweep::free_run(&f, unit, unit, towards, 0.2, 1.0);
+    assert!((0.05 - 1e-6..0.05).contains(&run), "{run}");
+    // A link parallel to the wall, 0.21 m off it, runs along it too; tilted to 0.19 m
+    // at one end it is already within the radius.
+    let (a, b) = (Point3::new(2.79, 0.5, 1.0), Point3::new(2.79, 0.5, 1.5));
+    assert_eq!(sweep::free_run(&f, a, b, along, 0.2, 3.0), 3.0);
+    let b = Point3::new(2.81, 0.5, 1.5);
+    assert_eq!(sweep::free_run(&f, a, b, along, 0.2, 3.0), 0.0);
+}
