@@ -50,6 +50,7 @@ impl CollisionContext {
                 }
             }
         }
+        self.end_in_map(&p0[..n], delta)?;
         let dir = if dist > 0.0 {
             delta * (1.0 / dist)
         } else {
@@ -100,6 +101,25 @@ impl CollisionContext {
                 return Ok(());
             }
         }
+    }
+
+    /// A translation of the unit centres `p0` by `delta` that ends with a unit proven
+    /// inside the map (its grown sphere meets an obstacle, by the field's bound and
+    /// what that bound can lose) is refused before the walk: most refused translations
+    /// end in a wall, and the walk, which would refuse it too, measures its way up to
+    /// it first.
+    fn end_in_map(&self, p0: &[Point3<f64>], delta: Vector3<f64>) -> Result<(), EdgeCollision> {
+        for (i, u) in p0.iter().enumerate() {
+            let w = u + delta;
+            if self.field.clearance_above(w, self.unit_r) + self.field_loss < self.unit_r {
+                let collision = Collision::Map {
+                    body: Body::Unit(i as u8),
+                    point: w,
+                };
+                return Err(EdgeCollision { t: 1.0, collision });
+            }
+        }
+        Ok(())
     }
 
     /// How far a body of radius `body_r` (the segment `a b`; a unit when `a == b`) with
