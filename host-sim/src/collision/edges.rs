@@ -18,8 +18,10 @@ use super::{
 impl CollisionContext {
     /// Conservative check of a translation edge: the shape stays, the head moves along
     /// the straight segment `from -> to`. Checks the shape once (limits, self-collision),
-    /// the unit centres at both ends against the bounds (the box is convex), and every
-    /// body along the motion by certified horizons (see the module docs).
+    /// the unit centres at both ends against the bounds (the box is convex), the units at
+    /// the end against the map (refusing at once where one is proven inside it), and
+    /// every body along the motion by certified horizons (see the module docs), run
+    /// against the cubes near its path beside a wall.
     pub fn check_translation(
         &self,
         from: impl Into<Point3<f64>>,

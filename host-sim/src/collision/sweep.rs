@@ -56,20 +56,20 @@ pub(super) fn free_run(
         grown,
         r,
     };
-    let (y0, ny) = (first.y as i32, ny as usize);
+    let (y0, ny) = (first.y as i64, ny as usize);
     let mut across_y = [(0.0, 0.0); MAX_SPAN];
     for (j, o) in across_y.iter_mut().enumerate().take(ny) {
-        *o = body.overlap(1, y0 + j as i32);
+        *o = body.overlap(1, y0 + j as i64);
     }
     let mut run = reach;
-    for z in first.z as i32..=last.z as i32 {
+    for z in first.z as i64..=last.z as i64 {
         let (z_in, z_out) = body.overlap(2, z);
         for (j, &(y_in, y_out)) in across_y[..ny].iter().enumerate() {
             // While the body's box is across this row's grown slabs in y and z.
             let from = z_in.max(y_in).max(0.0);
             let to = z_out.min(y_out).min(run);
             if from <= to {
-                run = run.min(body.first_in_row(field, y0 + j as i32, z, from, to));
+                run = run.min(body.first_in_row(field, y0 + j as i64, z, from, to));
                 if run <= 0.0 {
                     return 0.0;
                 }
@@ -94,7 +94,7 @@ struct Body {
 impl Body {
     /// The times `(in, out)` at which the body's box overlaps, along axis `a`, the grown
     /// slab of the cubes with lattice index `k` there; `in > out` when it never does.
-    fn overlap(&self, a: usize, k: i32) -> (f64, f64) {
+    fn overlap(&self, a: usize, k: i64) -> (f64, f64) {
         let (c_lo, c_hi) = (
             k as f64 * self.r - self.grown,
             (k as f64 + 1.0) * self.r + self.grown,
@@ -115,13 +115,14 @@ impl Body {
     /// cube of row `(y, z)`, while it is across the row's slabs; infinity when it does
     /// not. The row's cubes are read in the direction of motion (the first obstacle the
     /// box reaches is met first), skipping along the row's gaps.
-    fn first_in_row(&self, field: &DistanceField, y: i32, z: i32, from: f64, to: f64) -> f64 {
+    fn first_in_row(&self, field: &DistanceField, y: i64, z: i64, from: f64, to: f64) -> f64 {
         let grid = field.grid();
         let (d, r, g) = (self.dir.x, self.r, self.grown);
         let reach_lo = self.lo.x + (from * d).min(to * d) - g;
         let reach_hi = self.hi.x + (from * d).max(to * d) + g;
         let (k_lo, k_hi) = (floor(reach_lo / r) as i64, floor(reach_hi / r) as i64);
-        let Some(start) = grid.row_start(y, z) else {
+        let row = i32::try_from(y).ok().zip(i32::try_from(z).ok());
+        let Some(start) = row.and_then(|(y, z)| grid.row_start(y, z)) else {
             // A row beyond the grid is all unknown: an obstacle, it is met as soon as
             // the body is across it (its cubes span the body's whole reach in x).
             return if grid.unknown_is_occupied() {
@@ -148,7 +149,7 @@ impl Body {
                 }
             };
             if ahead == 0 {
-                let (x_in, x_out) = self.overlap(0, k as i32);
+                let (x_in, x_out) = self.overlap(0, k);
                 let at = x_in.max(from);
                 if at <= x_out.min(to) {
                     return at;
