@@ -543,7 +543,17 @@ impl CollisionContext {
             } else {
                 a
             };
-            let raw = self.bound(s, r + 2.0 * w);
+            // A piece longer than two voxels is split rather than measured where the
+            // field's bound falls short: its `need` reaches far, and measuring the cubes
+            // within it reads many rows, where its two halves cost two lookups (a piece
+            // of two voxels or less is measured). On the same 2000 cases, per 200:
+            // translations 460 -> 387 us, shape changes 1.62 -> 1.47 ms (splitting
+            // pieces longer than one voxel: 410 us, 1.56 ms; than four: 400 us, 1.55 ms).
+            let raw = if w > self.field.grid().resolution() {
+                self.field.clearance_above(s, r + 2.0 * w)
+            } else {
+                self.bound(s, r + 2.0 * w)
+            };
             // Bounds for the piece: from its centre, and from both ends of the link.
             let m = (raw - w).max(ca - t1).max(cb - (len - t0)) - r;
             let good_enough = m >= 0.5 * (raw - r) || m >= 0.5 * (ca.min(cb) - r);
