@@ -131,23 +131,18 @@ impl Body {
                 f64::INFINITY
             };
         };
-        let (cells, gaps) = (grid.raw_row_at(start), field.row_gaps_at(start));
+        let gaps = field.row_gaps_at(start);
         let x0 = grid.origin()[0] as i64;
+        // Beyond the row's ends every voxel is unknown.
+        let beyond = if grid.unknown_is_occupied() { 0 } else { 1 };
         let step = if d >= 0.0 { 1 } else { -1 };
         let mut k = if d >= 0.0 { k_lo } else { k_hi };
         while (k_lo..=k_hi).contains(&k) {
             // Free voxels ahead, by the row's gaps (beyond the row: one at a time).
-            let ahead = match usize::try_from(k - x0).ok().and_then(|i| gaps.get(i)) {
-                Some(&gap) => gap as i64,
-                None => {
-                    let raw = usize::try_from(k - x0).ok().and_then(|i| cells.get(i));
-                    if grid.is_obstacle_raw(raw.copied()) {
-                        0
-                    } else {
-                        1
-                    }
-                }
-            };
+            let ahead = usize::try_from(k - x0)
+                .ok()
+                .and_then(|i| gaps.get(i))
+                .map_or(beyond, |&gap| gap as i64);
             if ahead == 0 {
                 let (x_in, x_out) = self.overlap(0, k);
                 let at = x_in.max(from);
