@@ -20,6 +20,7 @@ pub trait KinematicsScalar: RealField + Copy {
 
 impl KinematicsScalar for f32 {
     /// libm's `sincosf`, so that every unit and the host compute the same bits.
+    #[inline]
     fn sincos(self) -> (f32, f32) {
         libm::sincosf(self)
     }
@@ -34,6 +35,7 @@ impl KinematicsScalar for f64 {
 
 /// Generic form of [`link_direction`]:
 /// `d = [cos yaw cos pitch, sin yaw cos pitch, -sin pitch]`.
+#[inline]
 pub fn link_direction_of<T: KinematicsScalar>(pitch: T, yaw: T) -> Vector3<T> {
     let (st, ct) = pitch.sincos();
     let (sp, cp) = yaw.sincos();
@@ -58,6 +60,7 @@ pub fn directions(shape: &Shape) -> [Vector3<f32>; MAX_LINKS] {
 /// The chain recurrence `out[0] = head`, `out[k + 1] = out[k] - link_length * dirs[k]`,
 /// for as many links as `dirs` yields and `out` holds. Returns the number of unit
 /// centres written.
+#[inline]
 pub fn chain_from_directions<T: KinematicsScalar>(
     link_length: T,
     head: Vector3<T>,
@@ -83,6 +86,7 @@ pub fn chain_from_directions<T: KinematicsScalar>(
 /// docs/model.md's order: head yaw, then each link's pitch and yaw; the head yaw is not
 /// read), head first, written into `out`. Returns the number of unit centres written:
 /// `N`, or fewer when `out` is shorter.
+#[inline]
 pub fn positions_into<T: KinematicsScalar>(
     link_length: T,
     head: Vector3<T>,

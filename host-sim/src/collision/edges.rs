@@ -37,7 +37,8 @@ impl CollisionContext {
         }
         shape_validity(&self.params, shape).map_err(|v| at0(Collision::Shape(v)))?;
         let n = shape.units();
-        let p0 = self.points(from, shape);
+        let mut p0 = [from; MAX_UNITS];
+        self.points(from, shape, &mut p0);
         let delta = to - from;
         let dist = delta.norm();
         for (t, q) in [(0.0, from), (1.0, to)] {
@@ -216,7 +217,8 @@ impl CollisionContext {
             } else {
                 from.lerp(to, t as f32)
             };
-            let p = self.points(head, &s);
+            let mut p = [head; MAX_UNITS];
+            self.points(head, &s, &mut p);
             for i in 0..n {
                 if !needs_bound(&horizon, n, i, t) {
                     continue;

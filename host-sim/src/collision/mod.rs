@@ -51,11 +51,11 @@ use std::fmt;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use aerial_chain_core::kinematics::offsets;
+use aerial_chain_core::kinematics::positions_into;
 use aerial_chain_core::validity::{check_shape, Body, Violation};
 use aerial_chain_core::{ChainParams, Shape, MAX_UNITS};
 
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector3};
 
 use crate::map::distance::DistanceField;
 
@@ -412,15 +412,17 @@ impl CollisionContext {
         (0..3).all(|a| p[a] >= lo[a] + FK_TOLERANCE && p[a] <= hi[a] - FK_TOLERANCE)
     }
 
-    /// Unit centres for `head` and `shape`.
+    /// Unit centres for `head` and `shape`, written into `p` (the caller's array: one
+    /// returned by value was copied, at a twentieth of a placement's time).
     #[inline]
-    fn points(&self, head: Point3<f64>, shape: &Shape) -> WorldPoints {
-        let o = offsets(&self.params, shape);
-        let mut p = [Point3::origin(); MAX_UNITS];
+    fn points(&self, head: Point3<f64>, shape: &Shape, p: &mut WorldPoints) {
+        // `kinematics::offsets`, in place for the same reason.
+        let mut o = [Vector3::zeros(); MAX_UNITS];
+        let z = Vector3::zeros();
+        positions_into(self.params.link_length, z, shape.as_slice(), &mut o);
         for (q, v) in p.iter_mut().zip(o.iter()).take(shape.units()) {
             *q = head + v.cast::<f64>();
         }
-        p
     }
 
     fn check_input(&self, head: Point3<f64>, shape: &Shape) -> Result<(), Collision> {
@@ -462,13 +464,19 @@ impl CollisionContext {
         self.counters.configs.fetch_add(1, Ordering::Relaxed);
         self.check_input(head, shape)?;
         let n = shape.units();
-        let p = self.points(head, shape);
+        let mut p = [head; MAX_UNITS];
+        self.points(head, shape, &mut p);
         let mut c = [0.0f64; MAX_UNITS];
+        // Every unit's one-lookup bound first, side by side; the units it leaves short
+        // are bounded as `bound` does (which gives the same value where it suffices).
+        self.field.clearance_coarse_each(&p[..n], &mut c[..n]);
         for i in 0..n {
             if !self.inside(p[i]) {
                 return Err(Collision::OutOfBounds(OutOfBounds::unit(i, p[i])));
             }
-            c[i] = self.bound(p[i], self.unit_r);
+            if c[i] <= self.unit_r {
+                c[i] = self.bound(p[i], self.unit_r);
+            }
             if c[i] <= self.unit_r {
                 return Err(Collision::Map {
                     body: Body::Unit(i as u8),
