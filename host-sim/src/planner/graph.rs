@@ -108,11 +108,6 @@ impl LazyGraph {
         &self.edges[v]
     }
 
-    /// The edges leaving `v`, to reweigh them.
-    pub fn edges_mut(&mut self, v: VertexId) -> &mut [Edge] {
-        &mut self.edges[v]
-    }
-
     /// The edge `a -> b`, if there is one.
     pub fn edge(&self, a: VertexId, b: VertexId) -> Option<&Edge> {
         self.edges[a].iter().find(|e| e.to == b)

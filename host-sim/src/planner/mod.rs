@@ -33,6 +33,7 @@ pub(crate) mod graph;
 pub(crate) mod lattice;
 mod linked;
 pub(crate) mod motion;
+mod near;
 mod numeric;
 mod pipeline;
 pub(crate) mod plan_ops;
