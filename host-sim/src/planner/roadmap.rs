@@ -4,9 +4,9 @@
 //! `M_VT` head positions are sampled uniformly in the map's box where the head's
 //! sphere is free; every vertex is joined to its `k` nearest within `r_T` (points
 //! binned in cubes, [`super::near`]), a query's vertices to every vertex within `r_T`
-//! (a k-d tree, kiddo). Edges are NOT checked when the roadmap is built: a query runs A* on the
-//! unchecked graph, then checks the edges of the path it found, marks the bad ones
-//! and searches again (lazy PRM). Checked edges stay checked, so later queries on
+//! (a k-d tree, kiddo). Edges are NOT checked when the roadmap is built: a query runs
+//! A* on the unchecked graph, then checks the edges of the path it found, marks the
+//! bad ones and searches again (lazy PRM). Checked edges stay checked, so later queries on
 //! the same roadmap get cheaper (multi-query).
 
 use std::time::Instant;
