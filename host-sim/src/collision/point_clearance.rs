@@ -112,6 +112,15 @@ pub fn exact_clearance(
     best
 }
 
+/// [`exact_clearance`] with `stop` 0, to the bit: the exact distance from `p` to the
+/// nearest obstacle cube, capped at `cap`, 0 in one. Read as [`exact_clearance_above`]
+/// reads (the rows straight across `p` first, a row's state only where it could lower
+/// the minimum); a point within a cube is measured by `exact_clearance` itself. The
+/// widening's and the threading's measures of a passage read it often.
+pub(crate) fn exact_distance(field: &DistanceField, p: Point3<f64>, cap: f64) -> f64 {
+    exact_clearance_above(field, p, 0.0, cap).unwrap_or_else(|| exact_clearance(field, p, 0.0, cap))
+}
+
 /// [`exact_clearance`] as the conservative checks use it: `Some(v)` with `v` the value
 /// it returns (to the bit: the exact distance from `p` to the nearest obstacle cube,
 /// capped at `cap`) when that value is above `stop`, `None` when it is not (some cube

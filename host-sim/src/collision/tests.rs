@@ -433,6 +433,20 @@ proptest! {
         let above = point_clearance::exact_clearance_above(&field, p, stop, cap);
         prop_assert_eq!(above.map(f64::to_bits), (e > stop).then_some(e.to_bits()));
     }
+
+    /// `exact_distance` is `exact_clearance` with `stop` 0, to the bit, within a cube too.
+    #[test]
+    fn exact_distance_is_exact_clearance_from_zero(
+        grid in small_grid(),
+        p in proptest::array::uniform3(-1.0f64..1.6),
+        cap in 0.0f64..0.8,
+    ) {
+        let p = Point3::from(p);
+        let field = DistanceField::new(grid);
+        let e = point_clearance::exact_clearance(&field, p, 0.0, cap);
+        let d = point_clearance::exact_distance(&field, p, cap);
+        prop_assert_eq!(d.to_bits(), e.to_bits());
+    }
 }
 
 #[test]

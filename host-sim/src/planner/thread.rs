@@ -31,7 +31,7 @@ use super::plan_ops::{differs, head_route};
 use super::widen::{distance, gradient, zeta};
 use super::{follow, Checker, Step, ThreadSettings};
 use crate::collision::exact::positions_f64;
-use crate::collision::point_clearance::exact_clearance;
+use crate::collision::point_clearance::exact_distance;
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
 use crate::collision::CollisionContext;
 
@@ -192,7 +192,7 @@ impl Threading {
                     {
                         continue;
                     }
-                    let d = exact_clearance(field, p, 0.0, cap).min(cap) - r_u;
+                    let d = exact_distance(field, p, cap).min(cap) - r_u;
                     out.narrowest = out.narrowest.min(d);
                     for k in alongside() {
                         out.share = out.share.min(d / k.middle.max(TIE));
@@ -434,7 +434,7 @@ impl Router<'_> {
                 .find(|t| self.ctx.clearance(c + sign * t * u) >= limit)
         };
         let (a, b) = (c - reach(-1.0)? * u, c + reach(1.0)? * u);
-        let middle = exact_clearance(self.ctx.field(), c, 0.0, limit).min(limit) - self.r_u();
+        let middle = exact_distance(self.ctx.field(), c, limit).min(limit) - self.r_u();
         (middle > 0.0 && self.head_flies(a, b)).then_some(Pinch { a, b, middle })
     }
 

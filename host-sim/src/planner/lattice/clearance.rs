@@ -3,7 +3,7 @@
 //! ([`exact_clearance`]).
 
 use super::HeadLattice;
-use crate::collision::point_clearance::exact_clearance;
+use crate::collision::point_clearance::exact_clearance_above;
 use crate::collision::FK_TOLERANCE;
 use crate::map::distance::DistanceField;
 
@@ -25,8 +25,7 @@ impl HeadLattice {
         if c + r_v * 3f64.sqrt() < self.r_min {
             return None;
         }
-        let e = exact_clearance(field, p, self.r_min, self.r_pref + self.h);
-        (e > self.r_min).then_some(e)
+        exact_clearance_above(field, p.into(), self.r_min, self.r_pref + self.h)
     }
 
     /// Whether `p` is inside the map's box (by the FK tolerance).

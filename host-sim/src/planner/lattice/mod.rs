@@ -54,7 +54,6 @@ mod search;
 #[cfg(test)]
 mod tests;
 
-pub use crate::collision::point_clearance::exact_clearance;
 pub(in crate::planner) use nodes::KeyHasher;
 pub use regions::Regions;
 pub(in crate::planner) use search::offsets26;

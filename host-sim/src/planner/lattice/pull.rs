@@ -2,7 +2,8 @@
 //! then the path pulled taut where the head's sphere can fly the segments.
 
 use super::nodes::Nodes;
-use super::{dist, exact_clearance, norm, search::offsets26, sub, HeadLattice};
+use super::{dist, norm, search::offsets26, sub, HeadLattice};
+use crate::collision::point_clearance::exact_distance;
 use crate::collision::CollisionContext;
 use crate::planner::numeric::{DIV_GUARD, MILLIMETRE, TIE};
 use crate::planner::plan_ops::farthest;
@@ -15,7 +16,7 @@ impl HeadLattice {
     pub(super) fn centre(&self, nodes: &mut Nodes, pts: &mut [[f64; 3]], clear: &mut [f64]) {
         let field = nodes.field;
         let cap = self.r_pref + self.tuning.centre_reach * self.h;
-        let exact = |p: [f64; 3]| exact_clearance(field, p, 0.0, cap);
+        let exact = |p: [f64; 3]| exact_distance(field, p.into(), cap);
         let offs = offsets26();
         for j in 1..pts.len().saturating_sub(1) {
             if clear[j] >= self.r_pref + 2.0 * self.h {

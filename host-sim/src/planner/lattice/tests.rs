@@ -10,6 +10,7 @@ use proptest::prelude::*;
 use super::nodes::{KeySet, Nodes};
 use super::search::offsets26;
 use super::*;
+use crate::collision::point_clearance::exact_clearance;
 use crate::map::distance::DistanceField;
 use crate::map::grid::{Cell, Grid};
 use crate::map::random_grids::scatter;

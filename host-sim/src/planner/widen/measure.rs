@@ -7,7 +7,7 @@ use nalgebra::{Point3, Vector3};
 
 use super::CAP;
 use crate::collision::exact::positions_f64;
-use crate::collision::point_clearance::exact_clearance;
+use crate::collision::point_clearance::{exact_clearance_above, exact_distance};
 use crate::collision::verify::{classify_edge, edge_intervals, edge_sample};
 use crate::collision::CollisionContext;
 use crate::planner::numeric::{TIE, TINY};
@@ -153,7 +153,7 @@ fn at_or_below(ctx: &CollisionContext, lb: f64, p: Point3<f64>, floor: f64) -> b
     let field = ctx.field();
     let reach = floor + r_u;
     lb - r_u >= CAP - field.grid().resolution()
-        || exact_clearance(field, p, reach, reach + TIE) <= reach
+        || exact_clearance_above(field, p, reach, reach + TIE).is_none()
 }
 
 /// Whether edge `e` of `steps` surely fails [`keeps_above`] at `floor`, by a look at
@@ -260,7 +260,7 @@ pub(in crate::planner) fn distance_below(ctx: &CollisionContext, p: Point3<f64>,
     if f.clearance_above(p, cap) >= cap {
         return cap;
     }
-    exact_clearance(f, p, 0.0, cap).min(cap)
+    exact_distance(f, p, cap).min(cap)
 }
 
 /// The gradient of [`distance`] at `p` (central differences, an eighth of a voxel).
