@@ -277,6 +277,21 @@ impl DistanceField {
         }
         let (sx, sxy) = (1, dims[0]);
         let sxyz = dims[0] * dims[1];
+        if !SKIP {
+            // The eight centres side by side (centre `c` is `i, j, k` = its bits), so
+            // that their square roots pair up in vector lanes; the best of them is the
+            // same in any order (no value is NaN: `p` is a number).
+            let mut v = [0f64; 8];
+            let mut s = [0f64; 8];
+            for c in 0..8 {
+                let (i, j, k) = (c & 1, (c >> 1) & 1, c >> 2);
+                v[c] = self.lb[idx[0][i] * sx + idx[1][j] * sxy + idx[2][k] * sxyz] as f64;
+                s[c] = d2[0][i] + (d2[1][j] + d2[2][k]);
+            }
+            let r = s.map(f64::sqrt);
+            let best = (0..8).fold(f64::NEG_INFINITY, |b, c| b.max(v[c] - r[c]));
+            return (best - ROUND_EPS).max(0.0);
+        }
         let mut best = f64::NEG_INFINITY;
         for k in 0..2 {
             for j in 0..2 {
