@@ -1,6 +1,6 @@
 //! Exact clearance of lattice points: the distance field's proven bound where it
 //! decides, the distance to the obstacle voxel cubes one by one where it does not
-//! ([`exact_clearance`]).
+//! ([`exact_clearance`](crate::collision::point_clearance::exact_clearance)).
 
 use super::HeadLattice;
 use crate::collision::point_clearance::exact_clearance_above;

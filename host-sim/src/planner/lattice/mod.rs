@@ -14,6 +14,8 @@
 //! `R`, and only where it does not are the obstacle cubes near the point measured one
 //! by one ([`exact_clearance`]). Points are 26-connected.
 //!
+//! [`exact_clearance`]: crate::collision::point_clearance::exact_clearance
+//!
 //! Once per map, setup labels the free regions of a relaxed voxel set
 //! ([`Regions`]): a query whose start and goal lie in different regions is refused at
 //! once (no lattice route can exist), whatever the map's size. The same sweep builds a
