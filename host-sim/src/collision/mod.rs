@@ -351,7 +351,14 @@ impl CollisionContext {
     /// although it is clear of both sides.
     #[inline]
     fn bound(&self, p: Point3<f64>, need: f64) -> f64 {
-        let c = self.field.clearance_above(p, need);
+        self.refined(p, need, self.field.clearance_above(p, need))
+    }
+
+    /// [`Self::bound`] from the field's bound `c` at `p` (as tight as
+    /// `clearance_above`'s where it matters for `need`): `c`, or the cubes nearby
+    /// measured where `c` falls just short.
+    #[inline]
+    fn refined(&self, p: Point3<f64>, need: f64, c: f64) -> f64 {
         if c > need || c + self.field_loss < need {
             return c;
         }
@@ -468,14 +475,15 @@ impl CollisionContext {
         self.points(head, shape, &mut p);
         let mut c = [0.0f64; MAX_UNITS];
         // Every unit's one-lookup bound first, side by side; the units it leaves short
-        // are bounded as `bound` does (which gives the same value where it suffices).
+        // get the fine query's, as `bound` would (`clearance_above` gives the fine
+        // query's value where the coarse one falls short), without its coarse lookup.
         self.field.clearance_coarse_each(&p[..n], &mut c[..n]);
         for i in 0..n {
             if !self.inside(p[i]) {
                 return Err(Collision::OutOfBounds(OutOfBounds::unit(i, p[i])));
             }
             if c[i] <= self.unit_r {
-                c[i] = self.bound(p[i], self.unit_r);
+                c[i] = self.refined(p[i], self.unit_r, self.field.clearance(p[i]));
             }
             if c[i] <= self.unit_r {
                 return Err(Collision::Map {

@@ -205,17 +205,23 @@ impl DistanceField {
     /// the grid while unknown space is occupied.
     #[inline]
     fn grid_coordinate(&self, x: f64, a: usize) -> Option<f64> {
+        let (rel, open) = self.axis_coordinate(x, a);
+        open.then_some(rel)
+    }
+
+    /// [`Self::grid_coordinate`] without the branch: the coordinate, and whether the
+    /// clearance there may be above 0.
+    #[inline]
+    fn axis_coordinate(&self, x: f64, a: usize) -> (f64, bool) {
         let q = x * self.inv_r;
-        if q.is_nan() {
-            return None;
-        }
         let rel = q - self.grid.origin()[a] as f64;
         // For the integer bound `dims`, `rel` and `rel.floor()` fall on the same side, so
         // the fine and the coarse query agree on what is outside.
-        if (rel < 0.0 || rel >= self.extent[a]) && self.grid.unknown_is_occupied() {
-            return None;
-        }
-        Some(rel)
+        let inside = (rel >= 0.0) & (rel < self.extent[a]);
+        (
+            rel,
+            !q.is_nan() & (inside | !self.grid.unknown_is_occupied()),
+        )
     }
 
     /// Squared distance along axis `a` from coordinate `x` to the centre of the voxel with
@@ -328,20 +334,16 @@ impl DistanceField {
     /// (a placement reads one per unit).
     #[inline]
     pub fn clearance_coarse_each(&self, ps: &[Point3<f64>], out: &mut [f64]) {
-        let unknown_free = !self.grid.unknown_is_occupied();
         for (p, o) in ps.iter().zip(out.iter_mut()) {
-            let mut ok = true;
+            let mut open = true;
             let mut rel = [0.0; 3];
             for a in 0..3 {
-                let q = p[a] * self.inv_r;
-                rel[a] = q - self.grid.origin()[a] as f64;
-                // As `grid_coordinate`: NaN, or outside with unknown space occupied, is 0.
-                let inside = (rel[a] >= 0.0) & (rel[a] < self.extent[a]);
-                ok &= !q.is_nan() & (inside | unknown_free);
+                let (r, ok) = self.axis_coordinate(p[a], a);
+                (rel[a], open) = (r, open & ok);
             }
             // A NaN coordinate reads voxel 0 (`clamped_floor`); its value is dropped.
             let c = self.coarse_at(p, &rel);
-            *o = if ok { c } else { 0.0 };
+            *o = if open { c } else { 0.0 };
         }
     }
 
