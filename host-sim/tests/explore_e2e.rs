@@ -143,13 +143,14 @@ fn a_sensor_that_sees_almost_nothing_keeps_the_chain_in_known_space() {
 }
 
 #[test]
-fn bad_sensor_settings_are_refused_naming_them() {
+fn bad_sensor_and_start_settings_are_refused_naming_them() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::write(d.join("wide.json"), r#"{"fov_h_deg": 200}"#).unwrap();
     std::fs::write(d.join("typo.json"), r#"{"fov_h": 60}"#).unwrap();
     let base = ["explore", "--scenario", "window", "--out", "f.json"];
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 6] = [
+        (&["--start-free", "all"], "--start-free"),
         (&["--sensor", "wide.json"], "fov_h_deg"),
         (&["--sensor", "typo.json"], "fov_h"),
         (&["--sensor-rate", "0"], "--sensor-rate"),

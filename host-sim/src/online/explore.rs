@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use super::belief::Belief;
 use super::planner::OnlinePlanner;
 use super::record::{Outcome, ReplanRecord, Trigger};
-use super::settings::{OnlineError, OnlineSettings};
+use super::settings::{OnlineError, OnlineSettings, StartFree};
 use crate::collision::{verify::verify_plan, CollisionContext, FK_TOLERANCE};
 use crate::flying::FlyOptions;
 use crate::map::{DistanceField, Grid};
@@ -229,6 +229,22 @@ pub enum ExploreError {
         /// Why.
         why: String,
     },
+    /// The space the start is taken to prove free (the chain's hull by default)
+    /// holds an obstacle of the world.
+    #[error(
+        "the start's hull is not free on the world map: the obstacle voxel at {voxel:.3?} lies \
+         {distance:.4} m from the chain's core, within the {reach:.4} m taken as free about it \
+         (start_free = hull: r_u plus the clearance about every unit and link); start farther \
+         from obstacles, or take only the grown bodies as free (--start-free bodies)"
+    )]
+    StartHull {
+        /// The radius taken as free about that body's core (m).
+        reach: f64,
+        /// The obstacle voxel's centre (m).
+        voxel: [f64; 3],
+        /// Its distance from the body's core (m).
+        distance: f64,
+    },
     /// The flight could record more than the memory budget.
     #[error("--time-limit: {0}")]
     Budget(String),
@@ -259,7 +275,7 @@ pub fn explore(
     // Pieces are timed as the flight times motion: one set of timing settings.
     let mut online = settings.online.clone();
     online.trajectory = settings.fly.timing;
-    check_start(truth, &params, start, online.plan.clearance)?;
+    check_start(truth, &params, start, &online)?;
     let mut planner = OnlinePlanner::new(
         params,
         tables,
@@ -314,13 +330,15 @@ fn check_budget(params: &ChainParams, settings: &ExploreSettings) -> Result<(), 
 }
 
 /// Refuses a start that is not valid on the truth with the clearance (grown by the
-/// FK tolerance, as the space about it is then marked seen free).
+/// FK tolerance), or where the space the planner takes as seen free about it
+/// (`settings.start_free`, when it is the hull) holds an obstacle of the truth.
 fn check_start(
     truth: &Grid,
     params: &ChainParams,
     start: &[f64],
-    clearance: f64,
+    settings: &OnlineSettings,
 ) -> Result<(), ExploreError> {
+    let clearance = settings.plan.clearance;
     let field = std::sync::Arc::new(DistanceField::new(truth.clone()));
     let bad = |why: String| ExploreError::Start { clearance, why };
     let ctx = CollisionContext::new(field, *params, clearance + FK_TOLERANCE)
@@ -329,7 +347,22 @@ fn check_start(
     let shape = aerial_chain_core::Shape::from_slice(params.units, &eta)
         .map_err(|e| bad(format!("{e:?}")))?;
     ctx.check_config(super::planner::head(start), &shape)
-        .map_err(|e| bad(e.to_string()))
+        .map_err(|e| bad(e.to_string()))?;
+    // A valid start proves its grown bodies free; the hull is the user's word, checked
+    // here on the world so that the simulated belief never holds what is false.
+    if settings.start_free != StartFree::Hull {
+        return Ok(());
+    }
+    for (a, b, r) in super::planner::start_free_space(params, start, settings) {
+        if let Some(hit) = crate::collision::exact::nearest_obstacle(truth, a, b, r) {
+            return Err(ExploreError::StartHull {
+                reach: r,
+                voxel: hit.voxel.into(),
+                distance: hit.distance,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The simulation loop's state.

@@ -39,7 +39,7 @@ pub use explore::{
 pub use planner::{OnlinePlanner, Piece};
 pub use record::{Outcome, ReplanRecord, Trigger};
 pub use route::{Radii, Route};
-pub use settings::{OnlineError, OnlineSettings, DEFAULT_DEADLINE_S};
+pub use settings::{OnlineError, OnlineSettings, StartFree, DEFAULT_DEADLINE_S};
 
 #[cfg(test)]
 mod tests;

@@ -78,7 +78,8 @@ impl OnlinePlanner {
     /// configuration `start` (`zeta`), toward `goal` (head within `goal_tol`), in the
     /// box of `bounds` (its contents are not read), knowing `prior` if given. The start
     /// must be valid with the clearance of `settings` (every body grown by it, on the
-    /// true map): the space within that reach of its bodies counts as seen free. The
+    /// true map), and free as far as `settings.start_free` says: that space counts as
+    /// seen free ([`super::StartFree`]). The
     /// units' `sensor` (every unit's the same) decides where the chain turns to look:
     /// along its route, and at the unseen part of its own hull before it moves.
     #[allow(clippy::too_many_arguments)]
@@ -105,9 +106,8 @@ impl OnlinePlanner {
             }
         }
         let mut belief = Belief::new(bounds, prior).map_err(|e| OnlineError::Map(e.to_string()))?;
-        let c = settings.plan.clearance;
-        belief.mark_clear(&bodies(&params, start, c + 2.0 * FK_TOLERANCE))?;
-        let grown = params.unit_radius as f64 + c + FK_TOLERANCE;
+        belief.mark_clear(&start_free_space(&params, start, &settings))?;
+        let grown = params.unit_radius as f64 + settings.plan.clearance + FK_TOLERANCE;
         Ok(Self {
             params,
             tables,
@@ -583,16 +583,32 @@ fn unit_centres(params: &ChainParams, zeta: &[f64]) -> Vec<Point3<f64>> {
         .collect()
 }
 
-/// The chain's bodies in configuration `zeta`, each as a segment and a radius grown
-/// by `grow`: a ball per unit, a capsule per link.
-pub(super) fn bodies(
+/// The space the start `zeta` is taken to prove free ([`super::StartFree`]): its bodies
+/// as far as `settings.start_free` reaches about the links, grown by the clearance and
+/// twice the FK tolerance (the start is checked valid within one of it).
+pub(super) fn start_free_space(
     params: &ChainParams,
     zeta: &[f64],
+    settings: &OnlineSettings,
+) -> Vec<(Point3<f64>, Point3<f64>, f64)> {
+    let link_reach = settings
+        .start_free
+        .link_reach(params.unit_radius as f64, params.link_radius as f64);
+    let grow = settings.plan.clearance + 2.0 * FK_TOLERANCE;
+    bodies(params, zeta, link_reach, grow)
+}
+
+/// The chain's bodies in configuration `zeta`, each as a segment and a radius grown
+/// by `grow`: a ball of `r_u` per unit, a capsule of `link_reach` per link.
+fn bodies(
+    params: &ChainParams,
+    zeta: &[f64],
+    link_reach: f64,
     grow: f64,
 ) -> Vec<(Point3<f64>, Point3<f64>, f64)> {
     let centres = unit_centres(params, zeta);
     let r_u = params.unit_radius as f64 + grow;
-    let r_l = params.link_radius as f64 + grow;
+    let r_l = link_reach + grow;
     let mut out: Vec<_> = centres.iter().map(|c| (*c, *c, r_u)).collect();
     out.extend(centres.windows(2).map(|w| (w[0], w[1], r_l)));
     out

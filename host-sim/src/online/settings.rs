@@ -26,6 +26,41 @@ pub struct OnlineSettings {
     /// Period of the route's replans when nothing cuts it (s): how soon a shortcut
     /// that sensing opened is taken. Default 1 s.
     pub route_period_s: f64,
+    /// What the start is taken to prove free (docs/online.md, "The start"). Default
+    /// [`StartFree::Hull`].
+    pub start_free: StartFree,
+}
+
+/// What an exploration takes as free about the chain at its start, before any sensor
+/// has seen it. The sensors look along the units' heading, so part of the space a unit
+/// passes as it moves along its link (the waist between two unit balls) may be seen by
+/// no sensor until the chain turns to look at it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum StartFree {
+    /// The chain's hull: every point within `r_u` plus the clearance of its unit
+    /// centres and of its links, the space any unit passes as it moves along the
+    /// chain. As exploration planners take a bubble about the robot as free at the
+    /// start: the chain starts where that much room is free (the simulator checks it
+    /// on the world). Lets the chain move along itself at once.
+    #[default]
+    Hull,
+    /// Only the bodies grown by the clearance (unit balls of `r_u` plus it, link
+    /// capsules of `r_l` plus it): what a valid start proves. For a start next to an
+    /// obstacle; a chain that must move along itself first turns to look at its hull
+    /// (a turn of up to half a circle and back).
+    Bodies,
+}
+
+impl StartFree {
+    /// The radius the start marks free about each link's axis, for a chain of unit
+    /// radius `r_u` and link radius `r_l` (before the clearance).
+    pub fn link_reach(self, r_u: f64, r_l: f64) -> f64 {
+        match self {
+            StartFree::Hull => r_u.max(r_l),
+            StartFree::Bodies => r_l,
+        }
+    }
 }
 
 impl Default for OnlineSettings {
@@ -35,6 +70,7 @@ impl Default for OnlineSettings {
             trajectory: crate::trajectory::Settings::default(),
             deadline_s: DEFAULT_DEADLINE_S,
             route_period_s: 1.0,
+            start_free: StartFree::default(),
         }
     }
 }

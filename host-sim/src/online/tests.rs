@@ -167,13 +167,15 @@ fn explore_audited(
     start: &[f64],
     goal: Point3<f64>,
     time_limit_s: f64,
+    start_free: StartFree,
 ) -> Exploration {
     let (params, tables) = chain(units);
-    let settings = ExploreSettings {
+    let mut settings = ExploreSettings {
         time_limit_s,
         audit: true,
         ..ExploreSettings::default()
     };
+    settings.online.start_free = start_free;
     let ex = explore(world, params, tables, start, goal, 0.3, None, &settings).unwrap();
     assert!(ex.end.reached(), "{:?}", ex.end);
     assert!(!ex.flight.report.contact);
@@ -190,7 +192,7 @@ fn a_dead_end_seen_late_is_left_the_way_the_chain_came() {
     let line = aerial_chain_core::Shape::line(4, 0.0);
     let start = Waypoint::new([2.2, 1.5, 1.3], &line).zeta;
     let goal = Point3::new(11.0, 4.5, 1.3);
-    let ex = explore_audited(&world, 4, &start, goal, 400.0);
+    let ex = explore_audited(&world, 4, &start, goal, 400.0, StartFree::Hull);
     // The route first led down lane A (unknown space is free to the route); the chain
     // went in, saw its end, and came back out to take lane B.
     let heads: Vec<[f64; 2]> = ex
@@ -247,11 +249,17 @@ fn tunnel() -> Grid {
 
 /// A chain at rest whose hull is partly unseen looks at it before it searches a piece:
 /// any piece would pass through that hull, so a search could only spend its deadline.
+/// (A start taking only its grown bodies as free leaves the waists between the units
+/// unseen.)
 #[test]
 fn a_chain_looks_at_its_unseen_hull_before_it_searches_a_piece() {
     let world = tunnel();
     let (params, tables) = chain(4);
     let start = Waypoint::new([2.0, 0.5, 0.5], &aerial_chain_core::Shape::line(4, 0.0)).zeta;
+    let settings = OnlineSettings {
+        start_free: StartFree::Bodies,
+        ..OnlineSettings::default()
+    };
     let mut planner = OnlinePlanner::new(
         params,
         tables,
@@ -260,7 +268,7 @@ fn a_chain_looks_at_its_unseen_hull_before_it_searches_a_piece() {
         0.3,
         &world,
         None,
-        OnlineSettings::default(),
+        settings,
         &crate::sensing::DepthSensor::default(),
     )
     .unwrap();
@@ -290,24 +298,36 @@ fn a_chain_looks_at_its_unseen_hull_before_it_searches_a_piece() {
     }
 }
 
-/// A straight chain at rest in a square tunnel, looking along itself, cannot move its
-/// last unit through the waist ahead of it, which no sensor looking forward sees: it
-/// turns to look at its own hull (back along itself), then flies down the tunnel.
-#[test]
-fn a_chain_looking_along_itself_looks_back_at_its_hull_then_flies_along_itself() {
-    let world = tunnel();
-    let start = Waypoint::new([2.0, 0.5, 0.5], &aerial_chain_core::Shape::line(4, 0.0)).zeta;
-    let ex = explore_audited(&world, 4, &start, Point3::new(4.2, 0.5, 0.5), 120.0);
-    // Before the chain first moved, it turned its head yaw round, back along itself.
+/// The head yaw's largest turn, in absolute value, before the head first moved from
+/// `x0` along x.
+fn turned_before_moving(ex: &Exploration, x0: f64) -> f64 {
     let zetas: Vec<&[f64]> = ex.plan.waypoints.iter().map(|w| &w.zeta[..]).collect();
     let moved = zetas
         .iter()
-        .position(|z| (z[0] - 2.0).abs() > 1e-3)
+        .position(|z| (z[0] - x0).abs() > 1e-3)
         .expect("the chain moved");
-    let turned = zetas[..moved]
+    zetas[..moved]
         .iter()
         .map(|z| crate::collision::verify::wrap(z[3]).abs())
-        .fold(0.0, f64::max);
+        .fold(0.0, f64::max)
+}
+
+/// A straight chain at rest in a square tunnel, looking along itself, that takes only
+/// its grown bodies as free cannot move its last unit through the waist ahead of it,
+/// which no sensor looking forward sees: it turns to look at its own hull (back along
+/// itself), then flies down the tunnel. Taking its hull as free (the default), it
+/// flies at once, and reaches the goal sooner.
+#[test]
+fn a_chain_looking_along_itself_flies_at_once_when_its_hull_is_taken_free() {
+    let world = tunnel();
+    let start = Waypoint::new([2.0, 0.5, 0.5], &aerial_chain_core::Shape::line(4, 0.0)).zeta;
+    let goal = Point3::new(4.2, 0.5, 0.5);
+    let reached = |ex: &Exploration| match ex.end {
+        ExploreEnd::Reached { t } => t,
+        ref end => panic!("not reached: {end:?}"),
+    };
+    let bodies = explore_audited(&world, 4, &start, goal, 120.0, StartFree::Bodies);
+    let turned = turned_before_moving(&bodies, 2.0);
     assert!(
         turned > 2.5,
         "the head yaw turned at most {turned} rad at rest"
@@ -315,12 +335,54 @@ fn a_chain_looking_along_itself_looks_back_at_its_hull_then_flies_along_itself()
     // Those turns are counted as looking: 2.5 rad at the angular-rate limit at least,
     // and less than the whole time to the goal.
     let rate = crate::trajectory::Limits::default().angular_rate;
-    let ExploreEnd::Reached { t } = ex.end else {
-        panic!("not reached: {:?}", ex.end);
-    };
+    let t_bodies = reached(&bodies);
     assert!(
-        ex.looking_s >= 2.5 / rate && ex.looking_s < t,
-        "looking {} s of {t} s",
-        ex.looking_s
+        bodies.looking_s >= 2.5 / rate && bodies.looking_s < t_bodies,
+        "looking {} s of {t_bodies} s",
+        bodies.looking_s
     );
+    let hull = explore_audited(&world, 4, &start, goal, 120.0, StartFree::Hull);
+    assert_eq!(turned_before_moving(&hull, 2.0), 0.0);
+    assert_eq!(hull.looking_s, 0.0);
+    let t_hull = reached(&hull);
+    assert!(
+        t_hull + 2.5 / rate < t_bodies,
+        "hull {t_hull} s, bodies {t_bodies} s"
+    );
+}
+
+/// A start with room for its bodies but not for its hull (an obstacle in the waist
+/// between two units) is refused when the hull is taken as free, naming the obstacle
+/// and the setting; taking only the bodies as free, the same start is flown.
+#[test]
+fn a_start_without_room_for_its_hull_is_refused_unless_only_its_bodies_are_taken_free() {
+    let mut world = tunnel();
+    // A block by the middle of the first link (x 1.5 to 2): 0.21 m from both unit
+    // centres and 0.07 m from the link's axis, so the start is valid with the
+    // clearance (0.2 m from the centres, 0.06 m from the axis) but its hull is not.
+    fill(
+        &mut world,
+        [1.7, 0.55, 0.55],
+        [1.8, 0.65, 0.65],
+        Cell::Occupied,
+    );
+    let (params, tables) = chain(4);
+    let start = Waypoint::new([2.0, 0.5, 0.5], &aerial_chain_core::Shape::line(4, 0.0)).zeta;
+    let goal = Point3::new(4.2, 0.5, 0.5);
+    let mut settings = ExploreSettings {
+        time_limit_s: 1.0,
+        ..ExploreSettings::default()
+    };
+    let run =
+        |s: &ExploreSettings| explore(&world, params, tables.clone(), &start, goal, 0.3, None, s);
+    let Err(e) = run(&settings) else {
+        panic!("a start without room for its hull was flown");
+    };
+    let msg = e.to_string();
+    assert!(matches!(e, ExploreError::StartHull { .. }), "{msg}");
+    assert!(msg.contains("--start-free bodies"), "{msg}");
+    assert!(msg.contains("[1.725, 0.575, 0.575]"), "{msg}");
+    settings.online.start_free = StartFree::Bodies;
+    let ex = run(&settings).unwrap();
+    assert!(!ex.flight.report.contact);
 }

@@ -12,7 +12,9 @@ use super::plan::load_tables;
 use super::{CliError, CliResult};
 use aerial_chain::flying::FlyOptions;
 use aerial_chain::map::{Grid, OcTree};
-use aerial_chain::online::{explore, Exploration, ExploreEnd, ExploreError, ExploreSettings};
+use aerial_chain::online::{
+    explore, Exploration, ExploreEnd, ExploreError, ExploreSettings, StartFree,
+};
 use aerial_chain::plan_file::MapSection;
 use aerial_chain::sensing::{DepthSensor, Survey};
 use aerial_chain::sim::FlightFile;
@@ -51,6 +53,13 @@ pub struct ExploreArgs {
     /// Clearance margin added to every body's radius while planning (m).
     #[arg(long, default_value_t = aerial_chain::collision::DEFAULT_CLEARANCE)]
     clearance: f64,
+    /// What the start is taken to prove free before any sensor saw it: `hull`, every
+    /// point within r_u plus the clearance of the chain's units and links (the start
+    /// must have that much room; checked on the world), or `bodies`, only the bodies
+    /// grown by the clearance (for a start next to an obstacle: a chain that moves
+    /// along itself first turns to look at its hull).
+    #[arg(long, value_enum, default_value_t = StartFree::Hull)]
+    start_free: StartFree,
     /// Scans per second of every unit's sensor (Hz).
     #[arg(long, default_value_t = aerial_chain::sensing::survey::DEFAULT_RATE_HZ)]
     sensor_rate: f64,
@@ -173,6 +182,7 @@ pub fn run(a: ExploreArgs) -> CliResult {
     };
     settings.online.deadline_s = a.deadline;
     settings.online.plan.clearance = a.clearance;
+    settings.online.start_free = a.start_free;
     let start = aerial_chain::plan_file::Waypoint::new(query.start.into(), &query.start_shape).zeta;
     let run = explore(
         &truth,
