@@ -136,8 +136,8 @@ impl Flight {
 /// (the library's `aerial_chain::flying::fly`, same defaults): along the plan's
 /// blended trajectory, or stopping at every waypoint where the plan is not admissible
 /// as one or `blend=False` asks for it; `rate` (Hz), largest unit `speed` (m/s), head
-/// `accel` (m/s^2), shape `angular_rate` (rad/s), arrival within `goal_tol` (m) and
-/// `settle_time` (s) of the plan's end. Keeps one step in `record_every`. Raises
+/// `accel` (m/s^2), link `angular_rate` (rad/s; the head yaw keeps `arc sim`'s own
+/// limit), arrival within `goal_tol` (m) and `settle_time` (s) of the plan's end. Keeps one step in `record_every`. Raises
 /// `SimError` for settings outside their limits or a plan the simulation cannot fly;
 /// a flight that fails is no error (`Flight.success`, `Flight.report`).
 #[pyfunction]

@@ -15,7 +15,7 @@ use crate::sim::{
     simulate_reference, simulate_with_progress, Flight, MapClearance, Progress, Reference,
     SimConfig, SimError,
 };
-use crate::trajectory::{self, Trajectory, TrajectoryError, Violation};
+use crate::trajectory::{self, ReferenceLimits, Trajectory, TrajectoryError, Violation};
 
 /// How to fly a plan: `arc sim`'s settings, with its defaults (`Default`).
 #[derive(Clone, Debug, Default)]
@@ -33,11 +33,10 @@ impl FlyOptions {
     /// The simulation settings flown: `sim` with the limits of `timing`.
     pub fn sim_config(&self) -> SimConfig {
         let mut cfg = self.sim.clone();
-        let l = &self.timing.limits;
-        cfg.limits.speed = l.speed;
-        cfg.limits.accel = l.accel;
-        cfg.limits.angular_rate = l.angular_rate;
-        cfg.limits.angular_accel = l.angular_accel;
+        cfg.limits = ReferenceLimits {
+            start_hold: cfg.limits.start_hold,
+            ..self.timing.limits.to_reference()
+        };
         cfg
     }
 }

@@ -332,9 +332,9 @@ fn a_chain_looking_along_itself_flies_at_once_when_its_hull_is_taken_free() {
         turned > 2.5,
         "the head yaw turned at most {turned} rad at rest"
     );
-    // Those turns are counted as looking: 2.5 rad at the angular-rate limit at least,
+    // Those turns are counted as looking: 2.5 rad at the head yaw's rate limit at least,
     // and less than the whole time to the goal.
-    let rate = crate::trajectory::Limits::default().angular_rate;
+    let rate = crate::trajectory::Limits::default().yaw_rate;
     let t_bodies = reached(&bodies);
     assert!(
         bodies.looking_s >= 2.5 / rate && bodies.looking_s < t_bodies,

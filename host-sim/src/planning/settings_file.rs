@@ -98,7 +98,15 @@ impl SettingsFile {
         use crate::trajectory::TrajectoryError as E;
         self.trajectory.validate().map_err(|e| match e {
             E::Limit { name, value } => {
-                let limit = ["speed", "accel", "angular_rate", "angular_accel"].contains(&name);
+                let limit = [
+                    "speed",
+                    "accel",
+                    "angular_rate",
+                    "angular_accel",
+                    "yaw_rate",
+                    "yaw_accel",
+                ]
+                .contains(&name);
                 let field = match limit {
                     true => format!("trajectory.limits.{name}"),
                     false => format!("trajectory.{name}"),

@@ -11,8 +11,9 @@
 //! is a convex mix of the two cruises (one ramps down as the other ramps up), so speeds
 //! and angle rates stay within their limits; the acceleration is `S'(x)/R` times the
 //! change of velocity, so `R = 1.5 * max(|dV_head| / accel, max_j |d omega_j| /
-//! angular_accel)` keeps it within its limits. A ramp from or to rest is the same rule
-//! with the other velocity zero. The ramps of an edge must fit (`r (U + W) / 2 <= 1`):
+//! angular_accel_j)` keeps it within its limits (`angular_accel_j` is the head yaw's
+//! own limit for the head yaw, `angular_accel` for every link angle). A ramp from or
+//! to rest is the same rule with the other velocity zero. The ramps of an edge must fit (`r (U + W) / 2 <= 1`):
 //! where they do not, the edge's cruise is lowered until they do.
 //!
 //! Before that, consecutive edges may be merged into one motion, straight in `zeta`,
@@ -43,7 +44,7 @@ use super::stages::{Stage, Stages};
 use super::{group, merge};
 use super::{Plan, Settings, TrajectoryError, MAX_SAMPLES};
 use crate::map::Grid;
-use crate::trajectory::reference::{Reference, Scaling, Segment};
+use crate::trajectory::reference::{angle_demand, Reference, Scaling, Segment};
 
 /// Peak of the smoothstep's derivative: a ramp of length `R` that changes a rate by
 /// `dv` accelerates by at most `1.5 dv / R`. Derived (the smoothstep `3t^2 - 2t^3` has
@@ -313,11 +314,6 @@ fn resume_at(before: &[Segment], now: &[Segment], dt: f64) -> usize {
     ((t / dt).floor().max(0.0) as usize).saturating_sub(2)
 }
 
-/// The largest change of any angle of `eta` in a change of `zeta` by `delta`.
-pub(super) fn max_angle(delta: &[f64]) -> f64 {
-    delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()))
-}
-
 /// When `v` happened: its interval's start plus its share of the sample spacing.
 fn at(v: &Violation, dt: f64) -> f64 {
     v.t + v.fraction * dt
@@ -377,8 +373,9 @@ impl Timing<'_> {
             .sum::<f64>()
             .sqrt();
         let dim = self.edges.first().map_or(0, |e| e.delta.len());
-        let angles = (3..dim).fold(0.0f64, |m, j| m.max((v(to, j) - v(from, j)).abs()));
-        RAMP_PEAK * (head / lim.accel).max(angles / lim.angular_accel)
+        let d_omega: Vec<f64> = (3..dim).map(|j| v(to, j) - v(from, j)).collect();
+        let angles = angle_demand(&d_omega, lim.yaw_accel, lim.angular_accel);
+        RAMP_PEAK * (head / lim.accel).max(angles)
     }
 
     /// Ramps up and down of every edge at cruise rates `rates`.

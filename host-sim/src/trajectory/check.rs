@@ -135,10 +135,32 @@ pub struct Peaks {
     pub speed: f64,
     /// Largest head acceleration (m/s^2).
     pub accel: f64,
-    /// Largest angle rate (rad/s).
+    /// Largest link angle rate (rad/s).
     pub angular_rate: f64,
-    /// Largest angular acceleration (rad/s^2).
+    /// Largest link angular acceleration (rad/s^2).
     pub angular_accel: f64,
+    /// Largest head yaw rate (rad/s).
+    pub yaw_rate: f64,
+    /// Largest head yaw acceleration (rad/s^2).
+    pub yaw_accel: f64,
+}
+
+impl Peaks {
+    /// The peak of angle `j` of `zeta` (3: the head yaw) as rate and acceleration.
+    fn of_angle(&mut self, j: usize) -> (&mut f64, &mut f64) {
+        match j {
+            3 => (&mut self.yaw_rate, &mut self.yaw_accel),
+            _ => (&mut self.angular_rate, &mut self.angular_accel),
+        }
+    }
+}
+
+/// The rate and acceleration limits of angle `j` of `zeta` (3: the head yaw).
+fn angle_limits(lim: &Limits, j: usize) -> (f64, f64) {
+    match j {
+        3 => (lim.yaw_rate, lim.yaw_accel),
+        _ => (lim.angular_rate, lim.angular_accel),
+    }
 }
 
 /// What [`check_samples`] found.
@@ -257,6 +279,8 @@ impl CheckReport {
         p.accel = p.accel.max(q.accel);
         p.angular_rate = p.angular_rate.max(q.angular_rate);
         p.angular_accel = p.angular_accel.max(q.angular_accel);
+        p.yaw_rate = p.yaw_rate.max(q.yaw_rate);
+        p.yaw_accel = p.yaw_accel.max(q.yaw_accel);
     }
 }
 
@@ -411,12 +435,14 @@ impl Checker<'_> {
         }
         for j in 3..z0.len() {
             let w = wrap(z1[j] - z0[j]).abs() / dt;
-            self.rep.peaks.angular_rate = self.rep.peaks.angular_rate.max(w);
-            if exceeds(w, lim.angular_rate) {
+            let peak = self.rep.peaks.of_angle(j).0;
+            *peak = peak.max(w);
+            let limit = angle_limits(lim, j).0;
+            if exceeds(w, limit) {
                 return Err(Problem::AngularRate {
                     angle: angle_name(j),
                     value: w,
-                    limit: lim.angular_rate,
+                    limit,
                 });
             }
         }
@@ -441,12 +467,14 @@ impl Checker<'_> {
         let (z0, z1, z2) = (&z[0], &z[1], &z[2]);
         for (j, ((a0, a1), a2)) in z0.iter().zip(z1).zip(z2).enumerate().skip(3) {
             let a = second(wrap(a1 - a0), wrap(a2 - a1)).abs();
-            self.rep.peaks.angular_accel = self.rep.peaks.angular_accel.max(a);
-            if exceeds(a, self.limits.angular_accel) {
+            let peak = self.rep.peaks.of_angle(j).1;
+            *peak = peak.max(a);
+            let limit = angle_limits(self.limits, j).1;
+            if exceeds(a, limit) {
                 return Err(Problem::AngularAccel {
                     angle: angle_name(j),
                     value: a,
-                    limit: self.limits.angular_accel,
+                    limit,
                 });
             }
         }

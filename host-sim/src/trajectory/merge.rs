@@ -3,7 +3,8 @@
 //!
 //! A shape change limited by the angular rate leaves most of the speed budget unused,
 //! and a translation uses none of the angular budget: flown together they take
-//! `max(w / speed, max_angle / angular_rate)` instead of the sum of both, where `w` is
+//! `max(w / speed, angles)` instead of the sum of both, where `angles` is the largest
+//! change of an angle over its rate limit (`reference::angle_demand`) and `w` is
 //! the fastest any unit moves per unit of the merged motion's progress (head and shape
 //! together), measured along the motion and made an upper bound by the largest change
 //! of velocity between measurements.
@@ -15,9 +16,8 @@
 //! bring the chain almost to rest); and a *pair*, a translation with the shape change
 //! beside it.
 
-use super::build::max_angle;
 use crate::collision::exact::positions_f64;
-use crate::trajectory::reference::{Segment, SegmentKind};
+use crate::trajectory::reference::{angle_demand, Segment, SegmentKind};
 use crate::trajectory::ReferenceLimits;
 
 /// Measurements along a shape change for its fastest unit.
@@ -33,8 +33,10 @@ const SPEED_SAMPLES: usize = 128;
 pub(super) struct Demand {
     /// Upper bound on the fastest unit's speed per unit of progress (m).
     speed: f64,
-    /// Largest change of any angle (rad).
-    angle: f64,
+    /// The head yaw's change (rad).
+    yaw: f64,
+    /// Largest change of any link angle (rad).
+    link_angle: f64,
 }
 
 impl Demand {
@@ -47,7 +49,8 @@ impl Demand {
                 SegmentKind::ShapeChange => motion_speed(l, &d[..3], &e.from[3..], &d[3..]),
                 _ => head_length(d),
             },
-            angle: max_angle(d),
+            yaw: d[3].abs(),
+            link_angle: d[4..].iter().fold(0.0f64, |m, a| m.max(a.abs())),
         }
     }
 
@@ -57,8 +60,9 @@ impl Demand {
         if self.speed > 0.0 {
             r = r.min(lim.speed / self.speed);
         }
-        if self.angle > 0.0 {
-            r = r.min(lim.angular_rate / self.angle);
+        if self.yaw > 0.0 || self.link_angle > 0.0 {
+            let angles = [self.yaw, self.link_angle];
+            r = r.min(1.0 / angle_demand(&angles, lim.yaw_rate, lim.angular_rate));
         }
         r
     }

@@ -39,7 +39,9 @@ use crate::plan_file::{ChainSection, FormatError, MapSection, Plan};
 pub use build::{build, build_until, Trajectory};
 pub use check::{check_samples, CheckReport, Peaks, Problem, Violation, LIMIT_TOLERANCE};
 pub use file::{FileError, SampleError, SampleRow, TrajectoryFile, TrajectoryStats, FORMAT};
-pub use reference::{LimitsError, Reference, ReferenceError, ReferenceLimits};
+pub use reference::{
+    LimitsError, Reference, ReferenceError, ReferenceLimits, DEFAULT_YAW_ACCEL, DEFAULT_YAW_RATE,
+};
 pub use stages::{Stage, StageReport, Stages};
 
 use serde::{Deserialize, Serialize};
@@ -73,10 +75,25 @@ pub struct Limits {
     pub speed: f64,
     /// Largest acceleration of the head (m/s^2).
     pub accel: f64,
-    /// Largest rate of any angle of `eta`: head yaw, link pitches and yaws (rad/s).
+    /// Largest rate of any link angle of `eta`, pitch or yaw (rad/s).
     pub angular_rate: f64,
-    /// Largest angular acceleration of any angle of `eta` (rad/s^2).
+    /// Largest angular acceleration of any link angle of `eta` (rad/s^2).
     pub angular_accel: f64,
+    /// Largest rate of the head yaw (rad/s); in a file written before it was a limit
+    /// of its own, the default.
+    #[serde(default = "default_yaw_rate")]
+    pub yaw_rate: f64,
+    /// Largest angular acceleration of the head yaw (rad/s^2); as `yaw_rate`.
+    #[serde(default = "default_yaw_accel")]
+    pub yaw_accel: f64,
+}
+
+fn default_yaw_rate() -> f64 {
+    reference::DEFAULT_YAW_RATE
+}
+
+fn default_yaw_accel() -> f64 {
+    reference::DEFAULT_YAW_ACCEL
 }
 
 impl Default for Limits {
@@ -87,6 +104,8 @@ impl Default for Limits {
             accel: r.accel,
             angular_rate: r.angular_rate,
             angular_accel: r.angular_accel,
+            yaw_rate: r.yaw_rate,
+            yaw_accel: r.yaw_accel,
         }
     }
 }
@@ -99,6 +118,8 @@ impl Limits {
             ("accel", self.accel),
             ("angular_rate", self.angular_rate),
             ("angular_accel", self.angular_accel),
+            ("yaw_rate", self.yaw_rate),
+            ("yaw_accel", self.yaw_accel),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(TrajectoryError::Limit { name, value: v });
@@ -114,6 +135,8 @@ impl Limits {
             accel: self.accel,
             angular_rate: self.angular_rate,
             angular_accel: self.angular_accel,
+            yaw_rate: self.yaw_rate,
+            yaw_accel: self.yaw_accel,
             start_hold: 0.0,
         }
     }

@@ -35,10 +35,30 @@ fn rule(holds: bool, why: &'static str) -> Result<(), LimitsError> {
 /// time: `max d/dx (3x^2 - 2x^3) = 1.5`.
 const RAMP_PEAK_ACCEL: f64 = 1.5;
 
-/// Default largest rate of any shape angle (rad/s, about 23 degrees/s): what the
+/// Default largest rate of any link angle (rad/s, about 23 degrees/s): what the
 /// defaults of `arc sim` and `arc trajectory` fly. Faster: shorter flights, larger
 /// link torques.
 const DEFAULT_ANGULAR_RATE: f64 = 0.4;
+
+/// Default largest rate of the head yaw (rad/s): 45 degrees/s, PX4's default yaw rate
+/// in autonomous flight (`MPC_YAWRAUTO_MAX`). The head yaw is the heading every unit
+/// holds, each about its own centre, which the links' spherical joints leave free: it
+/// moves no body, so it is limited by the units' yaw authority, not the links'.
+/// Faster: shorter turns to look, larger yaw moments.
+pub const DEFAULT_YAW_RATE: f64 = 45.0 * std::f64::consts::PI / 180.0;
+
+/// Default largest angular acceleration of the head yaw (rad/s^2): 60 degrees/s^2,
+/// PX4's default in autonomous flight (`MPC_YAWRAUTO_ACC`); a unit's yaw moment gives
+/// about ten times that (`sim::UnitModel`).
+pub const DEFAULT_YAW_ACCEL: f64 = 60.0 * std::f64::consts::PI / 180.0;
+
+/// The time per unit of progress (s) that the angle limits ask of a change `d_eta` of
+/// the shape angles (head yaw first): the largest `|d_j| / limit_j`, with `yaw` the
+/// head yaw's limit and `link` every link angle's (rates or accelerations alike).
+pub(crate) fn angle_demand(d_eta: &[f64], yaw: f64, link: f64) -> f64 {
+    let links = d_eta[1..].iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    (d_eta[0].abs() / yaw).max(links / link)
+}
 
 /// Largest difference (m or rad) between one reference's end and the next one's start
 /// that still joins them: far below what the controllers resolve, above the rounding
@@ -89,10 +109,14 @@ pub struct ReferenceLimits {
     pub speed: f64,
     /// Largest acceleration of the head on a translation (m/s^2).
     pub accel: f64,
-    /// Largest rate of any angle of `eta` (rad/s).
+    /// Largest rate of any link angle of `eta`, pitch or yaw (rad/s).
     pub angular_rate: f64,
-    /// Largest angular acceleration of any angle of `eta` (rad/s^2).
+    /// Largest angular acceleration of any link angle of `eta` (rad/s^2).
     pub angular_accel: f64,
+    /// Largest rate of the head yaw (rad/s).
+    pub yaw_rate: f64,
+    /// Largest angular acceleration of the head yaw (rad/s^2).
+    pub yaw_accel: f64,
     /// Time at rest at the start before the first edge (s).
     pub start_hold: f64,
 }
@@ -104,6 +128,8 @@ impl Default for ReferenceLimits {
             accel: 0.5,
             angular_rate: DEFAULT_ANGULAR_RATE,
             angular_accel: 0.5,
+            yaw_rate: DEFAULT_YAW_RATE,
+            yaw_accel: DEFAULT_YAW_ACCEL,
             start_hold: 1.0,
         }
     }
@@ -117,6 +143,8 @@ impl ReferenceLimits {
             self.accel,
             self.angular_rate,
             self.angular_accel,
+            self.yaw_rate,
+            self.yaw_accel,
         ]
         .iter()
         .all(|v| v.is_finite() && *v > 0.0);
@@ -141,14 +169,14 @@ pub(crate) fn max_rate(
         SegmentKind::Hold => 0.0,
         SegmentKind::Translation => limits.speed / V3::new(delta[0], delta[1], delta[2]).norm(),
         SegmentKind::ShapeChange => {
-            let max_angle = delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()));
             // Unit i moves at most at l * sum_{k<i} |d(dir_k)/ds| * ds/dt, and a link
             // direction moves at most at sqrt(dtheta^2 + dpsi^2).
             let sweep: f64 = (0..(delta.len() - 4) / 2)
                 .map(|k| (delta[4 + 2 * k].powi(2) + delta[5 + 2 * k].powi(2)).sqrt())
                 .sum::<f64>()
                 * link_length;
-            (limits.angular_rate / max_angle).min(limits.speed / sweep)
+            let angles = angle_demand(&delta[3..], limits.yaw_rate, limits.angular_rate);
+            (1.0 / angles).min(limits.speed / sweep)
         }
     }
 }
@@ -362,9 +390,9 @@ impl Reference {
                 }
                 (false, true) => {
                     delta[..3].iter_mut().for_each(|d| *d = 0.0);
-                    let max_angle = delta[3..].iter().fold(0.0f64, |m, d| m.max(d.abs()));
                     let rate = max_rate(SegmentKind::ShapeChange, link_length, &delta, limits);
-                    let scaling = Scaling::fastest(rate, limits.angular_accel / max_angle);
+                    let accel = angle_demand(&delta[3..], limits.yaw_accel, limits.angular_accel);
+                    let scaling = Scaling::fastest(rate, 1.0 / accel);
                     (SegmentKind::ShapeChange, scaling)
                 }
             };

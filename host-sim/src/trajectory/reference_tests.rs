@@ -118,6 +118,42 @@ fn shape_change_takes_the_short_way_and_respects_the_rate() {
     assert!((wrap(r.sample(r.duration()).links[0].yaw - (-3.0))).abs() < 1e-12);
 }
 
+/// A turn of the head yaw alone moves no body: it is timed at the head yaw's own
+/// limits, within them at every instant and as fast as they allow.
+#[test]
+fn a_head_yaw_turn_is_timed_at_the_head_yaws_own_limits() {
+    let lim = ReferenceLimits {
+        start_hold: 0.0,
+        ..Default::default()
+    };
+    assert!(lim.yaw_rate > lim.angular_rate && lim.yaw_accel > lim.angular_accel);
+    let a = zeta([1.0, 1.0, 1.0], &[0.0, 0.1, 0.2, 0.0, 0.0]);
+    let b = zeta([1.0, 1.0, 1.0], &[2.5, 0.1, 0.2, 0.0, 0.0]);
+    let r = Reference::new(3, 0.5, &[a, b], &lim).unwrap();
+    let (mut wmax, mut t) = (0.0f64, 0.0);
+    let mut last = r.sample(0.0).head_yaw_rate;
+    while t < r.duration() {
+        let s = r.sample(t);
+        wmax = wmax.max(s.head_yaw_rate.abs());
+        assert!((s.head_yaw_rate - last).abs() <= lim.yaw_accel * 1e-3 * (1.0 + 1e-6) + 1e-12);
+        last = s.head_yaw_rate;
+        assert!(s
+            .links
+            .iter()
+            .all(|l| l.yaw_rate == 0.0 && l.pitch_rate == 0.0));
+        t += 0.001;
+    }
+    assert!(
+        wmax <= lim.yaw_rate + 1e-9 && wmax > 0.99 * lim.yaw_rate,
+        "{wmax}"
+    );
+    // Cruise at the rate, smoothstep ramps at 1.5 rate / accel: 2.5 / rate + 1.5 rate /
+    // accel in all; at the link limits it would take 2.5 / 0.4 s and more.
+    let expected = 2.5 / lim.yaw_rate + 1.5 * lim.yaw_rate / lim.yaw_accel;
+    assert!((r.duration() - expected).abs() < 1e-9, "{}", r.duration());
+    assert!(r.duration() < 2.5 / lim.angular_rate);
+}
+
 #[test]
 fn samples_are_flown_through_in_time() {
     let lim = ReferenceLimits::default();

@@ -71,6 +71,21 @@ fn assert_respects_limits(grid: &Grid, tr: &Trajectory) {
     let angle = |a: f64| {
         (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
     };
+    // The head yaw (angle 3 of zeta) has limits of its own.
+    let rate = |i: usize| {
+        if i == 3 {
+            lim.yaw_rate
+        } else {
+            lim.angular_rate
+        }
+    };
+    let accel = |i: usize| {
+        if i == 3 {
+            lim.yaw_accel
+        } else {
+            lim.angular_accel
+        }
+    };
     for j in 0..z.len() {
         let head = [z[j][0], z[j][1], z[j][2]];
         check_config_exact(grid, params, head, &z[j][3..], 0.0)
@@ -88,7 +103,7 @@ fn assert_respects_limits(grid: &Grid, tr: &Trajectory) {
         }
         for (i, (x0, x1)) in z[j].iter().zip(&z[j + 1]).enumerate().skip(3) {
             let w = angle(x1 - x0).abs() / h;
-            assert!(w <= lim.angular_rate * slack, "angle {i} at {w} rad/s");
+            assert!(w <= rate(i) * slack, "angle {i} at {w} rad/s");
         }
         if j > 0 {
             let h0 = t[j] - t[j - 1];
@@ -99,7 +114,7 @@ fn assert_respects_limits(grid: &Grid, tr: &Trajectory) {
             assert!(a <= lim.accel * slack, "head at {a} m/s^2, t = {}", t[j]);
             for i in 3..z[j].len() {
                 assert!(
-                    acc(i).abs() <= lim.angular_accel * slack,
+                    acc(i).abs() <= accel(i) * slack,
                     "angle {i} accelerates at {}",
                     acc(i)
                 );

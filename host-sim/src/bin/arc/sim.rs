@@ -321,11 +321,10 @@ fn sim_config(a: &SimArgs) -> Result<SimConfig, CliError> {
         gusts,
         ..Default::default()
     };
-    let limits = a.timing.limits.limits()?;
-    cfg.limits.speed = limits.speed;
-    cfg.limits.accel = limits.accel;
-    cfg.limits.angular_rate = limits.angular_rate;
-    cfg.limits.angular_accel = limits.angular_accel;
+    cfg.limits = aerial_chain::trajectory::ReferenceLimits {
+        start_hold: cfg.limits.start_hold,
+        ..a.timing.limits.limits()?.to_reference()
+    };
     cfg.validate()
         .map_err(|e| CliError::input(format!("simulation settings: {e}")))?;
     Ok(cfg)

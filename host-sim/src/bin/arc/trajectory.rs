@@ -25,12 +25,20 @@ pub struct LimitArgs {
     /// Largest head acceleration (m/s^2).
     #[arg(long, default_value_t = 0.5)]
     pub accel: f64,
-    /// Largest rate of any shape angle (degrees/s).
+    /// Largest rate of any link angle, pitch or yaw (degrees/s).
     #[arg(long, default_value_t = 0.4f64.to_degrees())]
     pub angular_rate_deg: f64,
-    /// Largest angular acceleration of any shape angle (degrees/s^2).
+    /// Largest angular acceleration of any link angle (degrees/s^2).
     #[arg(long, default_value_t = 0.5f64.to_degrees())]
     pub angular_accel_deg: f64,
+    /// Largest rate of the head yaw, the heading every unit holds (degrees/s; PX4's
+    /// MPC_YAWRAUTO_MAX).
+    #[arg(long, default_value_t = trajectory::DEFAULT_YAW_RATE.to_degrees())]
+    pub yaw_rate_deg: f64,
+    /// Largest angular acceleration of the head yaw (degrees/s^2; PX4's
+    /// MPC_YAWRAUTO_ACC).
+    #[arg(long, default_value_t = trajectory::DEFAULT_YAW_ACCEL.to_degrees())]
+    pub yaw_accel_deg: f64,
 }
 
 impl LimitArgs {
@@ -40,11 +48,15 @@ impl LimitArgs {
         checks::positive("--accel", self.accel)?;
         checks::positive("--angular-rate-deg", self.angular_rate_deg)?;
         checks::positive("--angular-accel-deg", self.angular_accel_deg)?;
+        checks::positive("--yaw-rate-deg", self.yaw_rate_deg)?;
+        checks::positive("--yaw-accel-deg", self.yaw_accel_deg)?;
         Ok(Limits {
             speed: self.speed,
             accel: self.accel,
             angular_rate: self.angular_rate_deg.to_radians(),
             angular_accel: self.angular_accel_deg.to_radians(),
+            yaw_rate: self.yaw_rate_deg.to_radians(),
+            yaw_accel: self.yaw_accel_deg.to_radians(),
         })
     }
 }

@@ -255,8 +255,10 @@ fn run_trajectory(a: &VerifyArgs, path: &Path) -> CliResult {
     }
     let p = &rep.peaks;
     println!(
-        "  peaks: speed {:.4} m/s, head acceleration {:.4} m/s^2, angle rate {:.4} rad/s, angular acceleration {:.4} rad/s^2",
-        p.speed, p.accel, p.angular_rate, p.angular_accel
+        "  peaks: speed {:.4} m/s, head acceleration {:.4} m/s^2, link angle rate {:.4} rad/s, \
+         link angular acceleration {:.4} rad/s^2, head yaw rate {:.4} rad/s, head yaw \
+         acceleration {:.4} rad/s^2",
+        p.speed, p.accel, p.angular_rate, p.angular_accel, p.yaw_rate, p.yaw_accel
     );
     if let Some((t, body)) = rep.min_clearance_at {
         println!(

@@ -402,6 +402,12 @@ fn timing(
     if flag("angular_accel_deg", "limits.angular_accel") {
         t.limits.angular_accel = flags.limits.angular_accel;
     }
+    if flag("yaw_rate_deg", "limits.yaw_rate") {
+        t.limits.yaw_rate = flags.limits.yaw_rate;
+    }
+    if flag("yaw_accel_deg", "limits.yaw_accel") {
+        t.limits.yaw_accel = flags.limits.yaw_accel;
+    }
     if flag("dt", "dt") {
         t.dt = flags.dt;
     }
