@@ -551,8 +551,8 @@ impl Loop<'_> {
             .pieces()
             .iter()
             .filter(|p| p.is_look())
-            .map(|p| p.trajectory.duration())
-            .sum();
+            // From +0: a float sum of nothing is -0, which prints as "-0.00".
+            .fold(0.0, |sum, p| sum + p.trajectory.duration());
         let mut sensing = self.sensing;
         sensing.known = planner.belief().seen().known();
         Ok(Exploration {
