@@ -57,7 +57,7 @@ impl StartFree {
     /// radius `r_u` and link radius `r_l` (before the clearance).
     pub fn link_reach(self, r_u: f64, r_l: f64) -> f64 {
         match self {
-            StartFree::Hull => r_u.max(r_l),
+            StartFree::Hull => r_u,
             StartFree::Bodies => r_l,
         }
     }

@@ -13,8 +13,9 @@
 //! change of velocity, so `R = 1.5 * max(|dV_head| / accel, max_j |d omega_j| /
 //! angular_accel_j)` keeps it within its limits (`angular_accel_j` is the head yaw's
 //! own limit for the head yaw, `angular_accel` for every link angle). A ramp from or
-//! to rest is the same rule with the other velocity zero. The ramps of an edge must fit (`r (U + W) / 2 <= 1`):
-//! where they do not, the edge's cruise is lowered until they do.
+//! to rest is the same rule with the other velocity zero. The ramps of an edge must
+//! fit (`r (U + W) / 2 <= 1`): where they do not, the edge's cruise is lowered until
+//! they do.
 //!
 //! Before that, consecutive edges may be merged into one motion, straight in `zeta`,
 //! that moves head and shape at once (`super::group`, `super::merge`): a run of short
@@ -373,8 +374,8 @@ impl Timing<'_> {
             .sum::<f64>()
             .sqrt();
         let dim = self.edges.first().map_or(0, |e| e.delta.len());
-        let d_omega: Vec<f64> = (3..dim).map(|j| v(to, j) - v(from, j)).collect();
-        let angles = angle_demand(&d_omega, lim.yaw_accel, lim.angular_accel);
+        let d_omega = (3..dim).map(|j| v(to, j) - v(from, j));
+        let angles = angle_demand(d_omega, lim.yaw_accel, lim.angular_accel);
         RAMP_PEAK * (head / lim.accel).max(angles)
     }
 

@@ -62,7 +62,7 @@ impl Demand {
         }
         if self.yaw > 0.0 || self.link_angle > 0.0 {
             let angles = [self.yaw, self.link_angle];
-            r = r.min(1.0 / angle_demand(&angles, lim.yaw_rate, lim.angular_rate));
+            r = r.min(1.0 / angle_demand(angles, lim.yaw_rate, lim.angular_rate));
         }
         r
     }

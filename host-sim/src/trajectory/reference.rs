@@ -55,9 +55,11 @@ pub const DEFAULT_YAW_ACCEL: f64 = 60.0 * std::f64::consts::PI / 180.0;
 /// The time per unit of progress (s) that the angle limits ask of a change `d_eta` of
 /// the shape angles (head yaw first): the largest `|d_j| / limit_j`, with `yaw` the
 /// head yaw's limit and `link` every link angle's (rates or accelerations alike).
-pub(crate) fn angle_demand(d_eta: &[f64], yaw: f64, link: f64) -> f64 {
-    let links = d_eta[1..].iter().fold(0.0f64, |m, d| m.max(d.abs()));
-    (d_eta[0].abs() / yaw).max(links / link)
+pub(crate) fn angle_demand(d_eta: impl IntoIterator<Item = f64>, yaw: f64, link: f64) -> f64 {
+    d_eta.into_iter().enumerate().fold(0.0f64, |m, (j, d)| {
+        let limit = if j == 0 { yaw } else { link };
+        m.max(d.abs() / limit)
+    })
 }
 
 /// Largest difference (m or rad) between one reference's end and the next one's start
@@ -175,7 +177,8 @@ pub(crate) fn max_rate(
                 .map(|k| (delta[4 + 2 * k].powi(2) + delta[5 + 2 * k].powi(2)).sqrt())
                 .sum::<f64>()
                 * link_length;
-            let angles = angle_demand(&delta[3..], limits.yaw_rate, limits.angular_rate);
+            let d_eta = delta[3..].iter().copied();
+            let angles = angle_demand(d_eta, limits.yaw_rate, limits.angular_rate);
             (1.0 / angles).min(limits.speed / sweep)
         }
     }
@@ -391,7 +394,8 @@ impl Reference {
                 (false, true) => {
                     delta[..3].iter_mut().for_each(|d| *d = 0.0);
                     let rate = max_rate(SegmentKind::ShapeChange, link_length, &delta, limits);
-                    let accel = angle_demand(&delta[3..], limits.yaw_accel, limits.angular_accel);
+                    let d_eta = delta[3..].iter().copied();
+                    let accel = angle_demand(d_eta, limits.yaw_accel, limits.angular_accel);
                     let scaling = Scaling::fastest(rate, 1.0 / accel);
                     (SegmentKind::ShapeChange, scaling)
                 }
