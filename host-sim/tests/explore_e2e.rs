@@ -46,6 +46,7 @@ fn explore_to_goal(world: &[&str], dir: &Path) -> serde_json::Value {
     assert_eq!(flight["format"], "arc-sim/1");
     assert_eq!(flight["explore"]["format"], "arc-explore/1");
     assert_eq!(flight["explore"]["end"]["kind"], "reached");
+    assert_eq!(flight["explore"]["start_free"], "hull");
     assert_eq!(flight["report"]["contact"], false);
     assert!(flight["report"]["min_clearance"].as_f64().unwrap() > 0.0);
     // The world is the first two arguments: --map FILE or --scenario NAME.

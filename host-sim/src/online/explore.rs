@@ -126,6 +126,8 @@ pub struct Exploration {
     /// final seen map (s; the median of five builds), with `audit`: what an update of
     /// both is compared with.
     pub rebuild_s: Option<f64>,
+    /// What the start was taken to leave free.
+    pub start_free: StartFree,
 }
 
 /// The record of an exploration kept in its flight file (docs/model.md,
@@ -138,10 +140,19 @@ pub struct ExploreRecord {
     pub end: ExploreEnd,
     /// Pieces committed.
     pub pieces: usize,
+    /// What the start was taken to leave free (a record written before this field
+    /// existed took the bodies).
+    #[serde(default = "bodies")]
+    pub start_free: StartFree,
     /// Figures over the whole run.
     pub summary: ExploreSummary,
     /// Every replan, in order.
     pub replans: Vec<ReplanRecord>,
+}
+
+/// What a record without `start_free` took as free at the start.
+fn bodies() -> StartFree {
+    StartFree::Bodies
 }
 
 /// An exploration's figures.
@@ -185,6 +196,7 @@ impl Exploration {
             format: RECORD_FORMAT.into(),
             end: self.end.clone(),
             pieces: self.pieces,
+            start_free: self.start_free,
             summary: ExploreSummary {
                 replans: self.replans.len(),
                 latency_median_s: quantile(&lat, 0.5),
@@ -566,6 +578,7 @@ impl Loop<'_> {
             audit,
             looking_s,
             rebuild_s,
+            start_free: planner.settings().start_free,
         })
     }
 }

@@ -386,3 +386,24 @@ fn a_start_without_room_for_its_hull_is_refused_unless_only_its_bodies_are_taken
     let ex = run(&settings).unwrap();
     assert!(!ex.flight.report.contact);
 }
+
+/// A record written before `start_free` existed reads as a start that took only its
+/// bodies as free, as those runs did; a record written now keeps its setting.
+#[test]
+fn an_exploration_record_without_start_free_took_the_bodies() {
+    let record = ExploreRecord {
+        format: "arc-explore/1".into(),
+        end: ExploreEnd::Reached { t: 1.0 },
+        pieces: 0,
+        start_free: StartFree::Hull,
+        summary: Default::default(),
+        replans: Vec::new(),
+    };
+    let mut v = serde_json::to_value(&record).unwrap();
+    assert_eq!(v["start_free"], "hull");
+    let back: ExploreRecord = serde_json::from_value(v.clone()).unwrap();
+    assert_eq!(back, record);
+    v.as_object_mut().unwrap().remove("start_free");
+    let old: ExploreRecord = serde_json::from_value(v).unwrap();
+    assert_eq!(old.start_free, StartFree::Bodies);
+}
