@@ -40,7 +40,8 @@ pub use build::{build, build_until, Trajectory};
 pub use check::{check_samples, CheckReport, Peaks, Problem, Violation, LIMIT_TOLERANCE};
 pub use file::{FileError, SampleError, SampleRow, TrajectoryFile, TrajectoryStats, FORMAT};
 pub use reference::{
-    LimitsError, Reference, ReferenceError, ReferenceLimits, DEFAULT_YAW_ACCEL, DEFAULT_YAW_RATE,
+    LimitsError, Reference, ReferenceError, ReferenceLimits, DEFAULT_YAW_ACCEL,
+    DEFAULT_YAW_ACCEL_DEG, DEFAULT_YAW_RATE, DEFAULT_YAW_RATE_DEG,
 };
 pub use stages::{Stage, StageReport, Stages};
 

@@ -45,12 +45,18 @@ const DEFAULT_ANGULAR_RATE: f64 = 0.4;
 /// holds, each about its own centre, which the links' spherical joints leave free: it
 /// moves no body, so it is limited by the units' yaw authority, not the links'.
 /// Faster: shorter turns to look, larger yaw moments.
-pub const DEFAULT_YAW_RATE: f64 = 45.0 * std::f64::consts::PI / 180.0;
+pub const DEFAULT_YAW_RATE: f64 = DEFAULT_YAW_RATE_DEG.to_radians();
+
+/// [`DEFAULT_YAW_RATE`] in degrees/s, as PX4 and `--yaw-rate-deg` give it.
+pub const DEFAULT_YAW_RATE_DEG: f64 = 45.0;
 
 /// Default largest angular acceleration of the head yaw (rad/s^2): 60 degrees/s^2,
 /// PX4's default in autonomous flight (`MPC_YAWRAUTO_ACC`); a unit's yaw moment gives
 /// about ten times that (`sim::UnitModel`).
-pub const DEFAULT_YAW_ACCEL: f64 = 60.0 * std::f64::consts::PI / 180.0;
+pub const DEFAULT_YAW_ACCEL: f64 = DEFAULT_YAW_ACCEL_DEG.to_radians();
+
+/// [`DEFAULT_YAW_ACCEL`] in degrees/s^2, as PX4 and `--yaw-accel-deg` give it.
+pub const DEFAULT_YAW_ACCEL_DEG: f64 = 60.0;
 
 /// The time per unit of progress (s) that the angle limits ask of a change `d_eta` of
 /// the shape angles (head yaw first): the largest `|d_j| / limit_j`, with `yaw` the

@@ -33,11 +33,11 @@ pub struct LimitArgs {
     pub angular_accel_deg: f64,
     /// Largest rate of the head yaw, the heading every unit holds (degrees/s; PX4's
     /// MPC_YAWRAUTO_MAX).
-    #[arg(long, default_value_t = trajectory::DEFAULT_YAW_RATE.to_degrees())]
+    #[arg(long, default_value_t = trajectory::DEFAULT_YAW_RATE_DEG)]
     pub yaw_rate_deg: f64,
     /// Largest angular acceleration of the head yaw (degrees/s^2; PX4's
     /// MPC_YAWRAUTO_ACC).
-    #[arg(long, default_value_t = trajectory::DEFAULT_YAW_ACCEL.to_degrees())]
+    #[arg(long, default_value_t = trajectory::DEFAULT_YAW_ACCEL_DEG)]
     pub yaw_accel_deg: f64,
 }
 
