@@ -163,3 +163,5 @@ def test_bad_simulation_settings_raise_sim_error(window, window_plan):
         ac.simulate(window, window_plan, rate=10.0)
     with pytest.raises(ac.SimError, match="record_every"):
         ac.simulate(window, window_plan, record_every=0)
+    with pytest.raises(ac.SimError, match="angular limits"):
+        ac.simulate(window, window_plan, yaw_rate=0.0)

@@ -236,6 +236,79 @@ fn a_deadline_that_has_passed_keeps_the_plan_stop_and_go() {
     }
 }
 
+/// The head yaw is held to its own limits and the link angles to theirs: a turn at
+/// 0.6 rad/s (between the two rate limits) passes for the head yaw and fails for a
+/// link's yaw, and one faster than the head yaw's limit fails naming that limit.
+#[test]
+fn the_check_holds_the_head_yaw_and_the_links_to_their_own_limits() {
+    let params = ChainParams::new(3);
+    let grid = room();
+    let lim = Limits::default();
+    assert!(lim.angular_rate < 0.6 && 0.6 < lim.yaw_rate && lim.yaw_rate < 0.9);
+    let base = tour(&params).waypoints[0].zeta.clone();
+    let dt = 0.02;
+    let times: Vec<f64> = (0..10).map(|k| f64::from(k) * dt).collect();
+    // Angle `j` of zeta turning at a constant `rate` (no acceleration).
+    let turning = |j: usize, rate: f64| -> Vec<Vec<f64>> {
+        times
+            .iter()
+            .map(|t| {
+                let mut z = base.clone();
+                z[j] += rate * t;
+                z
+            })
+            .collect()
+    };
+    let check = |z: &[Vec<f64>]| check_samples(&grid, &params, &lim, &times, z, 0.0);
+    let head = check(&turning(3, 0.6));
+    assert!(head.ok, "{:?}", head.violation);
+    assert!((head.peaks.yaw_rate - 0.6).abs() < 1e-9 && head.peaks.angular_rate == 0.0);
+    let rate_problem = |z: &[Vec<f64>]| match check(z).violation.map(|v| v.problem) {
+        Some(Problem::AngularRate { angle, limit, .. }) => (angle, limit),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(
+        rate_problem(&turning(5, 0.6)),
+        ("psi1".to_string(), lim.angular_rate)
+    );
+    assert_eq!(
+        rate_problem(&turning(3, 0.9)),
+        ("psi1_r".to_string(), lim.yaw_rate)
+    );
+}
+
+/// A trajectory file or settings file written before the head yaw had limits of its
+/// own reads them as the defaults; a limit that is not positive is refused by name.
+#[test]
+fn limits_without_the_head_yaws_read_the_defaults_and_bad_ones_are_named() {
+    let old: Limits = serde_json::from_str(
+        r#"{"speed": 0.5, "accel": 0.5, "angular_rate": 0.4, "angular_accel": 0.5}"#,
+    )
+    .unwrap();
+    assert_eq!(old, Limits::default());
+    for (name, bad) in [
+        (
+            "yaw_rate",
+            Limits {
+                yaw_rate: 0.0,
+                ..Limits::default()
+            },
+        ),
+        (
+            "yaw_accel",
+            Limits {
+                yaw_accel: f64::NAN,
+                ..Limits::default()
+            },
+        ),
+    ] {
+        match bad.validate() {
+            Err(TrajectoryError::Limit { name: n, .. }) => assert_eq!(n, name),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+}
+
 #[test]
 fn the_check_names_what_is_wrong() {
     let params = ChainParams::new(3);

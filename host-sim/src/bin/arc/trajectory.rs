@@ -126,7 +126,8 @@ pub fn refused(e: TrajectoryError, name: &str) -> CliError {
         TrajectoryError::Inadmissible(_) => CliError::failed(format!("{name}: {e}")),
         TrajectoryError::TooLong(_) => CliError::input(format!(
             "{name}: {e}, the memory budget; the length follows from the plan, --speed, \
-             --accel, --angular-rate-deg, --angular-accel-deg and --dt"
+             --accel, --angular-rate-deg, --angular-accel-deg, --yaw-rate-deg, \
+             --yaw-accel-deg and --dt"
         )),
         _ => CliError::input(format!("{name}: {e}")),
     }
