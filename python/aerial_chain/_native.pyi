@@ -224,7 +224,7 @@ def simulate(
     speed: float = 0.5,
     accel: float = 0.5,
     angular_rate: float = 0.4,
-    yaw_rate: float = 0.7853981633974483,
+    yaw_rate: Optional[float] = None,
     goal_tol: float = 0.1,
     settle_time: float = 10.0,
     record_every: int = 10,
@@ -232,8 +232,8 @@ def simulate(
 ) -> Flight:
     """Flies ``plan`` on ``map`` with the chain's dynamics and control stack as ``arc
     sim`` does (along the plan's blended trajectory; ``blend=False``: stopping at every
-    waypoint); ``angular_rate`` limits the link angles, ``yaw_rate`` the head yaw (45
-    deg/s); raises ``SimError`` for settings outside their limits."""
+    waypoint); ``angular_rate`` limits the link angles, ``yaw_rate`` the head yaw
+    (``None``: ``arc sim``'s 45 deg/s); raises ``SimError`` for settings outside their limits."""
 
 def export(
     map: Map,

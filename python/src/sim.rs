@@ -136,14 +136,15 @@ impl Flight {
 /// (the library's `aerial_chain::flying::fly`, same defaults): along the plan's
 /// blended trajectory, or stopping at every waypoint where the plan is not admissible
 /// as one or `blend=False` asks for it; `rate` (Hz), largest unit `speed` (m/s), head
-/// `accel` (m/s^2), link `angular_rate` (rad/s), head `yaw_rate` (rad/s; 45 deg/s as
-/// `arc sim`'s), arrival within `goal_tol` (m) and `settle_time` (s) of the plan's end. Keeps one step in `record_every`. Raises
-/// `SimError` for settings outside their limits or a plan the simulation cannot fly;
-/// a flight that fails is no error (`Flight.success`, `Flight.report`).
+/// `accel` (m/s^2), link `angular_rate` (rad/s), head `yaw_rate` (rad/s; `None`:
+/// `arc sim`'s 45 deg/s), arrival within `goal_tol` (m) and `settle_time` (s) of the plan's
+/// end. Keeps one step in `record_every`. Raises `SimError` for settings outside their
+/// limits or a plan the simulation cannot fly; a flight that fails is no error
+/// (`Flight.success`, `Flight.report`).
 #[pyfunction]
 #[pyo3(signature = (
     map, plan, rate = 500.0, speed = 0.5, accel = 0.5, angular_rate = 0.4,
-    yaw_rate = aerial_chain::trajectory::DEFAULT_YAW_RATE, goal_tol = 0.1, settle_time = 10.0,
+    yaw_rate = None, goal_tol = 0.1, settle_time = 10.0,
     record_every = 10, blend = true
 ))]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each with a default.
@@ -155,7 +156,7 @@ pub fn simulate(
     speed: f64,
     accel: f64,
     angular_rate: f64,
-    yaw_rate: f64,
+    yaw_rate: Option<f64>,
     goal_tol: f64,
     settle_time: f64,
     record_every: usize,
@@ -174,7 +175,7 @@ pub fn simulate(
         speed,
         accel,
         angular_rate,
-        yaw_rate,
+        yaw_rate: yaw_rate.unwrap_or(aerial_chain::trajectory::DEFAULT_YAW_RATE),
         ..Limits::default()
     };
     let options = FlyOptions {

@@ -1,6 +1,7 @@
 """The Python bindings end to end: a scenario and a .bt file, plan, exact check,
 plan files, a short flight, and the typed errors of bad input."""
 
+import inspect
 import json
 import math
 from pathlib import Path
@@ -165,3 +166,9 @@ def test_bad_simulation_settings_raise_sim_error(window, window_plan):
         ac.simulate(window, window_plan, record_every=0)
     with pytest.raises(ac.SimError, match="angular limits"):
         ac.simulate(window, window_plan, yaw_rate=0.0)
+
+
+def test_the_head_yaw_rate_is_arc_sims_unless_given():
+    # None: `arc sim`'s 45 deg/s; a given rate reaches the limits (yaw_rate=0.0 is
+    # refused above).
+    assert inspect.signature(ac.simulate).parameters["yaw_rate"].default is None
