@@ -60,10 +60,9 @@ impl Demand {
         if self.speed > 0.0 {
             r = r.min(lim.speed / self.speed);
         }
-        if self.yaw > 0.0 || self.link_angle > 0.0 {
-            let angles = [self.yaw, self.link_angle];
-            r = r.min(1.0 / angle_demand(angles, lim.yaw_rate, lim.angular_rate));
-        }
+        // No angle change asks for no time: 1 / 0 is no bound.
+        let angles = [self.yaw, self.link_angle];
+        r = r.min(1.0 / angle_demand(angles, lim.yaw_rate, lim.angular_rate));
         r
     }
 }

@@ -156,11 +156,14 @@ fn check(a: &SimArgs) -> Result<(), CliError> {
 /// the map or itself.
 pub fn run(a: SimArgs) -> CliResult {
     check(&a)?;
-    let cfg = sim_config(&a)?;
     let options = FlyOptions {
-        sim: cfg.clone(),
+        sim: sim_config(&a)?,
         timing: a.timing.settings()?,
     };
+    // As the flight will be configured: the timing's limits in the simulation's.
+    let cfg = options.sim_config();
+    cfg.validate()
+        .map_err(|e| CliError::input(format!("simulation settings: {e}")))?;
     // With `--out -` the flight is standard output; the report goes to standard error.
     let report = Report::new(a.out.as_deref().unwrap_or(Path::new("")));
     let say = |args: std::fmt::Arguments<'_>| report.line(args);
@@ -307,27 +310,21 @@ fn timed(
     Ok(timed)
 }
 
-/// The simulation settings from the command line, checked.
+/// The simulation settings from the command line (its limits are the timing's,
+/// [`FlyOptions::sim_config`]).
 fn sim_config(a: &SimArgs) -> Result<SimConfig, CliError> {
     let gusts = a
         .gust
         .iter()
         .map(|g| parse_gust(g))
         .collect::<Result<Vec<_>, _>>()?;
-    let mut cfg = SimConfig {
+    Ok(SimConfig {
         rate: a.rate,
         goal_tolerance: a.goal_tol,
         settle_time: a.settle_time,
         gusts,
         ..Default::default()
-    };
-    cfg.limits = aerial_chain::trajectory::ReferenceLimits {
-        start_hold: cfg.limits.start_hold,
-        ..a.timing.limits.limits()?.to_reference()
-    };
-    cfg.validate()
-        .map_err(|e| CliError::input(format!("simulation settings: {e}")))?;
-    Ok(cfg)
+    })
 }
 
 /// The flight's report, one line per measure.
