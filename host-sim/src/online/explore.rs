@@ -1,6 +1,6 @@
 //! Flying into the unknown in simulation: the true map is read only by the units'
 //! simulated sensors; an [`OnlinePlanner`] plans from what they saw; the chain's
-//! dynamics fly what it commits (a [`FlightRun`] whose reference grows).
+//! dynamics fly what it commits (a [`FlightRun`] that follows the committed motion).
 //!
 //! # The loop
 //! At every physics step the unit centres that moved half a voxel since they were last
@@ -8,10 +8,11 @@
 //! `1 / rate_hz` s every unit's sensor scans the truth from the unit's flown pose (tilt
 //! included) and the clouds are fused; then the planner replans when one is due: the
 //! next piece when the committed motion ends within a deadline plus a sensor period
-//! ([`Trigger::CommitShort`]), else the route when a scan cut it or its period elapsed.
-//! A replan's measured wall time passes in the simulation before its piece is used:
-//! the piece joins the reference at the later of that time and the end of the
-//! committed motion (the chain rests there meanwhile).
+//! ([`Trigger::CommitShort`]; its lead is [`OnlinePlanner::commit_lead`]), else the
+//! route when a scan cut it or its period elapsed. A replan's measured wall time
+//! passes in the simulation before its piece is used: from then on the flight follows
+//! the planner's committed motion, the piece joined in flight or after the motion's
+//! end (the chain rests there meanwhile).
 
 use std::time::Instant;
 
@@ -28,7 +29,7 @@ use crate::flying::FlyOptions;
 use crate::map::{DistanceField, Grid};
 use crate::plan_file::{MapSection, Plan};
 use crate::sensing::{raycast, OccupancyMap, PointCloud, Survey, SurveyError, UnitPose};
-use crate::sim::{ChainModel, Flight, FlightEnd, FlightRun, MapClearance, Reference, SimError};
+use crate::sim::{ChainModel, Flight, FlightEnd, FlightRun, MapClearance, SimError};
 use crate::tables::ShapeTables;
 
 /// Everything an exploration needs besides the maps, the chain and the query.
@@ -128,6 +129,10 @@ pub struct Exploration {
     pub rebuild_s: Option<f64>,
     /// What the start was taken to leave free.
     pub start_free: StartFree,
+    /// The joints flown without a stop, in order: for every piece joined onto the
+    /// committed motion in flight, its blend (simulated s, from when the motion leaves
+    /// both pieces' paths to when it is back on the later one's).
+    pub joints: Vec<(f64, f64)>,
 }
 
 /// The record of an exploration kept in its flight file (docs/model.md,
@@ -301,9 +306,8 @@ pub fn explore(
     )?;
     planner.keep_maps(settings.audit);
     let cfg = settings.fly.sim_config();
-    let l = params.link_length as f64;
-    let rest =
-        Reference::new(params.n(), l, &[start.to_vec()], &cfg.limits).map_err(SimError::from)?;
+    planner.hold_at_start(cfg.limits.start_hold);
+    let rest = planner.committed().clone();
     let obstacles = MapClearance::new(truth, &params);
     let run = FlightRun::start(ChainModel::new(params), rest, &cfg, Some(&obstacles), 0)?;
     let mut lp = Loop {
@@ -386,7 +390,8 @@ struct Loop<'a> {
     flown_radius: f64,
     marked: Vec<Point3<f64>>,
     next_scan: f64,
-    pending: Option<(f64, Reference)>,
+    /// When the planner's committed motion, changed by a replan, may be flown.
+    pending: Option<f64>,
     sensing: SensingStats,
     goal: Point3<f64>,
 }
@@ -433,8 +438,9 @@ impl Loop<'_> {
         if self.pending.is_some() || self.planner.reached() {
             return None;
         }
-        let remaining = self.run.reference().duration() - t;
-        if remaining < self.planner.settings().deadline_s + period {
+        let remaining = self.planner.committed().duration() - t;
+        let lead = self.planner.commit_lead();
+        if remaining < lead + self.planner.settings().deadline_s + period {
             Some(Trigger::CommitShort)
         } else if self.planner.route_cut() {
             Some(Trigger::RouteCut)
@@ -453,24 +459,20 @@ impl Loop<'_> {
             return Some(ExploreEnd::Sealed { t, why });
         }
         if self.planner.pieces().len() > before {
-            let piece = self.planner.pieces().last().expect("committed");
-            let next = piece.trajectory.reference().clone();
-            self.pending = Some((t + record.wall_s, next));
+            self.pending = Some(self.planner.effective_from());
         }
         None
     }
 
-    /// Appends the pending piece once its replan's time has passed.
+    /// Flies the planner's committed motion once its replan's time has passed.
     fn join_pending(&mut self, t: f64) -> Result<(), crate::sim::ReferenceError> {
-        if let Some((ready, next)) = self.pending.take() {
-            if t >= ready {
-                let at = ready.max(self.run.reference().duration());
-                self.run.extend(at, &next)?;
-            } else {
-                self.pending = Some((ready, next));
+        match self.pending {
+            Some(ready) if t >= ready => {
+                self.pending = None;
+                self.run.follow(self.planner.committed().clone())
             }
+            _ => Ok(()),
         }
-        Ok(())
     }
 
     /// Marks the balls about the unit centres that moved half a voxel since last.
@@ -549,12 +551,14 @@ impl Loop<'_> {
         let planner = self.planner;
         let plan = planner.joined_plan(start, MapSection::of(self.truth));
         let audit = self.settings.audit.then(|| {
+            let timing = &self.settings.fly.timing;
             planner
                 .pieces()
                 .iter()
                 .map(|p| {
                     let map = p.map.as_ref().expect("kept with audit");
-                    verify_plan(map, &p.plan).violation.map(|v| v.to_string())
+                    let plan = verify_plan(map, &p.plan).violation.map(|v| v.to_string());
+                    plan.or_else(|| audit_joint(&flight.reference, p, map, timing))
                 })
                 .collect()
         });
@@ -579,8 +583,32 @@ impl Loop<'_> {
             looking_s,
             rebuild_s,
             start_free: planner.settings().start_free,
+            joints: planner.pieces().iter().filter_map(|p| p.blend).collect(),
         })
     }
+}
+
+/// The exact check's first violation of the flown `reference` on `map` over the
+/// joint where `piece` was joined in flight (its blend, a sample either side), if it
+/// was.
+fn audit_joint(
+    reference: &crate::sim::Reference,
+    piece: &super::Piece,
+    map: &Grid,
+    timing: &crate::trajectory::Settings,
+) -> Option<String> {
+    let (from, to) = piece.blend?;
+    let dt = timing.dt;
+    let count = ((to - from) / dt).ceil() as usize + 3;
+    let times: Vec<f64> = (0..count).map(|j| from - dt + j as f64 * dt).collect();
+    let zetas: Vec<Vec<f64>> = times.iter().map(|&t| reference.zeta(t)).collect();
+    let params = piece.trajectory.params();
+    let horizon = timing.clearance;
+    let report =
+        crate::trajectory::check_samples(map, params, &timing.limits, &times, &zetas, horizon);
+    report
+        .violation
+        .map(|v| format!("the joint in flight: {v}"))
 }
 
 /// Rebuilds of the audit: the median of this many is compared with the median update,

@@ -8,7 +8,7 @@
 //! - [`planner`]: [`OnlinePlanner`], the library's online planner: it observes point
 //!   clouds in the world frame, replans under a deadline, and commits pieces that lie
 //!   in space known free, pass the trajectory's exact check with unknown space
-//!   occupied, and end at rest;
+//!   occupied, and end at rest, joined into one committed motion;
 //! - [`settings`]: [`OnlineSettings`] and [`OnlineError`]; [`record`]: what every
 //!   replan records ([`ReplanRecord`]);
 //! - [`mod@explore`]: [`explore()`], the simulator as a client: sensors read the true map,
@@ -20,8 +20,11 @@
 //! ends, at rest, to the farthest route point whose head sphere is known free (or a
 //! nearer one), planned by the ARCplanner on the map with unknown space occupied,
 //! timed and checked there, and ends at rest; so the chain can always stop, in known
-//! space. Where the route leaves the sensors' view the piece ends with the head yaw
-//! (which every unit holds, and so every sensor) turned along the route.
+//! space. A piece committed before the chain begins to slow down for that rest is
+//! joined onto the committed motion in flight, the corner at the joint blended and
+//! checked on the map of the commit (`crate::trajectory::splice()`), so the chain does
+//! not stop there. Where the route leaves the sensors' view the piece ends with the
+//! head yaw (which every unit holds, and so every sensor) turned along the route.
 
 pub mod belief;
 pub mod explore;

@@ -19,7 +19,7 @@ use crate::planner::Query;
 use crate::planning::{plan, Request};
 use crate::sensing::{DepthSensor, PointCloud};
 use crate::tables::ShapeTables;
-use crate::trajectory::Trajectory;
+use crate::trajectory::{splice, Reference, Trajectory};
 
 /// A committed piece: its plan, timed and checked on the map of its commit.
 #[derive(Clone, Debug)]
@@ -31,7 +31,17 @@ pub struct Piece {
     /// The map it was planned and checked on (unknown space occupied), when the
     /// planner keeps them ([`OnlinePlanner::keep_maps`]).
     pub map: Option<Grid>,
+    /// When it was joined onto the motion before it in flight, without a stop: the
+    /// blend of the corner at the joint (simulated s, from when the motion leaves both
+    /// pieces' paths to when it is back on this one's), checked on the map of its
+    /// commit with the trajectory's clearance.
+    pub blend: Option<(f64, f64)>,
 }
+
+/// The lead of a joint that turns straight back, in ramps down of the motion before it:
+/// the joint's ramp is twice that ramp (it changes the velocity by twice the cruise),
+/// so that motion slows down `(1 + 2) / 2` of it before its old end. Derived.
+const LEAD_OF_A_REVERSAL: f64 = 1.5;
 
 /// The plan stat that marks a turn in place toward the route (look before moving).
 const TURN_TO_LOOK: &str = "turn_to_look";
@@ -71,6 +81,8 @@ pub struct OnlinePlanner {
     records: Vec<ReplanRecord>,
     looked_at_hull: bool,
     searches: usize,
+    committed: Reference,
+    effective: f64,
 }
 
 impl OnlinePlanner {
@@ -108,6 +120,10 @@ impl OnlinePlanner {
         let mut belief = Belief::new(bounds, prior).map_err(|e| OnlineError::Map(e.to_string()))?;
         belief.mark_clear(&start_free_space(&params, start, &settings))?;
         let grown = params.unit_radius as f64 + settings.plan.clearance + FK_TOLERANCE;
+        let l = params.link_length as f64;
+        let limits = settings.trajectory.limits.to_reference();
+        let committed = Reference::new(params.n(), l, &[as_written(start)], &limits)
+            .map_err(|e| OnlineError::Map(format!("the start: {e}")))?;
         Ok(Self {
             params,
             tables,
@@ -130,7 +146,18 @@ impl OnlinePlanner {
             records: Vec::new(),
             looked_at_hull: false,
             searches: 0,
+            committed,
+            effective: 0.0,
         })
+    }
+
+    /// Holds the chain at rest at its start for the first `seconds` of simulated time
+    /// (a simulation that settles the chain in trim first): no piece starts earlier.
+    /// Only before the first piece.
+    pub fn hold_at_start(&mut self, seconds: f64) {
+        if self.pieces.is_empty() {
+            self.committed = self.committed.with_start_hold(seconds);
+        }
     }
 
     /// Keeps the map every piece was committed on (for an audit of the pieces; each
@@ -186,6 +213,7 @@ impl OnlinePlanner {
             true => self.failed_on == Some(changed) && !self.retry_due(),
             false => !fresh && self.route.is_some(),
         };
+        let pieces = self.pieces.len();
         let (outcome, committed_m) = if self.reached {
             (Outcome::Reached, 0.0)
         } else if idle {
@@ -224,6 +252,8 @@ impl OnlinePlanner {
             }
             _ => {}
         }
+        let joined = self.pieces.len() > pieces;
+        let joined_moving = joined && self.join(now, began);
         let record = ReplanRecord {
             t: now,
             trigger,
@@ -232,9 +262,77 @@ impl OnlinePlanner {
             voxels_changed,
             committed_m,
             route_m: self.route.as_ref().map_or(0.0, Route::length),
+            joined_moving,
         };
+        if joined {
+            // The replan's whole wall time passes before its result is flown.
+            self.effective = now + record.wall_s;
+        }
         self.records.push(record.clone());
         record
+    }
+
+    /// Joins the piece just committed onto the committed motion: in flight when the
+    /// join takes effect before the chain begins to slow down for the motion's end and
+    /// its new part passes the exact check on the map of the commit
+    /// ([`crate::trajectory::splice()`]), else from rest after the motion ends; either
+    /// way no earlier than the end of this replan, begun at simulated time `now`.
+    /// Returns whether it joined in flight.
+    fn join(&mut self, now: f64, began: Instant) -> bool {
+        let Some(piece) = self.pieces.last_mut() else {
+            return false;
+        };
+        let next = piece.trajectory.reference();
+        let grid = self.belief.commit_field().grid();
+        let settings = &self.settings.trajectory;
+        let spliced = splice(&self.committed, next, &self.params, grid, settings, now);
+        let ready = now + began.elapsed().as_secs_f64();
+        match spliced {
+            Ok(s) if ready <= s.take_by => {
+                self.committed = s.reference;
+                piece.blend = Some(s.blend);
+                true
+            }
+            _ => {
+                let at = ready.max(self.committed.duration());
+                // A piece is planned from the committed end, as a plan file writes it.
+                self.committed = self
+                    .committed
+                    .then(at, next)
+                    .expect("a piece starts where the committed motion ends");
+                false
+            }
+        }
+    }
+
+    /// The committed motion in simulated time, from the start: every piece joined.
+    /// The chain flies it from [`Self::effective_from`] on.
+    pub fn committed(&self) -> &Reference {
+        &self.committed
+    }
+
+    /// When the committed motion as it is now may be flown (simulated s): the end of
+    /// the replan that last changed it, whose wall time passes first. Up to then it is
+    /// the motion committed before.
+    pub fn effective_from(&self) -> f64 {
+        self.effective
+    }
+
+    /// How long before the committed motion ends the next piece is due (s): long
+    /// enough to join it in flight, before the chain begins to slow down for the end.
+    /// That is where the last ramp down (of length `W`) would begin for a piece that
+    /// turns straight back, `1.5 W` before the end (`crate::trajectory::splice()`: the
+    /// joint's ramp is `2 W` then), so any corner can be joined. Zero after a turn to
+    /// look (the next piece waits for what it shows) or when the motion ends at rest.
+    pub fn commit_lead(&self) -> f64 {
+        let look = self.pieces.last().is_some_and(Piece::is_look);
+        let last = self.committed.segments().last();
+        match last {
+            Some(s) if !look && self.settings.trajectory.blend && !s.is_hold() => {
+                LEAD_OF_A_REVERSAL * s.scaling.ramp_down
+            }
+            _ => 0.0,
+        }
     }
 
     /// Most times a commit that found no piece is tried again, each with twice the
@@ -429,6 +527,7 @@ impl OnlinePlanner {
             plan,
             trajectory,
             map,
+            blend: None,
         })
     }
 

@@ -56,4 +56,8 @@ pub struct ReplanRecord {
     pub committed_m: f64,
     /// Length of the route to the goal (m; 0 when none).
     pub route_m: f64,
+    /// Whether the piece committed was joined onto the committed motion in flight,
+    /// without a stop (false when none was, and in records written before joins).
+    #[serde(default)]
+    pub joined_moving: bool,
 }

@@ -407,3 +407,40 @@ fn an_exploration_record_without_start_free_took_the_bodies() {
     let old: ExploreRecord = serde_json::from_value(v).unwrap();
     assert_eq!(old.start_free, StartFree::Bodies);
 }
+
+/// A square tunnel 0.6 m across along x, 11.8 m long, at 0.05 m: longer than the
+/// sensors' 5 m, so the chain flies it in pieces.
+fn long_tunnel() -> Grid {
+    let mut world = Grid::new(0.05, [0; 3], [240, 20, 20], Cell::Occupied, true).unwrap();
+    fill(&mut world, [0.1, 0.2, 0.2], [11.9, 0.8, 0.8], Cell::Free);
+    world
+}
+
+/// Pieces committed before the chain slows down for the end of the committed motion
+/// are joined onto it in flight: at every such joint the flown reference keeps moving,
+/// the joint passes the audit on its commit's map, and the flight is clear.
+#[test]
+fn pieces_committed_in_time_are_joined_in_flight_without_a_stop() {
+    let world = long_tunnel();
+    let start = Waypoint::new([2.0, 0.5, 0.5], &aerial_chain_core::Shape::line(4, 0.0)).zeta;
+    let goal = Point3::new(11.2, 0.5, 0.5);
+    let ex = explore_audited(&world, 4, &start, goal, 200.0, StartFree::Hull);
+    let joined: Vec<_> = ex.replans.iter().filter(|r| r.joined_moving).collect();
+    assert!(
+        !joined.is_empty(),
+        "no piece joined in flight: {:?}",
+        ex.replans
+    );
+    let reference = &ex.flight.reference;
+    assert_eq!(ex.joints.len(), joined.len());
+    for &(from, to) in &ex.joints {
+        let slowest = (0..=20)
+            .map(|k| from + (to - from) * f64::from(k) / 20.0)
+            .map(|t| reference.sample(t).v.norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            slowest > 0.1,
+            "the head slows to {slowest} m/s at the joint {from}..{to}"
+        );
+    }
+}

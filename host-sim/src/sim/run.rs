@@ -2,7 +2,7 @@
 //! reference, every step recorded and watched (tracking, limits, self and map
 //! clearance). [`FlightRun`] is the loop behind `simulate` and its kin, and the
 //! simulator of a chain whose reference grows while it flies (the online planner
-//! appends committed pieces with [`FlightRun::extend`]).
+//! replaces the reference ahead of the chain with [`FlightRun::follow`]).
 
 use std::time::Instant;
 
@@ -104,10 +104,19 @@ impl<'a> FlightRun<'a> {
         &self.tally.samples
     }
 
-    /// Appends `next` (which starts where the reference ends, at rest) at time `at`
-    /// (s, no earlier than the reference's end; the chain holds still until then).
-    pub fn extend(&mut self, at: f64, next: &Reference) -> Result<(), ReferenceError> {
-        self.reference = self.reference.then(at, next)?;
+    /// Follows `reference` from now on in place of the reference followed: the online
+    /// planner's committed motion, which changes only ahead of the chain (a piece
+    /// appended after its end, or joined onto its last motion before the chain begins
+    /// to slow down). Refuses one that is not where the followed one is now.
+    pub fn follow(&mut self, reference: Reference) -> Result<(), ReferenceError> {
+        let t = self.time();
+        if !self.reference.agrees_at(&reference, t) {
+            return Err(ReferenceError::Join {
+                at: t,
+                end: self.reference.duration(),
+            });
+        }
+        self.reference = reference;
         self.goal = Goal::of(&self.reference, self.model.units());
         Ok(())
     }

@@ -5,6 +5,7 @@ use aerial_chain_core::ChainParams;
 
 use super::dynamics::V3;
 use super::flight::{simulate, Gust, SimConfig};
+use super::{ChainModel, FlightRun, Reference, ReferenceError};
 
 fn zeta(xi: [f64; 3], eta: &[f64]) -> Vec<f64> {
     let mut z = xi.to_vec();
@@ -304,4 +305,29 @@ fn the_reported_clearance_is_the_every_step_minimum() {
         // The cases are what they claim: the gust pushes into the wall, the drift not.
         assert_eq!(r.contact, touches, "every-step minimum {exact} m");
     }
+}
+
+/// A flight follows a new reference only where it is where the one followed is now:
+/// a reference that differs ahead of the chain is taken, one that would move the chain
+/// now is refused.
+#[test]
+fn a_flight_follows_a_reference_that_changes_only_ahead_of_it() {
+    let params = ChainParams::new(3);
+    let cfg = SimConfig::default();
+    let start = vec![1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let ahead = vec![2.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let l = params.link_length as f64;
+    let rest = Reference::new(3, l, std::slice::from_ref(&start), &cfg.limits).unwrap();
+    let mut run = FlightRun::start(ChainModel::new(params), rest.clone(), &cfg, None, 0).unwrap();
+    for _ in 0..10 {
+        assert!(run.advance(false).is_none());
+    }
+    let go = Reference::new(3, l, &[start.clone(), ahead.clone()], &cfg.limits).unwrap();
+    // Starting to move now, from where the chain rests: the start hold keeps it still.
+    run.follow(go.clone()).unwrap();
+    assert_eq!(run.reference(), &go);
+    let elsewhere = Reference::new(3, l, &[ahead.clone(), start], &cfg.limits).unwrap();
+    let refused = run.follow(elsewhere).unwrap_err();
+    assert!(matches!(refused, ReferenceError::Join { .. }), "{refused}");
+    assert_eq!(run.reference(), &go);
 }

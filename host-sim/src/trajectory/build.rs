@@ -54,7 +54,7 @@ const RAMP_PEAK: f64 = 1.5;
 
 /// Each round of fitting lowers an edge's rate this much below what fits it exactly, so
 /// that rounding cannot keep the fit from ending. A numerical guard, not tuning.
-const FIT_UNDERSHOOT: f64 = 1.001;
+pub(super) const FIT_UNDERSHOOT: f64 = 1.001;
 
 /// A timed trajectory: its samples, and the analytic motion they were taken from.
 #[derive(Clone, Debug)]
@@ -356,6 +356,15 @@ fn corner_near(segments: &[Segment], blend: &[bool], v: &Violation, dt: f64) -> 
     })
 }
 
+/// The length of a ramp that changes the rate of `zeta` by `change` (per coordinate)
+/// within the acceleration limits: the head's by its norm, every angle by its own limit.
+pub(super) fn ramp_length(limits: &super::Limits, change: &[f64]) -> f64 {
+    let head = change.iter().take(3).map(|d| d * d).sum::<f64>().sqrt();
+    let d_omega = change.iter().skip(3).copied();
+    let angles = angle_demand(d_omega, limits.yaw_accel, limits.angular_accel);
+    RAMP_PEAK * (head / limits.accel).max(angles)
+}
+
 /// What timing the edges needs.
 struct Timing<'a> {
     settings: &'a Settings,
@@ -367,16 +376,10 @@ impl Timing<'_> {
     /// The length of a ramp that takes the chain from cruising along `from` to
     /// cruising along `to` (`None`: at rest) within the acceleration limits.
     fn ramp(&self, from: Option<(&Segment, f64)>, to: Option<(&Segment, f64)>) -> f64 {
-        let lim = &self.settings.limits;
         let v = |e: Option<(&Segment, f64)>, j: usize| e.map_or(0.0, |(s, r)| r * s.delta[j]);
-        let head = (0..3)
-            .map(|j| (v(to, j) - v(from, j)).powi(2))
-            .sum::<f64>()
-            .sqrt();
         let dim = self.edges.first().map_or(0, |e| e.delta.len());
-        let d_omega = (3..dim).map(|j| v(to, j) - v(from, j));
-        let angles = angle_demand(d_omega, lim.yaw_accel, lim.angular_accel);
-        RAMP_PEAK * (head / lim.accel).max(angles)
+        let change: Vec<f64> = (0..dim).map(|j| v(to, j) - v(from, j)).collect();
+        ramp_length(&self.settings.limits, &change)
     }
 
     /// Ramps up and down of every edge at cruise rates `rates`.

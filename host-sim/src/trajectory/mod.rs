@@ -17,6 +17,7 @@
 //! - `check`: [`check_samples`], the exact check of sampled motion and its limits;
 //! - `group`: which edges fly together as one motion, and how a merge gives way;
 //! - `legs`: a mission's plan timed leg by leg, with the holds at its goals;
+//! - `splice`: [`splice()`], a trajectory joined onto a motion in flight without a stop;
 //! - `merge`: what a merged motion demands of the limits, and which edges lie on a line;
 //! - `file`: [`TrajectoryFile`], the `arc-trajectory/1` JSON file and its CSV form.
 
@@ -28,6 +29,7 @@ mod group;
 mod legs;
 mod merge;
 pub(crate) mod reference;
+mod splice;
 mod stages;
 #[cfg(test)]
 mod tests;
@@ -43,6 +45,7 @@ pub use reference::{
     LimitsError, Reference, ReferenceError, ReferenceLimits, DEFAULT_YAW_ACCEL,
     DEFAULT_YAW_ACCEL_DEG, DEFAULT_YAW_RATE, DEFAULT_YAW_RATE_DEG,
 };
+pub use splice::{splice, NoSplice, Splice};
 pub use stages::{Stage, StageReport, Stages};
 
 use serde::{Deserialize, Serialize};

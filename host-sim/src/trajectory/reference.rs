@@ -337,6 +337,11 @@ pub struct Reference {
 }
 
 impl Segment {
+    /// Whether the chain rests through it.
+    pub fn is_hold(&self) -> bool {
+        self.kind == SegmentKind::Hold
+    }
+
     /// `(s, ds/dt, d2s/dt2)` at time `t` into the segment; a hold stays at 0.
     fn progress(&self, t: f64) -> (f64, f64, f64) {
         match self.kind {
@@ -634,6 +639,21 @@ impl Reference {
         let mut joined = Self::from_segments(self.units, first, segments);
         joined.duration = joined.duration.max(at);
         Ok(joined)
+    }
+
+    /// Whether `other`, a reference of the same chain, is where this one is at time `t`
+    /// (every number of `zeta` within the join tolerance, angles up to whole turns):
+    /// what a reference that replaces this one in flight must be.
+    pub fn agrees_at(&self, other: &Reference, t: f64) -> bool {
+        let (a, b) = (self.zeta(t), other.zeta(t));
+        other.units == self.units
+            && a.iter().zip(&b).enumerate().all(|(j, (x, y))| {
+                let d = match j >= 3 {
+                    true => crate::collision::verify::wrap(x - y),
+                    false => x - y,
+                };
+                d.abs() <= JOIN_TOLERANCE
+            })
     }
 
     /// The reference at time `t` (clamped to `[0, duration]`: at rest before and after).

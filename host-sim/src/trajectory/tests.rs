@@ -9,7 +9,7 @@ use crate::collision::exact::check_config_exact;
 use crate::map::{Cell, Grid};
 use crate::plan_file::{Waypoint, FORMAT as PLAN_FORMAT};
 
-fn plan(params: &ChainParams, points: &[([f64; 3], Shape)]) -> Plan {
+pub(super) fn plan(params: &ChainParams, points: &[([f64; 3], Shape)]) -> Plan {
     Plan {
         format: PLAN_FORMAT.into(),
         chain: ChainSection::from_params(params),
@@ -20,7 +20,7 @@ fn plan(params: &ChainParams, points: &[([f64; 3], Shape)]) -> Plan {
 }
 
 /// A free room of 4 x 4 x 2 m.
-fn room() -> Grid {
+pub(super) fn room() -> Grid {
     Grid::new(0.1, [0, 0, 0], [40, 40, 20], Cell::Free, true).unwrap()
 }
 
@@ -57,15 +57,25 @@ fn units(l: f64, z: &[f64]) -> Vec<[f64; 3]> {
 }
 
 /// The trajectory of `plan` on `grid` with the default settings.
-fn built(plan: &Plan, grid: &Grid) -> Trajectory {
+pub(super) fn built(plan: &Plan, grid: &Grid) -> Trajectory {
     build(plan, grid, &Settings::default()).unwrap()
 }
 
 /// Every limit `tr` was made within at every sample by differences, and every sample
 /// valid by the exact test: the test's own reading of docs/model.md, independent of the generator.
 fn assert_respects_limits(grid: &Grid, tr: &Trajectory) {
-    let (params, lim) = (tr.params(), &tr.settings().limits);
     let (t, z) = (tr.times(), tr.zetas());
+    assert_samples_respect_limits(grid, tr.params(), &tr.settings().limits, t, z);
+}
+
+/// [`assert_respects_limits`] of samples `z` at times `t` of chain `params` within `lim`.
+pub(super) fn assert_samples_respect_limits(
+    grid: &Grid,
+    params: &ChainParams,
+    lim: &Limits,
+    t: &[f64],
+    z: &[Vec<f64>],
+) {
     let l = params.link_length as f64;
     let slack = 1.0 + 1e-6;
     let angle = |a: f64| {

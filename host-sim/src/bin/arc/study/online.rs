@@ -38,7 +38,10 @@ pub struct OnlineRun {
     pub replans: usize,
     /// Pieces committed.
     pub pieces: usize,
-    /// Pieces that fail the exact test on the map they were committed on.
+    /// Pieces joined onto the committed motion in flight, without a stop.
+    pub joined: usize,
+    /// Pieces (or their joints) that fail the exact test on the map they were
+    /// committed on.
     pub pieces_invalid: usize,
     /// Replan wall time: median, 95th percentile, largest (s).
     pub latency_s: [f64; 3],
@@ -134,6 +137,7 @@ fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
     run.looking_s = ex.looking_s;
     run.replans = s.replans;
     run.pieces = ex.pieces;
+    run.joined = record.replans.iter().filter(|r| r.joined_moving).count();
     run.pieces_invalid = ex
         .audit
         .as_ref()
@@ -149,7 +153,7 @@ fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
 }
 
 /// The CSV's columns.
-const CSV_COLUMNS: [Column<OnlineRun>; 21] = [
+const CSV_COLUMNS: [Column<OnlineRun>; 22] = [
     ("scenario", |r| csv_field(&r.scenario)),
     ("units", |r| r.units.to_string()),
     ("end", |r| csv_field(&r.end)),
@@ -162,6 +166,7 @@ const CSV_COLUMNS: [Column<OnlineRun>; 21] = [
     }),
     ("replans", |r| r.replans.to_string()),
     ("pieces", |r| r.pieces.to_string()),
+    ("joined_in_flight", |r| r.joined.to_string()),
     ("pieces_invalid", |r| r.pieces_invalid.to_string()),
     ("latency_median_ms", |r| {
         format!("{:.2}", r.latency_s[0] * 1e3)
@@ -198,13 +203,13 @@ pub fn markdown(runs: &[OnlineRun]) -> String {
     let max = sorted(&|r| r.latency_s[2]);
     let speedup = sorted(&|r| r.speedup());
     let mut md = String::from(
-        "| scenario | N | end | time to goal (s) | finished map (s) | ratio | looking (s) | ratio without looks | replans | pieces (invalid) | latency median / p95 / max (ms) | update (ms) | rebuild / update | min clearance (m) |\n\
+        "| scenario | N | end | time to goal (s) | finished map (s) | ratio | looking (s) | ratio without looks | replans | pieces (joined in flight, invalid) | latency median / p95 / max (ms) | update (ms) | rebuild / update | min clearance (m) |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in runs {
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {:.1} | {:.1} | {:.2} | {:.1} | {:.2} | {} | {} ({}) | {:.1} / {:.1} / {:.1} | {:.2} | {:.0}x | {:.3} |",
+            "| {} | {} | {} | {:.1} | {:.1} | {:.2} | {:.1} | {:.2} | {} | {} ({}, {}) | {:.1} / {:.1} / {:.1} | {:.2} | {:.0}x | {:.3} |",
             r.scenario,
             r.units,
             r.end,
@@ -215,6 +220,7 @@ pub fn markdown(runs: &[OnlineRun]) -> String {
             r.ratio_without_looks(),
             r.replans,
             r.pieces,
+            r.joined,
             r.pieces_invalid,
             r.latency_s[0] * 1e3,
             r.latency_s[1] * 1e3,

@@ -1,0 +1,229 @@
+//! Joining a trajectory onto a motion in flight without a stop at the joint: the online
+//! planner's next piece starts where the committed motion ends at rest, and if it is
+//! committed before the chain begins to slow down for that rest, the two are flown as
+//! one motion, the corner between them blended as [`super::build`] blends a plan's
+//! corners (docs/online.md, "Pieces joined in flight").
+//!
+//! The committed motion's last segment `a` ramps down to rest over `W_a`; the piece's
+//! first segment `b` ramps up from rest over `U_b`. Joined, both ramps take the one
+//! length `R` that changes the velocity from `a`'s cruise to `b`'s within the limits
+//! (`super::build`'s rule), and `b` starts `R` before `a` ends; the cruise rates stay,
+//! so the ramps must fit (`r (U + W) / 2 <= 1`) as they are. Up to the time where
+//! either `a`'s old or its new ramp down begins, the joined motion is the committed
+//! one, so it can replace it while the chain flies there ([`Splice::take_by`]). From
+//! then until `b`'s ramp up ends it is new: those samples are checked exactly on the
+//! map given (the online planner's: unknown space occupied), and wherever the motion
+//! leaves both pieces' paths (the overlap) every body keeps the trajectory settings'
+//! clearance from the map, as a blend of one plan does.
+
+use aerial_chain_core::ChainParams;
+
+use super::build::{ramp_length, FIT_UNDERSHOOT};
+use super::check::{check_with_margin, Violation};
+use super::reference::{Reference, Scaling, Segment, SegmentKind};
+use super::Settings;
+use crate::map::Grid;
+
+/// A joined motion.
+#[derive(Clone, Debug)]
+pub struct Splice {
+    /// The committed motion, then the piece without a stop between them.
+    pub reference: Reference,
+    /// Latest time (s) at which `reference` may replace the committed motion: until
+    /// then the two are the same motion.
+    pub take_by: f64,
+    /// When the joined motion leaves both pieces' paths and when it is back on the
+    /// piece's (s): the blend of the corner at the joint.
+    pub blend: (f64, f64),
+}
+
+/// Why a piece cannot be joined in flight (it then starts from rest after the
+/// committed motion ends).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum NoSplice {
+    /// The trajectory settings do not blend.
+    #[error("the trajectory settings do not blend corners")]
+    Unblended,
+    /// The committed motion does not end in a motion (it is at rest, or holds).
+    #[error("the committed motion ends at rest")]
+    AtRest,
+    /// The piece does not start with a motion from time 0.
+    #[error("the piece does not start with a motion")]
+    PieceAtRest,
+    /// The ramps of the joint would not fit their segments at their cruise rates.
+    #[error("the ramps of the joint do not fit its segments")]
+    RampsDoNotFit,
+    /// The committed motion begins to slow down before the join could take effect.
+    #[error("the committed motion slows down at {take_by:.3} s, before {not_before:.3} s")]
+    TooLate {
+        /// When it must have taken effect (s).
+        take_by: f64,
+        /// The earliest it can (s).
+        not_before: f64,
+    },
+    /// The joined motion would reach the end of the piece's first motion later than a
+    /// stop at the joint would (the piece's first motion slowed down too much to fit).
+    #[error("the joined motion is slower than a stop at the joint")]
+    Slower,
+    /// The joined motion fails the exact check or the blend's clearance.
+    #[error("the joined motion is not admissible: {0}")]
+    Inadmissible(Violation),
+    /// The joined motion could not be sampled.
+    #[error("the joined motion could not be sampled")]
+    Unsampled,
+}
+
+/// Joins `next` (which starts at rest where `current` ends) onto `current`, the motion
+/// of chain `params` in flight, without a stop (see the module docs), if the join can
+/// take effect at `not_before` (s) or later and the new part of the motion passes the
+/// exact check on `grid` within `settings`.
+pub fn splice(
+    current: &Reference,
+    next: &Reference,
+    params: &ChainParams,
+    grid: &Grid,
+    settings: &Settings,
+    not_before: f64,
+) -> Result<Splice, NoSplice> {
+    if !settings.blend {
+        return Err(NoSplice::Unblended);
+    }
+    let segments = current.segments();
+    let (Some(a), Some(b)) = (segments.last(), next.segments().first()) else {
+        return Err(match segments.is_empty() {
+            true => NoSplice::AtRest,
+            false => NoSplice::PieceAtRest,
+        });
+    };
+    let ends_moving = a.kind != SegmentKind::Hold && a.t0 + a.duration >= current.duration();
+    if !ends_moving {
+        return Err(NoSplice::AtRest);
+    }
+    if b.kind == SegmentKind::Hold || b.t0 != 0.0 {
+        return Err(NoSplice::PieceAtRest);
+    }
+    let (sa, sb) = (&a.scaling, &b.scaling);
+    let (rate, ramp) = fit(a, b, next, settings).ok_or(NoSplice::RampsDoNotFit)?;
+    // The cruise of `a` ends where its ramp down begins: the old one or the new one.
+    let take_by = a.t0 + 1.0 / sa.rate + (sa.ramp - sa.ramp_down.max(ramp)) / 2.0;
+    if take_by < not_before {
+        return Err(NoSplice::TooLate {
+            take_by,
+            not_before,
+        });
+    }
+    let a_new = retimed(a, a.t0, Scaling::with_ramps(sa.rate, sa.ramp, ramp));
+    let a_end = a_new.t0 + a_new.duration;
+    let b_new = retimed(
+        b,
+        a_end - ramp,
+        Scaling::with_ramps(rate, ramp, sb.ramp_down),
+    );
+    // Stopping at the joint, `b` would end no earlier than this.
+    let stopped_end = current.duration() + b.duration;
+    if b_new.t0 + b_new.duration > stopped_end {
+        return Err(NoSplice::Slower);
+    }
+    // The piece's later segments keep their times relative to the end of `b`.
+    let shift = (b_new.t0 + b_new.duration) - (b.t0 + b.duration);
+    let mut joined: Vec<Segment> = segments[..segments.len() - 1].to_vec();
+    joined.push(a_new);
+    // Where `b` cruises slower than it would after a stop, it is new up to its end.
+    let new_to = match rate < sb.rate {
+        true => b_new.t0 + b_new.duration,
+        false => b_new.t0 + ramp,
+    };
+    let blend = (b_new.t0, a_end);
+    joined.push(b_new);
+    joined.extend(next.segments()[1..].iter().cloned().map(|mut s| {
+        s.t0 += shift;
+        s
+    }));
+    let first = segments.first().map_or(current.end(), |s| &s.from).to_vec();
+    let reference = Reference::from_segments(current.units(), &first, joined);
+    check_new_part(&reference, params, grid, settings, (take_by, new_to), blend)?;
+    Ok(Splice {
+        reference,
+        take_by,
+        blend,
+    })
+}
+
+/// The cruise rate of `b` and the joint's ramp: the ramp that changes the velocity
+/// from `a`'s cruise to `b`'s within the limits, `b`'s rate lowered until both
+/// segments' ramps fit (as `super::build` fits a plan's), in at most
+/// `settings.fit_rounds` rounds. `b`'s rate is lowered only when `b` ends at rest, so
+/// that nothing after it depends on it; `None` when they do not fit.
+fn fit(a: &Segment, b: &Segment, next: &Reference, settings: &Settings) -> Option<(f64, f64)> {
+    let (sa, sb) = (&a.scaling, &b.scaling);
+    let b_end = b.t0 + b.duration;
+    let b_rests = next.segments().get(1).is_none_or(|c| c.t0 >= b_end);
+    let mut rate = sb.rate;
+    for _ in 0..settings.fit_rounds {
+        let change: Vec<f64> = (a.delta.iter().zip(&b.delta))
+            .map(|(da, db)| rate * db - sa.rate * da)
+            .collect();
+        let ramp = ramp_length(&settings.limits, &change);
+        let excess = (sa.rate * (sa.ramp + ramp) / 2.0).max(rate * (ramp + sb.ramp_down) / 2.0);
+        if excess <= 1.0 {
+            return Some((rate, ramp));
+        }
+        if !b_rests {
+            return None;
+        }
+        rate /= excess.sqrt() * FIT_UNDERSHOOT;
+    }
+    None
+}
+
+/// Segment `s` started at `t0` with `scaling`.
+fn retimed(s: &Segment, t0: f64, scaling: Scaling) -> Segment {
+    Segment {
+        t0,
+        duration: scaling.duration,
+        scaling,
+        ..s.clone()
+    }
+}
+
+/// Checks `reference` exactly on `grid` from `from` to `to` (s; a sample beyond each),
+/// sampled every `settings.dt`; within `blend` (a sample either side) every body keeps
+/// `settings.clearance` from the map.
+fn check_new_part(
+    reference: &Reference,
+    params: &ChainParams,
+    grid: &Grid,
+    settings: &Settings,
+    (from, to): (f64, f64),
+    blend: (f64, f64),
+) -> Result<(), NoSplice> {
+    let dt = settings.dt;
+    let start = (from - dt).max(0.0);
+    let count = ((to + dt - start) / dt).ceil() as usize + 1;
+    if count > super::MAX_SAMPLES {
+        return Err(NoSplice::Unsampled);
+    }
+    let times: Vec<f64> = (0..count).map(|j| start + j as f64 * dt).collect();
+    let zetas: Vec<Vec<f64>> = times.iter().map(|&t| reference.zeta(t)).collect();
+    let margin = settings.clearance;
+    let required = |t: f64| match blend.0 - dt <= t && t <= blend.1 + dt {
+        true => margin,
+        false => 0.0,
+    };
+    let rep = check_with_margin(
+        grid,
+        params,
+        &settings.limits,
+        (&times, &zetas),
+        margin,
+        &required,
+    );
+    match rep.violation {
+        Some(v) => Err(NoSplice::Inadmissible(v)),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+#[path = "splice_tests.rs"]
+mod tests;

@@ -1,0 +1,137 @@
+//! Joining a piece onto a motion in flight: no stop at the joint, every limit and the
+//! map kept (checked by the tests' own reading of the limits), the same motion up to
+//! where the join must take effect, and refusals named.
+
+use aerial_chain_core::{ChainParams, Shape};
+
+use super::*;
+use crate::map::Cell;
+use crate::trajectory::tests::{assert_samples_respect_limits, built, plan, room};
+use crate::trajectory::Trajectory;
+
+/// A piece of a chain of 3 from head `from` to head `to`, the chain along x behind it.
+fn piece(params: &ChainParams, grid: &Grid, from: [f64; 3], to: [f64; 3]) -> Trajectory {
+    let s = Shape::line(3, 0.0);
+    built(&plan(params, &[(from, s), (to, s)]), grid)
+}
+
+/// `r`'s samples every `dt` from 0 to its end.
+fn samples(r: &Reference, dt: f64) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let n = (r.duration() / dt).ceil() as usize;
+    (0..=n)
+        .map(|j| (j as f64 * dt, r.zeta(j as f64 * dt)))
+        .unzip()
+}
+
+/// The head's speed of `r` at `t` (m/s).
+fn head_speed(r: &Reference, t: f64) -> f64 {
+    r.sample(t).v.norm()
+}
+
+#[test]
+fn a_piece_joined_straight_on_keeps_cruising_through_the_joint() {
+    let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
+    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.3, 1.0, 1.0]);
+    let b = piece(&params, &grid, [2.3, 1.0, 1.0], [3.5, 1.0, 1.0]);
+    let j = splice(a.reference(), b.reference(), &params, &grid, &s, 0.0).unwrap();
+    let joined = &j.reference;
+    // Two ramps of 1.5 s (0.5 m/s at 0.5 m/s^2) are saved: half of each.
+    let stopped = a.reference().duration() + b.reference().duration();
+    assert!(
+        joined.duration() <= stopped - 1.4,
+        "{} vs {stopped}",
+        joined.duration()
+    );
+    let v = head_speed(joined, a.reference().duration());
+    assert!(
+        v >= 0.99 * s.limits.speed,
+        "the head at {v} m/s at the joint"
+    );
+    for k in 0..=((j.take_by / s.dt) as usize) {
+        let t = k as f64 * s.dt;
+        assert!(joined.agrees_at(a.reference(), t), "differs at {t} s");
+    }
+    let end = b.reference().end();
+    assert!(joined
+        .end()
+        .iter()
+        .zip(end)
+        .all(|(x, y)| (x - y).abs() < 1e-9));
+    let (t, z) = samples(joined, s.dt);
+    assert_samples_respect_limits(&grid, &params, &s.limits, &t, &z);
+}
+
+/// Head along +x, then up: the tail rounds the joint's corner below a voxel that the
+/// pieces' own paths pass at 5 mm (as `tests::corner`).
+fn corner_pieces(params: &ChainParams, grid: &Grid) -> (Trajectory, Trajectory) {
+    (
+        piece(params, grid, [1.6, 1.0, 1.045], [2.955, 1.0, 1.045]),
+        piece(params, grid, [2.955, 1.0, 1.045], [2.955, 1.0, 1.8]),
+    )
+}
+
+#[test]
+fn a_corner_at_the_joint_is_rounded_only_where_it_keeps_off_the_map() {
+    let (params, s) = (ChainParams::new(3), Settings::default());
+    let free = room();
+    let (a, b) = corner_pieces(&params, &free);
+    let j = splice(a.reference(), b.reference(), &params, &free, &s, 0.0).unwrap();
+    // A right angle changes the velocity by sqrt(2) of the cruise: the joint's ramp is
+    // longer than the ramp to rest, so the chain slows down earlier than it would stop.
+    let rest_ramp = a.reference().segments().last().unwrap().scaling.ramp_down;
+    assert!(j.take_by < a.reference().duration() - rest_ramp);
+    assert!(j.blend.0 < a.reference().duration() && a.reference().duration() < j.blend.1);
+    let (t, z) = samples(&j.reference, s.dt);
+    assert_samples_respect_limits(&free, &params, &s.limits, &t, &z);
+    let mut blocked = room();
+    blocked.fill_box([1.71, 0.51, 1.21], [1.79, 1.49, 1.29], Cell::Occupied);
+    let (a, b) = corner_pieces(&params, &blocked);
+    let refused = splice(a.reference(), b.reference(), &params, &blocked, &s, 0.0);
+    assert!(
+        matches!(refused, Err(NoSplice::Inadmissible(_))),
+        "{refused:?}"
+    );
+}
+
+#[test]
+fn a_short_piece_is_slowed_to_join_and_never_joins_slower_than_a_stop() {
+    let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
+    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.5, 1.0, 1.0]);
+    let b = piece(&params, &grid, [2.5, 1.0, 1.0], [2.5, 1.3, 1.0]);
+    let j = splice(a.reference(), b.reference(), &params, &grid, &s, 0.0).unwrap();
+    let (before, after) = (
+        b.reference().segments()[0].scaling.rate,
+        j.reference.segments(),
+    );
+    let joined_b = after.last().unwrap();
+    assert!(
+        joined_b.scaling.rate < before,
+        "0.3 m cannot take the joint's ramp at its own cruise"
+    );
+    let stopped = a.reference().duration() + b.reference().duration();
+    assert!(j.reference.duration() <= stopped);
+    let (t, z) = samples(&j.reference, s.dt);
+    assert_samples_respect_limits(&grid, &params, &s.limits, &t, &z);
+}
+
+#[test]
+fn joins_that_cannot_be_made_are_refused_by_name() {
+    let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
+    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.3, 1.0, 1.0]);
+    let b = piece(&params, &grid, [2.3, 1.0, 1.0], [3.5, 1.0, 1.0]);
+    let (ra, rb) = (a.reference(), b.reference());
+    let j = splice(ra, rb, &params, &grid, &s, 0.0).unwrap();
+    let late = splice(ra, rb, &params, &grid, &s, j.take_by + 0.01);
+    assert!(matches!(late, Err(NoSplice::TooLate { .. })), "{late:?}");
+    let unblended = Settings { blend: false, ..s };
+    let off = splice(ra, rb, &params, &grid, &unblended, 0.0);
+    assert_eq!(off.unwrap_err(), NoSplice::Unblended);
+    // A motion that has come to rest and waits there, and a piece that waits first.
+    let still = Reference::new(3, 0.5, &[ra.end().to_vec()], &s.limits.to_reference()).unwrap();
+    let waiting = ra.then(ra.duration() + 1.0, &still).unwrap();
+    let rested = splice(&waiting, rb, &params, &grid, &s, 0.0);
+    assert_eq!(rested.unwrap_err(), NoSplice::AtRest);
+    let held = rb.with_start_hold(1.0);
+    let holds = splice(ra, &held, &params, &grid, &s, 0.0);
+    assert_eq!(holds.unwrap_err(), NoSplice::PieceAtRest);
+}
