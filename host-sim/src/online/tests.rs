@@ -240,11 +240,17 @@ fn a_goal_behind_a_wall_across_the_box_is_proven_sealed_from_an_empty_map() {
     assert!(!ex.flight.report.contact);
 }
 
+/// A square tunnel 0.6 m across along x, from x = 0.1 to `end` m, at 0.05 m.
+fn tunnel_to(end: f64) -> Grid {
+    let cells = ((end + 0.1) / 0.05).round() as usize;
+    let mut world = Grid::new(0.05, [0; 3], [cells, 20, 20], Cell::Occupied, true).unwrap();
+    fill(&mut world, [0.1, 0.2, 0.2], [end, 0.8, 0.8], Cell::Free);
+    world
+}
+
 /// A square tunnel 0.6 m across along x, from x = 0.1 to 4.9, at 0.05 m.
 fn tunnel() -> Grid {
-    let mut world = Grid::new(0.05, [0; 3], [100, 20, 20], Cell::Occupied, true).unwrap();
-    fill(&mut world, [0.1, 0.2, 0.2], [4.9, 0.8, 0.8], Cell::Free);
-    world
+    tunnel_to(4.9)
 }
 
 /// A chain at rest whose hull is partly unseen looks at it before it searches a piece:
@@ -408,20 +414,13 @@ fn an_exploration_record_without_start_free_took_the_bodies() {
     assert_eq!(old.start_free, StartFree::Bodies);
 }
 
-/// A square tunnel 0.6 m across along x, 11.8 m long, at 0.05 m: longer than the
-/// sensors' 5 m, so the chain flies it in pieces.
-fn long_tunnel() -> Grid {
-    let mut world = Grid::new(0.05, [0; 3], [240, 20, 20], Cell::Occupied, true).unwrap();
-    fill(&mut world, [0.1, 0.2, 0.2], [11.9, 0.8, 0.8], Cell::Free);
-    world
-}
-
 /// Pieces committed before the chain slows down for the end of the committed motion
 /// are joined onto it in flight: at every such joint the flown reference keeps moving,
 /// the joint passes the audit on its commit's map, and the flight is clear.
 #[test]
 fn pieces_committed_in_time_are_joined_in_flight_without_a_stop() {
-    let world = long_tunnel();
+    // Longer than the sensors' 5 m, so the chain flies it in pieces.
+    let world = tunnel_to(11.9);
     let start = Waypoint::new([2.0, 0.5, 0.5], &aerial_chain_core::Shape::line(4, 0.0)).zeta;
     let goal = Point3::new(11.2, 0.5, 0.5);
     let ex = explore_audited(&world, 4, &start, goal, 200.0, StartFree::Hull);
