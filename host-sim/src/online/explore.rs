@@ -129,10 +129,9 @@ pub struct Exploration {
     pub rebuild_s: Option<f64>,
     /// What the start was taken to leave free.
     pub start_free: StartFree,
-    /// The joints flown without a stop, in order: for every piece joined onto the
-    /// committed motion in flight, its blend (simulated s, from when the motion leaves
-    /// both pieces' paths to when it is back on the later one's).
-    pub joints: Vec<(f64, f64)>,
+    /// The joints flown without a stop, in order: one for every piece joined onto the
+    /// committed motion in flight.
+    pub joints: Vec<crate::trajectory::Joint>,
 }
 
 /// The record of an exploration kept in its flight file (docs/model.md,
@@ -307,6 +306,8 @@ pub fn explore(
     planner.keep_maps(settings.audit);
     let cfg = settings.fly.sim_config();
     planner.hold_at_start(cfg.limits.start_hold);
+    // The flight adopts a changed motion at its next physics step.
+    planner.follow_at_ticks(1.0 / cfg.rate);
     let rest = planner.committed().clone();
     let obstacles = MapClearance::new(truth, &params);
     let run = FlightRun::start(ChainModel::new(params), rest, &cfg, Some(&obstacles), 0)?;
@@ -558,7 +559,7 @@ impl Loop<'_> {
                 .map(|p| {
                     let map = p.map.as_ref().expect("kept with audit");
                     let plan = verify_plan(map, &p.plan).violation.map(|v| v.to_string());
-                    plan.or_else(|| audit_joint(&flight.reference, p, map, timing))
+                    plan.or_else(|| audit_joint(planner.committed(), p, map, timing))
                 })
                 .collect()
         });
@@ -583,31 +584,24 @@ impl Loop<'_> {
             looking_s,
             rebuild_s,
             start_free: planner.settings().start_free,
-            joints: planner.pieces().iter().filter_map(|p| p.blend).collect(),
+            joints: planner.pieces().iter().filter_map(|p| p.joint).collect(),
         })
     }
 }
 
-/// The exact check's first violation of the flown `reference` on `map` over the
-/// joint where `piece` was joined in flight (its blend, a sample either side), if it
-/// was.
+/// The check's first violation, on `map`, of the committed motion `reference` at the
+/// joint where `piece` was joined in flight, if it was: sampled again from the motion
+/// as it stands at the end (every piece joined), which is what was flown or would be.
 fn audit_joint(
     reference: &crate::sim::Reference,
     piece: &super::Piece,
     map: &Grid,
     timing: &crate::trajectory::Settings,
 ) -> Option<String> {
-    let (from, to) = piece.blend?;
-    let dt = timing.dt;
-    let count = ((to - from) / dt).ceil() as usize + 3;
-    let times: Vec<f64> = (0..count).map(|j| from - dt + j as f64 * dt).collect();
-    let zetas: Vec<Vec<f64>> = times.iter().map(|&t| reference.zeta(t)).collect();
+    let joint = piece.joint.as_ref()?;
     let params = piece.trajectory.params();
-    let horizon = timing.clearance;
-    let report =
-        crate::trajectory::check_samples(map, params, &timing.limits, &times, &zetas, horizon);
-    report
-        .violation
+    crate::trajectory::check_joint(reference, params, map, timing, joint)
+        .err()
         .map(|v| format!("the joint in flight: {v}"))
 }
 

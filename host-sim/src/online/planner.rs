@@ -19,7 +19,7 @@ use crate::planner::Query;
 use crate::planning::{plan, Request};
 use crate::sensing::{DepthSensor, PointCloud};
 use crate::tables::ShapeTables;
-use crate::trajectory::{splice, Reference, Trajectory};
+use crate::trajectory::{splice, splice_lead, Joint, Reference, Trajectory};
 
 /// A committed piece: its plan, timed and checked on the map of its commit.
 #[derive(Clone, Debug)]
@@ -32,16 +32,9 @@ pub struct Piece {
     /// planner keeps them ([`OnlinePlanner::keep_maps`]).
     pub map: Option<Grid>,
     /// When it was joined onto the motion before it in flight, without a stop: the
-    /// blend of the corner at the joint (simulated s, from when the motion leaves both
-    /// pieces' paths to when it is back on this one's), checked on the map of its
-    /// commit with the trajectory's clearance.
-    pub blend: Option<(f64, f64)>,
+    /// joint, in simulated time, checked on the map of its commit.
+    pub joint: Option<Joint>,
 }
-
-/// The lead of a joint that turns straight back, in ramps down of the motion before it:
-/// the joint's ramp is twice that ramp (it changes the velocity by twice the cruise),
-/// so that motion slows down `(1 + 2) / 2` of it before its old end. Derived.
-const LEAD_OF_A_REVERSAL: f64 = 1.5;
 
 /// The plan stat that marks a turn in place toward the route (look before moving).
 const TURN_TO_LOOK: &str = "turn_to_look";
@@ -83,6 +76,7 @@ pub struct OnlinePlanner {
     searches: usize,
     committed: Reference,
     effective: f64,
+    tick: f64,
 }
 
 impl OnlinePlanner {
@@ -148,6 +142,7 @@ impl OnlinePlanner {
             searches: 0,
             committed,
             effective: 0.0,
+            tick: 0.0,
         })
     }
 
@@ -254,20 +249,21 @@ impl OnlinePlanner {
         }
         let joined = self.pieces.len() > pieces;
         let joined_moving = joined && self.join(now, began);
+        // A committed piece is flown from the end of the wall time its join measured.
+        let wall_s = match joined {
+            true => self.effective - now,
+            false => began.elapsed().as_secs_f64(),
+        };
         let record = ReplanRecord {
             t: now,
             trigger,
             outcome,
-            wall_s: began.elapsed().as_secs_f64(),
+            wall_s,
             voxels_changed,
             committed_m,
             route_m: self.route.as_ref().map_or(0.0, Route::length),
             joined_moving,
         };
-        if joined {
-            // The replan's whole wall time passes before its result is flown.
-            self.effective = now + record.wall_s;
-        }
         self.records.push(record.clone());
         record
     }
@@ -276,26 +272,31 @@ impl OnlinePlanner {
     /// join takes effect before the chain begins to slow down for the motion's end and
     /// its new part passes the exact check on the map of the commit
     /// ([`crate::trajectory::splice()`]), else from rest after the motion ends; either
-    /// way no earlier than the end of this replan, begun at simulated time `now`.
-    /// Returns whether it joined in flight.
+    /// way no earlier than the end of this replan, begun at simulated time `now`: the
+    /// wall time up to this decision passes first (what is left, the join itself, is a
+    /// copy). Sets when the result may be flown; returns whether it joined in flight.
     fn join(&mut self, now: f64, began: Instant) -> bool {
-        let Some(piece) = self.pieces.last_mut() else {
+        let Some(last) = self.pieces.len().checked_sub(1) else {
             return false;
         };
-        let next = piece.trajectory.reference();
+        let next = self.pieces[last].trajectory.reference();
         let grid = self.belief.commit_field().grid();
         let settings = &self.settings.trajectory;
         let spliced = splice(&self.committed, next, &self.params, grid, settings, now);
         let ready = now + began.elapsed().as_secs_f64();
+        self.effective = ready;
+        let adopted = self.next_tick(ready);
         match spliced {
-            Ok(s) if ready <= s.take_by => {
+            Ok(s) if adopted <= s.joint.take_by => {
                 self.committed = s.reference;
-                piece.blend = Some(s.blend);
+                self.pieces[last].joint = Some(s.joint);
                 true
             }
             _ => {
                 let at = ready.max(self.committed.duration());
-                // A piece is planned from the committed end, as a plan file writes it.
+                // A piece is planned from the committed end, as a plan file writes it,
+                // so it starts there: `then` cannot refuse it.
+                let next = self.pieces[last].trajectory.reference();
                 self.committed = self
                     .committed
                     .then(at, next)
@@ -319,19 +320,36 @@ impl OnlinePlanner {
     }
 
     /// How long before the committed motion ends the next piece is due (s): long
-    /// enough to join it in flight, before the chain begins to slow down for the end.
-    /// That is where the last ramp down (of length `W`) would begin for a piece that
-    /// turns straight back, `1.5 W` before the end (`crate::trajectory::splice()`: the
-    /// joint's ramp is `2 W` then), so any corner can be joined. Zero after a turn to
-    /// look (the next piece waits for what it shows) or when the motion ends at rest.
+    /// enough to join any piece found within the deadline in flight, before the chain
+    /// begins to slow down for the end ([`crate::trajectory::splice_lead`]). Zero after
+    /// a turn to look (the next piece waits for what it shows) or when the motion ends
+    /// at rest.
     pub fn commit_lead(&self) -> f64 {
         let look = self.pieces.last().is_some_and(Piece::is_look);
         let last = self.committed.segments().last();
+        let limits = &self.settings.trajectory.limits;
         match last {
             Some(s) if !look && self.settings.trajectory.blend && !s.is_hold() => {
-                LEAD_OF_A_REVERSAL * s.scaling.ramp_down
+                splice_lead(s, limits)
             }
             _ => 0.0,
+        }
+    }
+
+    /// Adopts a changed committed motion at the follower's next tick of `period` s
+    /// (a simulator's physics step, a controller's period; 0: at once), on a clock
+    /// whose ticks are the multiples of `period` from 0: a piece is joined in flight
+    /// only when that tick comes before the chain begins to slow down, so that the
+    /// follower never switches to a motion that differs from the one it flies.
+    pub fn follow_at_ticks(&mut self, period: f64) {
+        self.tick = period.max(0.0);
+    }
+
+    /// The follower's first tick at or after `t` (s).
+    fn next_tick(&self, t: f64) -> f64 {
+        match self.tick > 0.0 {
+            true => (t / self.tick - TICK_GUARD).ceil() * self.tick,
+            false => t,
         }
     }
 
@@ -527,7 +545,7 @@ impl OnlinePlanner {
             plan,
             trajectory,
             map,
-            blend: None,
+            joint: None,
         })
     }
 
@@ -642,6 +660,10 @@ impl OnlinePlanner {
         plan
     }
 }
+
+/// Floating-point guard of a tick count: a time that is a whole number of ticks up to
+/// rounding counts as that tick. Not tuning.
+const TICK_GUARD: f64 = 1e-9;
 
 /// Head position of configuration `zeta`.
 pub(super) fn head(zeta: &[f64]) -> Point3<f64> {

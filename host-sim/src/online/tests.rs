@@ -432,7 +432,10 @@ fn pieces_committed_in_time_are_joined_in_flight_without_a_stop() {
     );
     let reference = &ex.flight.reference;
     assert_eq!(ex.joints.len(), joined.len());
-    for &(from, to) in &ex.joints {
+    let flown = ex.flight.report.simulated_time;
+    for j in &ex.joints {
+        let (from, to) = j.blend;
+        assert!(j.take_by <= from && from < to && to <= j.until && j.until < flown);
         let slowest = (0..=20)
             .map(|k| from + (to - from) * f64::from(k) / 20.0)
             .map(|t| reference.sample(t).v.norm())

@@ -45,7 +45,7 @@ pub use reference::{
     LimitsError, Reference, ReferenceError, ReferenceLimits, DEFAULT_YAW_ACCEL,
     DEFAULT_YAW_ACCEL_DEG, DEFAULT_YAW_RATE, DEFAULT_YAW_RATE_DEG,
 };
-pub use splice::{splice, NoSplice, Splice};
+pub use splice::{check_joint, lead as splice_lead, splice, Joint, NoSplice, Splice};
 pub use stages::{Stage, StageReport, Stages};
 
 use serde::{Deserialize, Serialize};

@@ -73,6 +73,19 @@ pub(crate) fn angle_demand(d_eta: impl IntoIterator<Item = f64>, yaw: f64, link:
 /// of a plan written to a file and read back.
 const JOIN_TOLERANCE: f64 = 1e-6;
 
+/// Whether configurations `a` and `b` (`zeta`) are one: every number within the join
+/// tolerance, angles up to whole turns.
+pub(crate) fn same_configuration(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len()
+        && a.iter().zip(b).enumerate().all(|(j, (x, y))| {
+            let d = match j >= 3 {
+                true => crate::collision::verify::wrap(x - y),
+                false => x - y,
+            };
+            d.abs() <= JOIN_TOLERANCE
+        })
+}
+
 /// Why a plan's waypoints cannot be timed into a reference.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ReferenceError {
@@ -604,15 +617,7 @@ impl Reference {
         let joined = next.units == self.units
             && at.is_finite()
             && at >= self.duration
-            && start.iter().zip(&self.end).enumerate().all(|(j, (a, b))| {
-                let d = a - b;
-                let d = if j >= 3 {
-                    crate::collision::verify::wrap(d)
-                } else {
-                    d
-                };
-                d.abs() <= JOIN_TOLERANCE
-            });
+            && same_configuration(start, &self.end);
         if !joined {
             return Err(ReferenceError::Join {
                 at,
@@ -645,15 +650,7 @@ impl Reference {
     /// (every number of `zeta` within the join tolerance, angles up to whole turns):
     /// what a reference that replaces this one in flight must be.
     pub fn agrees_at(&self, other: &Reference, t: f64) -> bool {
-        let (a, b) = (self.zeta(t), other.zeta(t));
-        other.units == self.units
-            && a.iter().zip(&b).enumerate().all(|(j, (x, y))| {
-                let d = match j >= 3 {
-                    true => crate::collision::verify::wrap(x - y),
-                    false => x - y,
-                };
-                d.abs() <= JOIN_TOLERANCE
-            })
+        other.units == self.units && same_configuration(&self.zeta(t), &other.zeta(t))
     }
 
     /// The reference at time `t` (clamped to `[0, duration]`: at rest before and after).

@@ -7,10 +7,13 @@
 //! The committed motion's last segment `a` ramps down to rest over `W_a`; the piece's
 //! first segment `b` ramps up from rest over `U_b`. Joined, both ramps take the one
 //! length `R` that changes the velocity from `a`'s cruise to `b`'s within the limits
-//! (`super::build`'s rule), and `b` starts `R` before `a` ends; the cruise rates stay,
-//! so the ramps must fit (`r (U + W) / 2 <= 1`) as they are. Up to the time where
+//! (`super::build`'s rule), and `b` starts `R` before `a` ends. `a` is in flight, so its
+//! cruise rate stays and its ramps must fit (`r (U + W) / 2 <= 1`) as they are; `b`'s
+//! rate is lowered until its ramps fit too, when `b` ends at rest (nothing after it
+//! depends on its rate), but never so far that `b` would end later than after a stop
+//! at the joint. Up to the time where
 //! either `a`'s old or its new ramp down begins, the joined motion is the committed
-//! one, so it can replace it while the chain flies there ([`Splice::take_by`]). From
+//! one, so it can replace it while the chain flies there ([`Joint::take_by`]). From
 //! then until `b`'s ramp up ends it is new: those samples are checked exactly on the
 //! map given (the online planner's: unknown space occupied), and wherever the motion
 //! leaves both pieces' paths (the overlap) every body keeps the trajectory settings'
@@ -20,7 +23,7 @@ use aerial_chain_core::ChainParams;
 
 use super::build::{ramp_length, FIT_UNDERSHOOT};
 use super::check::{check_with_margin, Violation};
-use super::reference::{Reference, Scaling, Segment, SegmentKind};
+use super::reference::{same_configuration, Reference, Scaling, Segment, SegmentKind};
 use super::Settings;
 use crate::map::Grid;
 
@@ -29,11 +32,24 @@ use crate::map::Grid;
 pub struct Splice {
     /// The committed motion, then the piece without a stop between them.
     pub reference: Reference,
-    /// Latest time (s) at which `reference` may replace the committed motion: until
+    /// Where and when it differs from the two motions flown one after the other.
+    pub joint: Joint,
+}
+
+/// A joint flown without a stop, in the joined motion's time (s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Joint {
+    /// Latest time at which the joined motion may replace the committed motion: until
     /// then the two are the same motion.
     pub take_by: f64,
+    /// When the joined motion is the piece's own again, shifted in time: the later end
+    /// of the piece's first ramp up as joined and as timed alone, or the end of its
+    /// first motion where that was slowed down. From `take_by` to here the motion is
+    /// new, and checked ([`check_joint`]).
+    pub until: f64,
     /// When the joined motion leaves both pieces' paths and when it is back on the
-    /// piece's (s): the blend of the corner at the joint.
+    /// piece's: the blend of the corner at the joint, where every body keeps the
+    /// trajectory's clearance.
     pub blend: (f64, f64),
 }
 
@@ -50,6 +66,9 @@ pub enum NoSplice {
     /// The piece does not start with a motion from time 0.
     #[error("the piece does not start with a motion")]
     PieceAtRest,
+    /// The piece does not start where the committed motion ends.
+    #[error("the piece does not start where the committed motion ends")]
+    Elsewhere,
     /// The ramps of the joint would not fit their segments at their cruise rates.
     #[error("the ramps of the joint do not fit its segments")]
     RampsDoNotFit,
@@ -68,9 +87,6 @@ pub enum NoSplice {
     /// The joined motion fails the exact check or the blend's clearance.
     #[error("the joined motion is not admissible: {0}")]
     Inadmissible(Violation),
-    /// The joined motion could not be sampled.
-    #[error("the joined motion could not be sampled")]
-    Unsampled,
 }
 
 /// Joins `next` (which starts at rest where `current` ends) onto `current`, the motion
@@ -102,6 +118,9 @@ pub fn splice(
     if b.kind == SegmentKind::Hold || b.t0 != 0.0 {
         return Err(NoSplice::PieceAtRest);
     }
+    if !same_configuration(&b.from, current.end()) {
+        return Err(NoSplice::Elsewhere);
+    }
     let (sa, sb) = (&a.scaling, &b.scaling);
     let (rate, ramp) = fit(a, b, next, settings).ok_or(NoSplice::RampsDoNotFit)?;
     // The cruise of `a` ends where its ramp down begins: the old one or the new one.
@@ -128,10 +147,11 @@ pub fn splice(
     let shift = (b_new.t0 + b_new.duration) - (b.t0 + b.duration);
     let mut joined: Vec<Segment> = segments[..segments.len() - 1].to_vec();
     joined.push(a_new);
-    // Where `b` cruises slower than it would after a stop, it is new up to its end.
+    // `b` is timed as in the piece (shifted) once both its ramps up are over; where
+    // it cruises slower than after a stop, only after its end.
     let new_to = match rate < sb.rate {
         true => b_new.t0 + b_new.duration,
-        false => b_new.t0 + ramp,
+        false => (b_new.t0 + ramp).max(shift + sb.ramp),
     };
     let blend = (b_new.t0, a_end);
     joined.push(b_new);
@@ -141,12 +161,13 @@ pub fn splice(
     }));
     let first = segments.first().map_or(current.end(), |s| &s.from).to_vec();
     let reference = Reference::from_segments(current.units(), &first, joined);
-    check_new_part(&reference, params, grid, settings, (take_by, new_to), blend)?;
-    Ok(Splice {
-        reference,
+    let joint = Joint {
         take_by,
+        until: new_to,
         blend,
-    })
+    };
+    check_joint(&reference, params, grid, settings, &joint).map_err(NoSplice::Inadmissible)?;
+    Ok(Splice { reference, joint })
 }
 
 /// The cruise rate of `b` and the joint's ramp: the ramp that changes the velocity
@@ -176,6 +197,17 @@ fn fit(a: &Segment, b: &Segment, next: &Reference, settings: &Settings) -> Optio
     None
 }
 
+/// How long before the end of a motion whose last segment is `last` (moving, ending at
+/// rest) a piece must be joined so that any piece can be: `(W + R) / 2` with `W` its
+/// ramp down and `R` the longest joint ramp. A piece's first motion moves the head at
+/// most at the speed limit and every angle at most at its rate limit, so its ramp from
+/// rest is at most `R_0`, that of all of them at once; the joint's velocity change is at
+/// most `last`'s to rest plus that, so `R <= W + R_0`, and the lead is `W + R_0 / 2`.
+pub fn lead(last: &Segment, limits: &super::Limits) -> f64 {
+    let full = [limits.speed, 0.0, 0.0, limits.yaw_rate, limits.angular_rate];
+    last.scaling.ramp_down + ramp_length(limits, &full) / 2.0
+}
+
 /// Segment `s` started at `t0` with `scaling`.
 fn retimed(s: &Segment, t0: f64, scaling: Scaling) -> Segment {
     Segment {
@@ -186,23 +218,21 @@ fn retimed(s: &Segment, t0: f64, scaling: Scaling) -> Segment {
     }
 }
 
-/// Checks `reference` exactly on `grid` from `from` to `to` (s; a sample beyond each),
-/// sampled every `settings.dt`; within `blend` (a sample either side) every body keeps
-/// `settings.clearance` from the map.
-fn check_new_part(
+/// Checks the new part of `reference` at `joint` exactly on `grid`: from `take_by` to
+/// `until` (a sample beyond each), sampled every `settings.dt`, within the limits;
+/// within the blend (a sample either side) every body keeps `settings.clearance` from
+/// the map. What a join is checked by, and what an audit of a flown motion checks again.
+pub fn check_joint(
     reference: &Reference,
     params: &ChainParams,
     grid: &Grid,
     settings: &Settings,
-    (from, to): (f64, f64),
-    blend: (f64, f64),
-) -> Result<(), NoSplice> {
-    let dt = settings.dt;
-    let start = (from - dt).max(0.0);
-    let count = ((to + dt - start) / dt).ceil() as usize + 1;
-    if count > super::MAX_SAMPLES {
-        return Err(NoSplice::Unsampled);
-    }
+    joint: &Joint,
+) -> Result<(), Violation> {
+    let (dt, blend) = (settings.dt, joint.blend);
+    let start = (joint.take_by - dt).max(0.0);
+    // The span is a few ramps long: far below the samples' budget.
+    let count = ((joint.until + dt - start) / dt).ceil().max(0.0) as usize + 1;
     let times: Vec<f64> = (0..count).map(|j| start + j as f64 * dt).collect();
     let zetas: Vec<Vec<f64>> = times.iter().map(|&t| reference.zeta(t)).collect();
     let margin = settings.clearance;
@@ -219,7 +249,7 @@ fn check_new_part(
         &required,
     );
     match rep.violation {
-        Some(v) => Err(NoSplice::Inadmissible(v)),
+        Some(v) => Err(v),
         None => Ok(()),
     }
 }

@@ -47,7 +47,7 @@ fn a_piece_joined_straight_on_keeps_cruising_through_the_joint() {
         v >= 0.99 * s.limits.speed,
         "the head at {v} m/s at the joint"
     );
-    for k in 0..=((j.take_by / s.dt) as usize) {
+    for k in 0..=((j.joint.take_by / s.dt) as usize) {
         let t = k as f64 * s.dt;
         assert!(joined.agrees_at(a.reference(), t), "differs at {t} s");
     }
@@ -79,8 +79,10 @@ fn a_corner_at_the_joint_is_rounded_only_where_it_keeps_off_the_map() {
     // A right angle changes the velocity by sqrt(2) of the cruise: the joint's ramp is
     // longer than the ramp to rest, so the chain slows down earlier than it would stop.
     let rest_ramp = a.reference().segments().last().unwrap().scaling.ramp_down;
-    assert!(j.take_by < a.reference().duration() - rest_ramp);
-    assert!(j.blend.0 < a.reference().duration() && a.reference().duration() < j.blend.1);
+    assert!(j.joint.take_by < a.reference().duration() - rest_ramp);
+    assert!(
+        j.joint.blend.0 < a.reference().duration() && a.reference().duration() < j.joint.blend.1
+    );
     let (t, z) = samples(&j.reference, s.dt);
     assert_samples_respect_limits(&free, &params, &s.limits, &t, &z);
     let mut blocked = room();
@@ -121,7 +123,7 @@ fn joins_that_cannot_be_made_are_refused_by_name() {
     let b = piece(&params, &grid, [2.3, 1.0, 1.0], [3.5, 1.0, 1.0]);
     let (ra, rb) = (a.reference(), b.reference());
     let j = splice(ra, rb, &params, &grid, &s, 0.0).unwrap();
-    let late = splice(ra, rb, &params, &grid, &s, j.take_by + 0.01);
+    let late = splice(ra, rb, &params, &grid, &s, j.joint.take_by + 0.01);
     assert!(matches!(late, Err(NoSplice::TooLate { .. })), "{late:?}");
     let unblended = Settings { blend: false, ..s };
     let off = splice(ra, rb, &params, &grid, &unblended, 0.0);
@@ -134,4 +136,75 @@ fn joins_that_cannot_be_made_are_refused_by_name() {
     let held = rb.with_start_hold(1.0);
     let holds = splice(ra, &held, &params, &grid, &s, 0.0);
     assert_eq!(holds.unwrap_err(), NoSplice::PieceAtRest);
+}
+
+/// A piece of a chain of 3 through the heads `heads`, the chain along x behind it.
+fn path(params: &ChainParams, grid: &Grid, heads: &[[f64; 3]]) -> Trajectory {
+    let s = Shape::line(3, 0.0);
+    let points: Vec<([f64; 3], Shape)> = heads.iter().map(|h| (*h, s)).collect();
+    built(&plan(params, &points), grid)
+}
+
+#[test]
+fn the_rest_of_a_piece_is_flown_as_timed_after_its_joint() {
+    let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
+    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.5, 1.0, 1.0]);
+    let b = path(
+        &params,
+        &grid,
+        &[[2.5, 1.0, 1.0], [3.0, 1.0, 1.0], [3.0, 2.0, 1.0]],
+    );
+    assert!(
+        b.reference().segments().len() >= 2,
+        "a piece of two motions"
+    );
+    let j = splice(a.reference(), b.reference(), &params, &grid, &s, 0.0).unwrap();
+    // After the joint the piece's own motion, shifted by one time.
+    let shift = j.reference.duration() - b.reference().duration();
+    let own_from = j.joint.until - shift;
+    let n = ((b.reference().duration() - own_from) / s.dt) as usize;
+    for k in 0..=n {
+        let t = own_from + k as f64 * s.dt;
+        let (x, y) = (b.reference().zeta(t), j.reference.zeta(t + shift));
+        let d = x
+            .iter()
+            .zip(&y)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
+        assert!(d < 1e-9, "the piece's motion differs by {d} at {t} s of it");
+    }
+    let (t, z) = samples(&j.reference, s.dt);
+    assert_samples_respect_limits(&grid, &params, &s.limits, &t, &z);
+}
+
+#[test]
+fn a_joint_whose_ramps_cannot_fit_or_that_would_be_slower_is_refused() {
+    let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
+    // The piece's first motion, 0.2 m, blends into its next, so it cannot be slowed:
+    // the joint's ramp does not fit it.
+    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.5, 1.0, 1.0]);
+    let b = path(
+        &params,
+        &grid,
+        &[[2.5, 1.0, 1.0], [2.5, 1.2, 1.0], [3.5, 1.2, 1.0]],
+    );
+    let no_fit = splice(a.reference(), b.reference(), &params, &grid, &s, 0.0);
+    assert_eq!(no_fit.unwrap_err(), NoSplice::RampsDoNotFit);
+    // Turning straight back for 2.3 m: the joint's ramp fits the motion before it only
+    // at a third of the speed, which costs more than the stop saves.
+    let a = piece(&params, &grid, [2.5, 1.0, 1.0], [3.5, 1.0, 1.0]);
+    let back = piece(&params, &grid, [3.5, 1.0, 1.0], [1.2, 1.0, 1.0]);
+    let slower = splice(a.reference(), back.reference(), &params, &grid, &s, 0.0);
+    assert_eq!(slower.unwrap_err(), NoSplice::Slower);
+    // A piece that starts elsewhere is not joined.
+    let elsewhere = piece(&params, &grid, [2.5, 1.0, 1.0], [3.0, 1.0, 1.0]);
+    let refused = splice(
+        a.reference(),
+        elsewhere.reference(),
+        &params,
+        &grid,
+        &s,
+        0.0,
+    );
+    assert_eq!(refused.unwrap_err(), NoSplice::Elsewhere);
 }
