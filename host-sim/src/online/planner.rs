@@ -296,7 +296,6 @@ impl OnlinePlanner {
                 let at = ready.max(self.committed.duration());
                 // A piece is planned from the committed end, as a plan file writes it,
                 // so it starts there: `then` cannot refuse it.
-                let next = self.pieces[last].trajectory.reference();
                 self.committed = self
                     .committed
                     .then(at, next)

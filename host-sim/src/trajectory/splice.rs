@@ -11,11 +11,11 @@
 //! cruise rate stays and its ramps must fit (`r (U + W) / 2 <= 1`) as they are; `b`'s
 //! rate is lowered until its ramps fit too, when `b` ends at rest (nothing after it
 //! depends on its rate), but never so far that `b` would end later than after a stop
-//! at the joint. Up to the time where
-//! either `a`'s old or its new ramp down begins, the joined motion is the committed
-//! one, so it can replace it while the chain flies there ([`Joint::take_by`]). From
-//! then until `b`'s ramp up ends it is new: those samples are checked exactly on the
-//! map given (the online planner's: unknown space occupied), and wherever the motion
+//! at the joint. Up to the time where either `a`'s old or its new ramp down begins,
+//! the joined motion is the committed one, so it can replace it while the chain flies
+//! there ([`Joint::take_by`]). From then until the piece's motion is timed as its own
+//! again ([`Joint::until`]) it is new: those samples are checked exactly on the map
+//! given (the online planner's: unknown space occupied), and wherever the motion
 //! leaves both pieces' paths (the overlap) every body keeps the trajectory settings'
 //! clearance from the map, as a blend of one plan does.
 
@@ -23,7 +23,7 @@ use aerial_chain_core::ChainParams;
 
 use super::build::{ramp_length, FIT_UNDERSHOOT};
 use super::check::{check_with_margin, Violation};
-use super::reference::{same_configuration, Reference, Scaling, Segment, SegmentKind};
+use super::reference::{same_configuration, Reference, Scaling, Segment};
 use super::Settings;
 use crate::map::Grid;
 
@@ -111,11 +111,10 @@ pub fn splice(
             false => NoSplice::PieceAtRest,
         });
     };
-    let ends_moving = a.kind != SegmentKind::Hold && a.t0 + a.duration >= current.duration();
-    if !ends_moving {
+    if a.is_hold() || a.t0 + a.duration < current.duration() {
         return Err(NoSplice::AtRest);
     }
-    if b.kind == SegmentKind::Hold || b.t0 != 0.0 {
+    if b.is_hold() || b.t0 != 0.0 {
         return Err(NoSplice::PieceAtRest);
     }
     if !same_configuration(&b.from, current.end()) {

@@ -9,18 +9,31 @@ use crate::map::Cell;
 use crate::trajectory::tests::{assert_samples_respect_limits, built, plan, room};
 use crate::trajectory::Trajectory;
 
-/// A piece of a chain of 3 from head `from` to head `to`, the chain along x behind it.
-fn piece(params: &ChainParams, grid: &Grid, from: [f64; 3], to: [f64; 3]) -> Trajectory {
+/// A piece of a chain of 3 through the heads `heads`, the chain along x behind it.
+fn path(params: &ChainParams, grid: &Grid, heads: &[[f64; 3]]) -> Trajectory {
     let s = Shape::line(3, 0.0);
-    built(&plan(params, &[(from, s), (to, s)]), grid)
+    let points: Vec<([f64; 3], Shape)> = heads.iter().map(|h| (*h, s)).collect();
+    built(&plan(params, &points), grid)
 }
 
-/// `r`'s samples every `dt` from 0 to its end.
-fn samples(r: &Reference, dt: f64) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let n = (r.duration() / dt).ceil() as usize;
-    (0..=n)
-        .map(|j| (j as f64 * dt, r.zeta(j as f64 * dt)))
-        .unzip()
+/// A piece of a chain of 3 from head `from` to head `to`, the chain along x behind it.
+fn piece(params: &ChainParams, grid: &Grid, from: [f64; 3], to: [f64; 3]) -> Trajectory {
+    path(params, grid, &[from, to])
+}
+
+/// Two pieces along x, the second going straight on from where the first ends.
+fn straight_on(params: &ChainParams, grid: &Grid) -> (Trajectory, Trajectory) {
+    (
+        piece(params, grid, [1.5, 1.0, 1.0], [2.3, 1.0, 1.0]),
+        piece(params, grid, [2.3, 1.0, 1.0], [3.5, 1.0, 1.0]),
+    )
+}
+
+/// Every limit of `s` and the map of `grid` kept by `r` at its samples every `s.dt`
+/// (the trajectory's own sampling), by the tests' own reading of the limits.
+fn assert_joined_respects_limits(grid: &Grid, params: &ChainParams, s: &Settings, r: &Reference) {
+    let (t, z) = crate::trajectory::build::sample(r, s.dt).unwrap();
+    assert_samples_respect_limits(grid, params, &s.limits, &t, &z);
 }
 
 /// The head's speed of `r` at `t` (m/s).
@@ -31,8 +44,7 @@ fn head_speed(r: &Reference, t: f64) -> f64 {
 #[test]
 fn a_piece_joined_straight_on_keeps_cruising_through_the_joint() {
     let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
-    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.3, 1.0, 1.0]);
-    let b = piece(&params, &grid, [2.3, 1.0, 1.0], [3.5, 1.0, 1.0]);
+    let (a, b) = straight_on(&params, &grid);
     let j = splice(a.reference(), b.reference(), &params, &grid, &s, 0.0).unwrap();
     let joined = &j.reference;
     // Two ramps of 1.5 s (0.5 m/s at 0.5 m/s^2) are saved: half of each.
@@ -57,8 +69,7 @@ fn a_piece_joined_straight_on_keeps_cruising_through_the_joint() {
         .iter()
         .zip(end)
         .all(|(x, y)| (x - y).abs() < 1e-9));
-    let (t, z) = samples(joined, s.dt);
-    assert_samples_respect_limits(&grid, &params, &s.limits, &t, &z);
+    assert_joined_respects_limits(&grid, &params, &s, joined);
 }
 
 /// Head along +x, then up: the tail rounds the joint's corner below a voxel that the
@@ -83,8 +94,7 @@ fn a_corner_at_the_joint_is_rounded_only_where_it_keeps_off_the_map() {
     assert!(
         j.joint.blend.0 < a.reference().duration() && a.reference().duration() < j.joint.blend.1
     );
-    let (t, z) = samples(&j.reference, s.dt);
-    assert_samples_respect_limits(&free, &params, &s.limits, &t, &z);
+    assert_joined_respects_limits(&free, &params, &s, &j.reference);
     let mut blocked = room();
     blocked.fill_box([1.71, 0.51, 1.21], [1.79, 1.49, 1.29], Cell::Occupied);
     let (a, b) = corner_pieces(&params, &blocked);
@@ -112,15 +122,13 @@ fn a_short_piece_is_slowed_to_join_and_never_joins_slower_than_a_stop() {
     );
     let stopped = a.reference().duration() + b.reference().duration();
     assert!(j.reference.duration() <= stopped);
-    let (t, z) = samples(&j.reference, s.dt);
-    assert_samples_respect_limits(&grid, &params, &s.limits, &t, &z);
+    assert_joined_respects_limits(&grid, &params, &s, &j.reference);
 }
 
 #[test]
 fn joins_that_cannot_be_made_are_refused_by_name() {
     let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
-    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.3, 1.0, 1.0]);
-    let b = piece(&params, &grid, [2.3, 1.0, 1.0], [3.5, 1.0, 1.0]);
+    let (a, b) = straight_on(&params, &grid);
     let (ra, rb) = (a.reference(), b.reference());
     let j = splice(ra, rb, &params, &grid, &s, 0.0).unwrap();
     let late = splice(ra, rb, &params, &grid, &s, j.joint.take_by + 0.01);
@@ -136,13 +144,6 @@ fn joins_that_cannot_be_made_are_refused_by_name() {
     let held = rb.with_start_hold(1.0);
     let holds = splice(ra, &held, &params, &grid, &s, 0.0);
     assert_eq!(holds.unwrap_err(), NoSplice::PieceAtRest);
-}
-
-/// A piece of a chain of 3 through the heads `heads`, the chain along x behind it.
-fn path(params: &ChainParams, grid: &Grid, heads: &[[f64; 3]]) -> Trajectory {
-    let s = Shape::line(3, 0.0);
-    let points: Vec<([f64; 3], Shape)> = heads.iter().map(|h| (*h, s)).collect();
-    built(&plan(params, &points), grid)
 }
 
 #[test]
@@ -173,8 +174,7 @@ fn the_rest_of_a_piece_is_flown_as_timed_after_its_joint() {
             .fold(0.0, f64::max);
         assert!(d < 1e-9, "the piece's motion differs by {d} at {t} s of it");
     }
-    let (t, z) = samples(&j.reference, s.dt);
-    assert_samples_respect_limits(&grid, &params, &s.limits, &t, &z);
+    assert_joined_respects_limits(&grid, &params, &s, &j.reference);
 }
 
 #[test]
