@@ -178,7 +178,8 @@ fn build_leg(
     let l = params.link_length as f64;
     let limits = settings.limits.to_reference();
     let timed = Reference::new(params.n(), l, &waypoints, &limits)?;
-    let edges: Vec<Segment> = timed.segments().to_vec();
+    let corners = timed.segments().len().saturating_sub(1);
+    let (edges, turns) = super::turns::spread(timed.segments().to_vec(), l, &limits);
     let stop_go = timed.duration();
     let steps = (stop_go / settings.dt).ceil() as usize + edges.len() + 1;
     if steps > MAX_SAMPLES {
@@ -257,9 +258,9 @@ fn build_leg(
                 reference,
                 times,
                 zetas,
-                corners: edges.len().saturating_sub(1),
+                corners,
                 blended,
-                merged: grouping.merged_corners(),
+                merged: grouping.merged_corners() + turns,
                 stop_go,
                 head_path,
                 stages,

@@ -5,7 +5,8 @@
 //! cruise at the limit, the mirror ramp), and then consecutive edges are blended: the
 //! next edge starts while the one before is still ramping down, so a corner is rounded
 //! and a shape change runs while the head slows down or speeds up; a translation and the
-//! shape change beside it may also be merged into one move. A blend or merge is kept
+//! shape change beside it may also be merged into one move, and a turn of the head yaw
+//! alone runs during the motion before it (the yaw moves no body). A blend or merge is kept
 //! only where the motion is admissible, checked exactly as `arc verify` checks edges,
 //! and keeps the planner's clearance margin; elsewhere the trajectory keeps the plan's
 //! "finish one edge, then start the next". The result is sampled on a uniform time grid, and the samples are the
@@ -18,6 +19,7 @@
 //! - `group`: which edges fly together as one motion, and how a merge gives way;
 //! - `legs`: a mission's plan timed leg by leg, with the holds at its goals;
 //! - `splice`: [`splice()`], a trajectory joined onto a motion in flight without a stop;
+//! - `turns`: a turn of the head yaw alone flown during the motion before it;
 //! - `merge`: what a merged motion demands of the limits, and which edges lie on a line;
 //! - `file`: [`TrajectoryFile`], the `arc-trajectory/1` JSON file and its CSV form.
 
@@ -33,6 +35,7 @@ mod splice;
 mod stages;
 #[cfg(test)]
 mod tests;
+mod turns;
 
 // The one place this module names the plan file's types: the other files take them
 // from here.
