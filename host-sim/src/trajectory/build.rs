@@ -29,7 +29,9 @@
 //! check fails is unblended, else a merged motion there gives way a step (a run is
 //! halved, a pair flies less of its translation or comes apart), and the timing is
 //! redone, until the whole passes. Without blends the chain is on the plan's own edges, resting
-//! on a sample at every waypoint, so only a plan that is itself inadmissible fails.
+//! on a sample at every waypoint (but where a turn of the head yaw alone runs during the
+//! edges before it, `super::turns`: the bodies still move as the plan's edges move
+//! them), so only a plan that is itself inadmissible fails.
 //!
 //! A deadline ([`build_until`]) bounds the rounds: a round that begins after it gives
 //! way everywhere at once (no blend, no merge: the plan's own edges, stop and go) and is

@@ -47,18 +47,19 @@ pub(super) fn spread(
             continue;
         }
         let need = cruise(&e, l, limits);
+        // The edges that take the turn, walking back from the one before it.
         let mut first = out.len();
         let mut times = Vec::new();
-        while first > 0 && times.iter().sum::<f64>() < need && carries(&out[first - 1]) {
+        let mut total = 0.0;
+        while first > 0 && total < need && carries(&out[first - 1]) {
             first -= 1;
             times.push(cruise(&out[first], l, limits));
+            total += times[times.len() - 1];
         }
         if times.is_empty() {
             out.push(e);
             continue;
         }
-        let total: f64 = times.iter().sum();
-        // `times` runs backwards from the edge before the turn.
         for (s, t) in out[first..].iter_mut().zip(times.iter().rev()) {
             let share = t / total;
             s.delta
