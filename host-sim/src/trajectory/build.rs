@@ -29,9 +29,11 @@
 //! check fails is unblended, else a merged motion there gives way a step (a run is
 //! halved, a pair flies less of its translation or comes apart), and the timing is
 //! redone, until the whole passes. Without blends the chain is on the plan's own edges, resting
-//! on a sample at every waypoint (but where a turn of the head yaw alone runs during the
-//! edges before it, `super::turns`: the bodies still move as the plan's edges move
-//! them), so only a plan that is itself inadmissible fails.
+//! on a sample at every waypoint, so only a plan that is itself inadmissible fails.
+//!
+//! With blends, a turn of the head yaw alone first runs during the edges before it
+//! (`super::turns`): the yaw moves no body, so the bodies still move as the plan's
+//! edges move them.
 //!
 //! A deadline ([`build_until`]) bounds the rounds: a round that begins after it gives
 //! way everywhere at once (no blend, no merge: the plan's own edges, stop and go) and is
@@ -109,7 +111,8 @@ impl Trajectory {
         self.blended
     }
     /// Edges flown in one move with the edge before them (a merged pair counts one, a
-    /// run of `k` edges `k - 1`).
+    /// run of `k` edges `k - 1`, a turn of the head yaw alone flown during the edges
+    /// before it one).
     pub fn merged(&self) -> usize {
         self.merged
     }
@@ -181,7 +184,13 @@ fn build_leg(
     let limits = settings.limits.to_reference();
     let timed = Reference::new(params.n(), l, &waypoints, &limits)?;
     let corners = timed.segments().len().saturating_sub(1);
-    let (edges, turns) = super::turns::spread(timed.segments().to_vec(), l, &limits);
+    // The plan's own edges, and (with blends) its turns of the head yaw alone flown
+    // during the edges before them.
+    let own: Vec<Segment> = timed.segments().to_vec();
+    let (mut edges, mut turns) = match settings.blend {
+        true => super::turns::spread(own.clone(), l, &limits),
+        false => (own.clone(), 0),
+    };
     let stop_go = timed.duration();
     let steps = (stop_go / settings.dt).ceil() as usize + edges.len() + 1;
     if steps > MAX_SAMPLES {
@@ -201,6 +210,8 @@ fn build_leg(
     loop {
         if !cut_short && deadline.is_some_and(|d| Instant::now() >= d) {
             cut_short = true;
+            (edges, turns) = (own.clone(), 0);
+            demands.clear();
             grouping = group::Grouping::new(&edges, l, false, settings);
         }
         let motions = stages.run(Stage::Group, || {

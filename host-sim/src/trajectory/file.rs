@@ -47,7 +47,8 @@ pub struct TrajectoryStats {
     pub corners: usize,
     /// Corners flown blended.
     pub blended: usize,
-    /// Corners flown as one move with the edge before them (merged edges).
+    /// Corners flown as one move with the edge before them (merged edges, and turns of
+    /// the head yaw alone flown during the edges before them).
     #[serde(default)]
     pub merged: usize,
 }

@@ -228,7 +228,8 @@ pub struct Segment {
     /// Change of every coordinate of `zeta` over the segment (angles: shortest signed
     /// difference).
     pub delta: Vec<f64>,
-    /// Index of the waypoint the segment ends at.
+    /// Index of the waypoint the segment ends at (an edge that carries a turn of the
+    /// head yaw after it, `super::turns`, ends where the turn ends).
     pub to_waypoint: usize,
     /// How the segment's progress from 0 to 1 runs in time.
     pub scaling: Scaling,

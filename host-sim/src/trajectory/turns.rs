@@ -4,12 +4,16 @@
 //! (docs/model.md, "Trajectories"). So an edge that turns only the head yaw (a turn to
 //! a goal's yaw, or to look along a route) need not wait for the motion before it to
 //! end: it is spread over the edges before it, each taking a share of the turn in
-//! proportion to its time at its cruise, so that the yaw turns at one rate while the
-//! chain moves along the plan's own path. It takes as many of those edges as its own
-//! time at the yaw rate needs, back to an edge that turns the yaw itself or rests;
-//! where they are shorter than that, it takes them all and they slow to its rate.
+//! proportion to its time at its cruise, so that at their cruises the yaw turns at one
+//! rate while the chain moves along the plan's own path. It takes as many of those
+//! edges as its own time at the yaw rate needs, back to an edge that turns the yaw
+//! itself or to the start of the plan (of a mission's leg); where they are shorter
+//! than that, it takes them all and they slow to its rate. Only with blends: without
+//! them, or when a deadline stops the generator's rounds, the chain stops at every
+//! waypoint, the turn's first among them.
 
-use super::reference::{max_rate, Segment, SegmentKind};
+use super::merge::Demand;
+use super::reference::{Segment, SegmentKind};
 use crate::collision::verify::STAY_TOLERANCE;
 use crate::trajectory::ReferenceLimits;
 
@@ -20,14 +24,16 @@ fn turns_only(e: &Segment) -> bool {
         && e.delta[4..].iter().all(|d| d.abs() <= STAY_TOLERANCE)
 }
 
-/// Whether a turn after edge `e` may run during it: it moves and turns no yaw.
+/// Whether a turn after edge `e` may run during it: it turns no yaw of its own. (The
+/// generator's edges all move: `Reference::new` leaves out those that change nothing.)
 fn carries(e: &Segment) -> bool {
-    e.kind != SegmentKind::Hold && e.delta[3].abs() <= STAY_TOLERANCE
+    e.delta[3].abs() <= STAY_TOLERANCE
 }
 
-/// Time (s) edge `e` takes at its largest rate within `limits`, ramps left out.
+/// Time (s) edge `e` takes at the largest rate the generator times it at within
+/// `limits` (`super::merge::Demand`), ramps left out.
 fn cruise(e: &Segment, l: f64, limits: &ReferenceLimits) -> f64 {
-    1.0 / max_rate(e.kind, l, &e.delta, limits)
+    1.0 / Demand::of(e, l).max_rate(limits)
 }
 
 /// `edges` (a plan's, in order, each as [`super::Reference::new`] times it alone) with
@@ -90,7 +96,7 @@ mod tests {
 
     use super::*;
     use crate::trajectory::tests::{assert_samples_respect_limits, built, plan, room};
-    use crate::trajectory::{Reference, Settings};
+    use crate::trajectory::{build, Reference, Settings};
 
     /// A straight chain of 3 units along x, its head yaw turned to `yaw` (its links stay).
     fn line(yaw: f32) -> Shape {
@@ -195,6 +201,63 @@ mod tests {
         let lim = Settings::default().limits;
         assert_samples_respect_limits(&grid, &params, &lim, tr.times(), tr.zetas());
         assert_eq!((tr.corners(), tr.merged()), (1, 1));
+    }
+
+    #[test]
+    fn without_blends_or_past_a_deadline_the_chain_rests_before_the_turn() {
+        let params = ChainParams::new(3);
+        let grid = room();
+        let (a, b) = (line(0.0), line(1.5));
+        let pts = [
+            ([2.0, 2.0, 1.0], a),
+            ([3.5, 2.0, 1.0], a),
+            ([3.5, 2.0, 1.0], b),
+        ];
+        let p = plan(&params, &pts);
+        let stop = Settings {
+            blend: false,
+            ..Settings::default()
+        };
+        let now = Some(std::time::Instant::now());
+        let timed = [
+            build(&p, &grid, &stop).unwrap(),
+            super::super::build_until(&p, &grid, &Settings::default(), now).unwrap(),
+        ];
+        for tr in timed {
+            assert_eq!(tr.merged(), 0);
+            assert!((tr.duration() - tr.stop_go_duration()).abs() <= 2.0 * stop.dt);
+            // Resting at the translation's end, the yaw not yet turned.
+            let rest = tr.zetas().iter().any(|z| z[..4] == [3.5, 2.0, 1.0, 0.0]);
+            assert!(rest, "no sample rests at the waypoint before the turn");
+        }
+    }
+
+    #[test]
+    fn a_shape_change_before_a_turn_carries_it_at_the_rate_it_is_timed_at() {
+        let params = ChainParams::new(3);
+        let grid = room();
+        let mut eta = Shape::line(3, 0.0).as_slice().to_vec();
+        eta[4] = 0.5; // the second link's yaw
+        let bent = Shape::from_slice(3, &eta).unwrap();
+        let mut turned = eta.clone();
+        turned[0] = 0.4;
+        let turned = Shape::from_slice(3, &turned).unwrap();
+        let pts = [
+            ([2.5, 2.0, 1.0], line(0.0)),
+            ([2.5, 2.0, 1.0], bent),
+            ([2.5, 2.0, 1.0], turned),
+        ];
+        let (out, n) = spread(edges(&pts), 0.5, &limits());
+        assert_eq!((out.len(), n), (1, 1));
+        assert!((out[0].delta[3] - 0.4).abs() < 1e-9);
+        let tr = built(&plan(&params, &pts), &grid);
+        let alone = built(&plan(&params, &pts[..2]), &grid);
+        assert!(
+            (tr.duration() - alone.duration()).abs() < 1e-9,
+            "0.4 rad fit in the bend"
+        );
+        let lim = Settings::default().limits;
+        assert_samples_respect_limits(&grid, &params, &lim, tr.times(), tr.zetas());
     }
 
     #[test]
