@@ -460,22 +460,39 @@ impl OnlinePlanner {
         (Outcome::NoRoom, 0.0)
     }
 
-    /// Index of the last route point up to which every point's head sphere is known
-    /// free (the first points, within a voxel of the head, are the head's own).
+    /// Index of the last route point up to which every point is known as far as the
+    /// route asks ([`Self::known`]; the first points, within a voxel of the head, are
+    /// the head's own).
     fn known_prefix(&self, route: &Route) -> usize {
-        let field = self.belief.commit_field();
         let start = head(&self.end);
-        let r_v = field.grid().resolution();
+        let r_v = self.belief.commit_field().grid().resolution();
         let mut last = 0;
         for (k, p) in route.points.iter().enumerate().skip(1) {
             let own = (p - start).norm() <= r_v;
-            if field.clearance(*p) > self.radii.route {
+            if self.known(p) {
                 last = k;
             } else if !own {
                 break;
             }
         }
         last
+    }
+
+    /// Whether route point `p` (a voxel centre) is known as far as the route asks: its
+    /// head sphere (the route radius) is known free, or no unknown voxel is nearer to
+    /// it than the nearest seen obstacle. The second is a narrow place the route passes
+    /// (a route point may keep less than the route radius, down to the proof radius),
+    /// seen whole: asking it for the route radius would ask for room a seen wall takes,
+    /// and no piece could end beyond it.
+    fn known(&self, p: &Point3<f64>) -> bool {
+        let commit = self.belief.commit_field();
+        if commit.clearance(*p) > self.radii.route {
+            return true;
+        }
+        // Both fields hold the bound of the same voxel by the same rule, so equal
+        // distances to the same seen obstacle compare equal.
+        let i = commit.grid().lattice_index(*p);
+        commit.voxel_clearance(i) >= self.belief.route_field().voxel_clearance(i)
     }
 
     /// The head yaw that looks from route point `k` along the route: toward the point
@@ -732,4 +749,55 @@ fn bodies(
     let mut out: Vec<_> = centres.iter().map(|c| (*c, *c, r_u)).collect();
     out.extend(centres.windows(2).map(|w| (w[0], w[1], r_l)));
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::AtomicUsize;
+
+    use super::*;
+    use crate::map::Cell;
+    use crate::planning::PlanOptions;
+
+    /// A planner for a chain of 3 units in a 4 x 2 x 2 m box at 0.1 m, seen free but
+    /// for one occupied voxel centred at (2.05, 1.05, 1.05) and one unseen voxel centred
+    /// at (3.05, 1.05, 1.05).
+    fn planner() -> OnlinePlanner {
+        let params = ChainParams::new(3).validate().unwrap();
+        let settings = PlanOptions::default().table_settings();
+        let tables = ShapeTables::build(params, &settings, &AtomicUsize::new(0)).unwrap();
+        let bounds = Grid::new(0.1, [0, 0, 0], [40, 20, 20], Cell::Free, true).unwrap();
+        let mut prior = bounds.clone();
+        prior.set([20, 10, 10], Cell::Occupied);
+        prior.set([30, 10, 10], Cell::Unknown);
+        let start = crate::plan_file::Waypoint::new([1.05, 1.05, 1.05], &Shape::line(3, 0.0)).zeta;
+        let goal = Point3::new(3.55, 1.05, 1.05);
+        OnlinePlanner::new(
+            params,
+            tables,
+            &start,
+            goal,
+            0.3,
+            &bounds,
+            Some(&prior),
+            OnlineSettings::default(),
+            &DepthSensor::default(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn a_route_point_beside_a_seen_wall_is_known_and_one_beside_unseen_space_is_not() {
+        let p = planner();
+        // Both keep 0.15 m to a voxel's face, less than the route radius (0.2 m).
+        let by_wall = Point3::new(2.25, 1.05, 1.05);
+        let by_unseen = Point3::new(3.25, 1.05, 1.05);
+        let field = p.belief.commit_field();
+        for q in [by_wall, by_unseen] {
+            assert!(field.clearance(q) < p.radii.route, "{q:?}");
+        }
+        assert!(p.known(&by_wall), "a narrow place seen whole");
+        assert!(!p.known(&by_unseen), "unseen space within the route radius");
+        assert!(p.known(&Point3::new(1.55, 0.45, 1.05)), "room to spare");
+    }
 }
