@@ -123,7 +123,7 @@ mod tests {
     fn a_turn_takes_as_many_edges_before_it_as_its_time_needs_in_proportion_to_theirs() {
         let lim = limits();
         let (a, b) = (line(0.0), line(0.2));
-        // 0.2 rad need 0.25 s at the yaw rate: the 1 m before it (2 s) carries it all.
+        // 0.2 rad needs 0.25 s at the yaw rate: the 1 m before it (2 s) carries it all.
         let short = [
             ([1.0, 1.0, 1.0], a),
             ([2.0, 1.0, 1.0], a),
@@ -156,7 +156,7 @@ mod tests {
     }
 
     #[test]
-    fn a_turn_after_a_rest_or_a_turn_of_the_yaw_stays_its_own_edge() {
+    fn a_turn_at_the_start_or_after_a_turn_of_the_yaw_stays_its_own_edge() {
         let lim = limits();
         let (a, b) = (line(0.0), line(0.8));
         // Nothing moves before it.
