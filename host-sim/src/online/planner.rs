@@ -753,19 +753,15 @@ fn bodies(
 
 #[cfg(test)]
 mod tests {
-    use std::sync::atomic::AtomicUsize;
-
     use super::*;
     use crate::map::Cell;
-    use crate::planning::PlanOptions;
+    use crate::online::tests::chain;
 
     /// A planner for a chain of 3 units in a 4 x 2 x 2 m box at 0.1 m, seen free but
     /// for one occupied voxel centred at (2.05, 1.05, 1.05) and one unseen voxel centred
     /// at (3.05, 1.05, 1.05).
     fn planner() -> OnlinePlanner {
-        let params = ChainParams::new(3).validate().unwrap();
-        let settings = PlanOptions::default().table_settings();
-        let tables = ShapeTables::build(params, &settings, &AtomicUsize::new(0)).unwrap();
+        let (params, tables) = chain(3);
         let bounds = Grid::new(0.1, [0, 0, 0], [40, 20, 20], Cell::Free, true).unwrap();
         let mut prior = bounds.clone();
         prior.set([20, 10, 10], Cell::Occupied);

@@ -24,7 +24,7 @@ fn window(units: u8) -> (Scenario, ChainParams, ShapeTables, Vec<f64>) {
 }
 
 /// A chain of `units` units and `arc plan`'s tables for it.
-fn chain(units: u8) -> (ChainParams, ShapeTables) {
+pub(super) fn chain(units: u8) -> (ChainParams, ShapeTables) {
     let params = ChainParams::new(units).validate().unwrap();
     let settings = PlanOptions::default().table_settings();
     let tables = ShapeTables::build(params, &settings, &AtomicUsize::new(0)).unwrap();

@@ -63,7 +63,7 @@ pub(super) fn built(plan: &Plan, grid: &Grid) -> Trajectory {
 
 /// Every limit `tr` was made within at every sample by differences, and every sample
 /// valid by the exact test: the test's own reading of docs/model.md, independent of the generator.
-fn assert_respects_limits(grid: &Grid, tr: &Trajectory) {
+pub(super) fn assert_respects_limits(grid: &Grid, tr: &Trajectory) {
     let (t, z) = (tr.times(), tr.zetas());
     assert_samples_respect_limits(grid, tr.params(), &tr.settings().limits, t, z);
 }

@@ -95,8 +95,8 @@ mod tests {
     use aerial_chain_core::{ChainParams, Shape};
 
     use super::*;
-    use crate::trajectory::tests::{assert_samples_respect_limits, built, plan, room};
-    use crate::trajectory::{build, Reference, Settings};
+    use crate::trajectory::tests::{assert_respects_limits, built, plan, room};
+    use crate::trajectory::{build, build_until, Reference, Settings};
 
     /// A straight chain of 3 units along x, its head yaw turned to `yaw` (its links stay).
     fn line(yaw: f32) -> Shape {
@@ -198,8 +198,7 @@ mod tests {
         }
         let end = tr.zetas().last().unwrap();
         assert!((end[3] - 1.5f32 as f64).abs() < 1e-9);
-        let lim = Settings::default().limits;
-        assert_samples_respect_limits(&grid, &params, &lim, tr.times(), tr.zetas());
+        assert_respects_limits(&grid, &tr);
         assert_eq!((tr.corners(), tr.merged()), (1, 1));
     }
 
@@ -221,7 +220,7 @@ mod tests {
         let now = Some(std::time::Instant::now());
         let timed = [
             build(&p, &grid, &stop).unwrap(),
-            super::super::build_until(&p, &grid, &Settings::default(), now).unwrap(),
+            build_until(&p, &grid, &Settings::default(), now).unwrap(),
         ];
         for tr in timed {
             assert_eq!(tr.merged(), 0);
@@ -256,8 +255,7 @@ mod tests {
             (tr.duration() - alone.duration()).abs() < 1e-9,
             "0.4 rad fit in the bend"
         );
-        let lim = Settings::default().limits;
-        assert_samples_respect_limits(&grid, &params, &lim, tr.times(), tr.zetas());
+        assert_respects_limits(&grid, &tr);
     }
 
     #[test]
@@ -275,8 +273,7 @@ mod tests {
         let step = built(&plan(&params, &pts[..2]), &grid);
         assert!(tr.duration() >= turn.duration() - 1e-9);
         assert!(tr.duration() < turn.duration() + step.duration() - 1.0);
-        let lim = Settings::default().limits;
-        assert_samples_respect_limits(&grid, &params, &lim, tr.times(), tr.zetas());
+        assert_respects_limits(&grid, &tr);
         let end = tr.zetas().last().unwrap();
         assert_eq!(end[..3], [2.3, 2.0, 1.0]);
     }

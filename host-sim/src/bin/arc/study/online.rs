@@ -137,7 +137,7 @@ fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
     run.looking_s = ex.looking_s;
     run.replans = s.replans;
     run.pieces = ex.pieces;
-    run.joined = record.replans.iter().filter(|r| r.joined_moving).count();
+    run.joined = ex.joints.len();
     run.pieces_invalid = ex
         .audit
         .as_ref()
