@@ -149,11 +149,13 @@ fn bad_sensor_and_start_settings_are_refused_naming_them() {
     let d = dir.path();
     std::fs::write(d.join("wide.json"), r#"{"fov_h_deg": 200}"#).unwrap();
     std::fs::write(d.join("typo.json"), r#"{"fov_h": 60}"#).unwrap();
+    std::fs::write(d.join("splay.json"), r#"{"splay_deg": -10}"#).unwrap();
     let base = ["explore", "--scenario", "window", "--out", "f.json"];
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 7] = [
         (&["--start-free", "all"], "--start-free"),
         (&["--sensor", "wide.json"], "fov_h_deg"),
         (&["--sensor", "typo.json"], "fov_h"),
+        (&["--sensor", "splay.json"], "splay_deg = -10"),
         (&["--sensor-rate", "0"], "--sensor-rate"),
         (&["--sensor-range", "0.1"], "--sensor-range"),
         (&["--deadline", "-1"], "--deadline"),

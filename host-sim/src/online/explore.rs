@@ -503,8 +503,9 @@ impl Loop<'_> {
 
     /// Every unit's sensor scans the truth from the unit's flown pose.
     fn scan(&mut self) -> Result<(), ExploreError> {
-        let sensor = &self.settings.survey.sensor;
-        for u in self.run.units() {
+        let rig = &self.settings.survey.sensor;
+        for (i, u) in self.run.units().iter().enumerate() {
+            let sensor = &rig.for_unit(i);
             let q = nalgebra::UnitQuaternion::from_matrix(&u.r);
             let attitude = [q.w, q.i, q.j, q.k];
             let pose = UnitPose::new([u.p.x, u.p.y, u.p.z], attitude)

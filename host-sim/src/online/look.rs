@@ -80,8 +80,9 @@ pub(super) fn unseen_hull(
 /// The head yaw, turned from `yaw` by a multiple of a step of at most half the
 /// horizontal field of view (an even number of steps round the circle, so that looking
 /// straight back along the chain is one), from which the sensors of the units at
-/// `centres` (level, holding that yaw) see the most of `unseen`; the smaller turn on a
-/// tie. `None` when no such yaw sees any of it.
+/// `centres` (level, holding that yaw, each unit's own: [`DepthSensor::for_unit`]) see
+/// the most of `unseen`; the smaller turn on a tie. `None` when no such yaw sees any of
+/// it.
 pub(super) fn best_view(
     sensor: &DepthSensor,
     centres: &[Point3<f64>],
@@ -91,6 +92,7 @@ pub(super) fn best_view(
     use std::f64::consts::TAU;
     let turns = 2 * (TAU / sensor.fov_h_deg.to_radians()).ceil().max(1.0) as usize;
     let step = TAU / turns as f64;
+    let sensors: Vec<DepthSensor> = (0..centres.len()).map(|i| sensor.for_unit(i)).collect();
     let seen_from = |heading: f64| {
         let poses: Vec<UnitPose> = centres
             .iter()
@@ -98,7 +100,10 @@ pub(super) fn best_view(
             .collect();
         unseen
             .iter()
-            .filter(|p| poses.iter().any(|pose| sensor.in_view(pose, p)))
+            .filter(|p| {
+                let mut views = sensors.iter().zip(&poses);
+                views.any(|(s, pose)| s.in_view(pose, p))
+            })
             .count()
     };
     // Turns ordered by size, left before right: the first of the most seen is the
@@ -182,16 +187,40 @@ mod tests {
         // the waist from two units ahead of it).
         let turned = crate::collision::verify::wrap(yaw).abs();
         assert!(turned > 2.5, "turned {turned} rad");
-        // From there the sensors see all of it.
-        let poses: Vec<_> = centres.iter().map(|c| UnitPose::level(*c, yaw)).collect();
-        assert!(last_waist
-            .iter()
-            .all(|p| poses.iter().any(|pose| sensor.in_view(pose, p))));
-        // Looking along the chain, the sensors do not see it all.
-        let ahead: Vec<_> = centres.iter().map(|c| UnitPose::level(*c, 0.0)).collect();
-        assert!(!last_waist
-            .iter()
-            .all(|p| ahead.iter().any(|pose| sensor.in_view(pose, p))));
+        // From there the sensors see all of it; looking along the chain, not all.
+        assert!(last_waist.iter().all(|p| seen(&sensor, &centres, yaw, p)));
+        assert!(!last_waist.iter().all(|p| seen(&sensor, &centres, 0.0, p)));
+    }
+
+    /// Whether some unit at `centres` holding `yaw` has `p` in its own sensor's view.
+    fn seen(sensor: &DepthSensor, centres: &[Point3<f64>], yaw: f64, p: &Point3<f64>) -> bool {
+        let mut units = centres.iter().enumerate();
+        units.any(|(i, c)| sensor.for_unit(i).in_view(&UnitPose::level(*c, yaw), p))
+    }
+
+    #[test]
+    fn splayed_sensors_are_counted_by_their_own_views() {
+        let (_, centres) = chain_at_rest(3);
+        // Level, 69 degrees to the left of the middle unit's heading and 45 of the last
+        // one's: in unit 1's view when splayed to the left, in no view with every
+        // sensor looking along the chain.
+        let left = [Point3::new(1.8, 1.8, 1.0)];
+        let ahead = DepthSensor::default();
+        let splayed = DepthSensor {
+            splay_deg: 43.5,
+            ..DepthSensor::default()
+        };
+        assert!(seen(&splayed, &centres, 0.0, &left[0]));
+        assert!(!seen(&ahead, &centres, 0.0, &left[0]));
+        // The rig looking ahead turns left to see it; every heading best_view picks
+        // sees it by the units' own views.
+        let turn = best_view(&ahead, &centres, 0.0, &left).expect("a view");
+        assert!(
+            turn > 0.0 && seen(&ahead, &centres, turn, &left[0]),
+            "{turn}"
+        );
+        let turn = best_view(&splayed, &centres, 0.0, &left).expect("a view");
+        assert!(seen(&splayed, &centres, turn, &left[0]), "{turn}");
     }
 
     #[test]

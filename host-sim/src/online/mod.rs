@@ -23,8 +23,9 @@
 //! space. A piece committed before the chain begins to slow down for that rest is
 //! joined onto the committed motion in flight, the corner at the joint blended and
 //! checked on the map of the commit (`crate::trajectory::splice()`), so the chain does
-//! not stop there. Where the route leaves the sensors' view the piece ends with the
-//! head yaw (which every unit holds, and so every sensor) turned along the route.
+//! not stop there. Where the route leaves the head's sensor's view the piece ends with
+//! the head yaw (which every unit holds; the other units' sensors are splayed to its
+//! sides) turned along the route.
 
 pub mod belief;
 pub mod explore;

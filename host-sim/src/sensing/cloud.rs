@@ -5,11 +5,12 @@ use nalgebra::Point3;
 
 use super::raycast::{RayReturn, Scan};
 
-/// How far a return's end point is moved from the hit point towards the centre of the
-/// voxel it hit, as a fraction of the way: the hit point lies on the cube's face, which
-/// OctoMap's `floor` may give to the free voxel in front; 1 % of the way (at least
-/// 0.5 % of a voxel edge from every face) survives rounding to `f32` for coordinates up
-/// to about 1 km at 0.05 m.
+/// How far a return's end point is moved from the hit point into the voxel it hit: along
+/// the ray, as a fraction of a voxel edge, or, where that leaves the voxel, towards its
+/// centre, as a fraction of the way. The hit point lies on the cube's face, which
+/// OctoMap's `floor` may give to the free voxel in front; 1 % (at least 0.5 % of a voxel
+/// edge from every face towards the centre) survives rounding to `f32` for coordinates
+/// up to about 1 km at 0.05 m.
 pub const ENDPOINT_NUDGE: f64 = 0.01;
 
 /// A sensor origin and the end points of its rays (W, `f32` as OctoMap stores them).
@@ -26,10 +27,33 @@ pub fn to_f32(p: &Point3<f64>) -> [f32; 3] {
     [p.x as f32, p.y as f32, p.z as f32]
 }
 
+/// The end point of a return at `distance` along `direction` from `o` in `voxel`: a
+/// little further along the ray ([`ENDPOINT_NUDGE`] of a voxel edge), so the segment
+/// the fusion traverses stays on the ray, which entered no obstacle before; where that
+/// point leaves the voxel (the ray entered it at an edge or a corner), the hit point
+/// moved [`ENDPOINT_NUDGE`] of the way to the voxel's centre.
+fn end_point(
+    o: Point3<f64>,
+    direction: nalgebra::Vector3<f64>,
+    distance: f64,
+    voxel: [i32; 3],
+    resolution: f64,
+) -> [f32; 3] {
+    let hit = o + direction * distance;
+    let along = to_f32(&(hit + direction * (ENDPOINT_NUDGE * resolution)));
+    let key = along.map(|c| (f64::from(c) / resolution).floor() as i32);
+    if key == voxel {
+        return along;
+    }
+    let centre = Point3::from(voxel.map(|i| (f64::from(i) + 0.5) * resolution));
+    to_f32(&(hit + (centre - hit) * ENDPOINT_NUDGE))
+}
+
 impl PointCloud {
     /// The cloud of a scan, as a depth camera's driver would give it to OctoMap:
-    /// - a [`RayReturn::Hit`] gives its hit point moved [`ENDPOINT_NUDGE`] of the way to
-    ///   the hit voxel's centre (so that the end point lies in the voxel hit);
+    /// - a [`RayReturn::Hit`] gives its hit point moved a little into the voxel hit
+    ///   ([`end_point`]): along the ray where it can, so that the segment traversed does
+    ///   not tilt into an obstacle a grazing ray passes;
     /// - a ray without a return ([`RayReturn::Nothing`]) gives the point at twice the
     ///   maximum range along the ray, which the fusion, as OctoMap, clears up to the
     ///   maximum range without marking an end point;
@@ -43,9 +67,7 @@ impl PointCloud {
             .iter()
             .filter_map(|ray| match ray.ret {
                 RayReturn::Hit { distance, voxel } => {
-                    let hit = o + ray.direction * distance;
-                    let centre = Point3::from(voxel.map(|i| (f64::from(i) + 0.5) * resolution));
-                    Some(to_f32(&(hit + (centre - hit) * ENDPOINT_NUDGE)))
+                    Some(end_point(o, ray.direction, distance, voxel, resolution))
                 }
                 RayReturn::Nothing => Some(to_f32(&(o + ray.direction * (2.0 * scan.max_range)))),
                 RayReturn::TooClose { .. } => None,

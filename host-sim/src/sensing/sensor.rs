@@ -4,8 +4,10 @@
 //! Frames (docs/model.md): the body frame has x forward, y left, z up; a unit's attitude
 //! is the quaternion rotating its body frame into W. The sensor's own frame has x along
 //! the optical axis, y left, z up; its mounting pose ([`Mount`]) rotates and offsets that
-//! frame in the body frame. Today every unit holds the head's yaw (docs/model.md,
-//! "Trajectories"), so every sensor with the default mount looks along the head's heading.
+//! frame in the body frame, and the units after the head may turn theirs about body z
+//! ([`DepthSensor::splay_deg`]). Every unit holds the head's yaw (docs/model.md,
+//! "Trajectories"), so with the default mount and no splay every sensor looks along the
+//! head's heading.
 
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
@@ -60,6 +62,14 @@ pub struct DepthSensor {
     pub resolution_deg: f64,
     /// Mounting pose on the unit's body.
     pub mount: Mount,
+    /// How far the sensors of the units after the head are turned about body z from
+    /// `mount` (degrees), alternately to the left (units 1, 3, ...) and to the right
+    /// (units 2, 4, ...); the head's sensor keeps `mount`. Default 0: every sensor as
+    /// `mount`. At half the horizontal field of view each side view begins at the
+    /// head's optical axis and the three views together span twice the head's, the
+    /// chain's flanks included; it trades the view straight ahead (seen by every unit
+    /// at 0) for the view to the sides, which a shape change sweeps (docs/online.md).
+    pub splay_deg: f64,
 }
 
 impl Default for DepthSensor {
@@ -71,6 +81,7 @@ impl Default for DepthSensor {
             max_range: 5.0,
             resolution_deg: 1.5,
             mount: Mount::default(),
+            splay_deg: 0.0,
         }
     }
 }
@@ -173,7 +184,32 @@ impl DepthSensor {
                 format!("gives {n} rays per scan, more than {MAX_RAYS}"),
             ));
         }
+        let a = self.splay_deg;
+        if !(a.is_finite() && (0.0..=180.0).contains(&a)) {
+            return Err(refuse("splay_deg", a, "must be in [0, 180] degrees"));
+        }
         self.validate_mount()
+    }
+
+    /// The turn of unit `unit`'s sensor about body z from `mount` (rad, positive to the
+    /// left): 0 for the head, then the splay to the left and to the right in turn.
+    pub fn unit_turn(&self, unit: usize) -> f64 {
+        let splay = self.splay_deg.to_radians();
+        match unit {
+            0 => 0.0,
+            u if u % 2 == 1 => splay,
+            _ => -splay,
+        }
+    }
+
+    /// The sensor of unit `unit`: this one with its mount turned about body z by
+    /// [`Self::unit_turn`].
+    pub fn for_unit(&self, unit: usize) -> DepthSensor {
+        let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), self.unit_turn(unit));
+        let q = turn * self.mount_rotation();
+        let mut out = self.clone();
+        out.mount.rotation = [q.w, q.i, q.j, q.k];
+        out
     }
 
     fn validate_mount(&self) -> Result<(), SensorError> {
@@ -306,7 +342,7 @@ mod tests {
     fn bad_settings_name_the_field_and_value() {
         /// A change to the default sensor.
         type Change = fn(&mut DepthSensor);
-        let cases: [(Change, &str); 9] = [
+        let cases: [(Change, &str); 11] = [
             (|s| s.fov_h_deg = 180.0, "fov_h_deg = 180.0"),
             (|s| s.fov_v_deg = 0.0, "fov_v_deg = 0.0"),
             (|s| s.fov_v_deg = f64::NAN, "fov_v_deg = NaN"),
@@ -325,6 +361,8 @@ mod tests {
                 |s| s.mount.offset = [0.0, f64::INFINITY, 0.0],
                 "mount.offset = [0.0, inf, 0.0]",
             ),
+            (|s| s.splay_deg = -1.0, "splay_deg = -1.0"),
+            (|s| s.splay_deg = f64::NAN, "splay_deg = NaN"),
         ];
         for (change, expected) in cases {
             let mut s = DepthSensor::default();
@@ -344,6 +382,36 @@ mod tests {
         assert_eq!(s.fov_h_deg, 87.0);
         assert_eq!(s.mount.rotation, [1.0, 0.0, 0.0, 0.0]);
         assert!(serde_json::from_str::<DepthSensor>(r#"{"fov": 3}"#).is_err());
+    }
+
+    #[test]
+    fn the_units_after_the_head_look_left_and_right_in_turn() {
+        // The optical axis (body +x in the sensor frame) of each unit's sensor.
+        let axis = |s: &DepthSensor, unit: usize| {
+            let d = s.for_unit(unit).body_rays()[19 * 59 + 29];
+            d.y.atan2(d.x).to_degrees()
+        };
+        let ahead = DepthSensor::default();
+        assert!((0..4).all(|u| axis(&ahead, u).abs() < 1e-9));
+        let splayed = DepthSensor {
+            splay_deg: 43.5,
+            ..DepthSensor::default()
+        };
+        for (unit, expected) in [(0, 0.0), (1, 43.5), (2, -43.5), (3, 43.5), (4, -43.5)] {
+            assert!(
+                (axis(&splayed, unit) - expected).abs() < 1e-9,
+                "unit {unit}"
+            );
+        }
+        // The splay turns the mounted sensor about body z: one looking down stays down.
+        let down = DepthSensor {
+            splay_deg: 43.5,
+            ..looking_down()
+        };
+        let d = down.for_unit(1).body_rays()[19 * 59 + 29];
+        assert!((d - Vector3::new(0.0, 0.0, -1.0)).norm() < 1e-9, "{d}");
+        let read: DepthSensor = serde_json::from_str(r#"{"splay_deg": 90}"#).unwrap();
+        assert!((axis(&read, 2) + 90.0).abs() < 1e-9);
     }
 
     /// The default sensor mounted pitched by +90 degrees about body y (looking down),

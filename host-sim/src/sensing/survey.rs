@@ -98,10 +98,10 @@ impl Survey {
         let mut next = samples.first().map_or(0.0, |s| s.t);
         for s in samples {
             if s.t + 1e-9 >= next {
-                for unit in &s.units {
+                for (i, unit) in s.units.iter().enumerate() {
                     let q = unit.q.map(f64::from);
                     let pose = UnitPose::new(unit.p.map(f64::from), q)?;
-                    let scan = super::raycast::scan(truth, &self.sensor, &pose);
+                    let scan = super::raycast::scan(truth, &self.sensor.for_unit(i), &pose);
                     stats.rays += scan.rays.len();
                     let cloud = PointCloud::from_scan(&scan, truth.resolution());
                     on_change(&map.insert(&cloud, scan.max_range)?);

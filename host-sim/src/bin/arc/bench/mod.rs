@@ -12,6 +12,7 @@ use super::{CliError, CliResult};
 use crate::study::paper::PaperOptions;
 use crate::study::scale::ScaleOptions;
 use crate::study::{self, paper, robust, scale, Budgets, RunResult, RunSpec, Summary};
+use aerial_chain::sensing::DepthSensor;
 use prm::{run_prm, PrmArgs};
 
 /// `arc bench ...`
@@ -205,6 +206,10 @@ pub struct OnlineArgs {
     /// Simulated seconds an exploration may take.
     #[arg(long, default_value_t = 600.0)]
     time_limit: f64,
+    /// The units' sensor settings (JSON, as `arc explore --sensor`); default the
+    /// default sensor.
+    #[arg(long)]
+    sensor: Option<PathBuf>,
     /// Where CSV, markdown and the plot go.
     #[arg(long, default_value = "bench-out")]
     out_dir: PathBuf,
@@ -677,6 +682,21 @@ fn run_limit(a: LimitArgs) -> CliResult {
     publish_runs(&a.out_dir, "limit", &md, &study::limit::csv(&runs), None)
 }
 
+/// The sensor settings of `--sensor`'s file (validated), or the default sensor.
+fn online_sensor(path: Option<&Path>) -> Result<DepthSensor, CliError> {
+    let Some(p) = path else {
+        return Ok(DepthSensor::default());
+    };
+    let text = std::fs::read_to_string(p)
+        .map_err(|e| CliError::input(format!("{}: cannot read: {e}", p.display())))?;
+    let sensor = serde_json::from_str::<DepthSensor>(&text)
+        .map_err(|e| CliError::input(format!("{}: {e}", p.display())))?;
+    sensor
+        .validate()
+        .map_err(|e| CliError::input(format!("{}: {e}", p.display())))?;
+    Ok(sensor)
+}
+
 fn run_online(a: OnlineArgs) -> CliResult {
     a.runs.check()?;
     if !(a.time_limit > 0.0 && a.time_limit <= 86_400.0) {
@@ -686,6 +706,7 @@ fn run_online(a: OnlineArgs) -> CliResult {
             "a positive number of simulated seconds, at most 86400",
         ));
     }
+    let sensor = online_sensor(a.sensor.as_deref())?;
     let t = Instant::now();
     let mut jobs: Vec<(String, u8)> = Vec::new();
     for sc in &a.runs.scenarios {
@@ -698,7 +719,7 @@ fn run_online(a: OnlineArgs) -> CliResult {
     );
     let mut runs = Vec::new();
     for (sc, n) in jobs {
-        let r = study::online::run_one(&sc, n, a.time_limit);
+        let r = study::online::run_one(&sc, n, a.time_limit, &sensor);
         eprintln!(
             "{sc} N = {n}: {} in {:.1} s (finished map {:.1} s), {} replans, p95 {:.1} ms, max {:.1} ms",
             r.end,
@@ -711,8 +732,11 @@ fn run_online(a: OnlineArgs) -> CliResult {
         runs.push(r);
     }
     let md = format!(
-        "{}\n`arc explore`'s defaults from an empty map; the finished-map flight is `arc bench flight`'s trajectory flight of the same query (seed 1); {} build, {} worker threads; whole study {:.0} s.\n",
+        "{}\n`arc explore`'s defaults from an empty map{}; the finished-map flight is `arc bench flight`'s trajectory flight of the same query (seed 1); {} build, {} worker threads; whole study {:.0} s.\n",
         study::online::markdown(&runs),
+        a.sensor
+            .as_ref()
+            .map_or(String::new(), |p| format!(", the sensors of {}", p.display())),
         if cfg!(debug_assertions) { "debug" } else { "release" },
         std::env::var("RAYON_NUM_THREADS").unwrap_or_else(|_| "every core's".into()),
         t.elapsed().as_secs_f64()

@@ -12,6 +12,7 @@ use aerial_chain::picture::palette;
 use aerial_chain::plan_file::Waypoint;
 use aerial_chain::planning::PlanOptions;
 use aerial_chain::problem::scenarios;
+use aerial_chain::sensing::DepthSensor;
 use aerial_chain::tables::ShapeTables;
 use aerial_chain_core::ChainParams;
 use std::sync::atomic::AtomicUsize;
@@ -86,13 +87,13 @@ impl OnlineRun {
 
 /// Explores `scenario` with `units` from an empty map, and flies the finished-map
 /// plan of the same query.
-pub fn run_one(scenario: &str, units: u8, time_limit_s: f64) -> OnlineRun {
+pub fn run_one(scenario: &str, units: u8, time_limit_s: f64, sensor: &DepthSensor) -> OnlineRun {
     let mut run = OnlineRun {
         scenario: scenario.into(),
         units,
         ..OnlineRun::default()
     };
-    if let Err(e) = explore_one(&mut run, time_limit_s) {
+    if let Err(e) = explore_one(&mut run, time_limit_s, sensor) {
         run.end = e;
     }
     let finished = super::flight::run_one(scenario, units, 1);
@@ -100,7 +101,7 @@ pub fn run_one(scenario: &str, units: u8, time_limit_s: f64) -> OnlineRun {
     run
 }
 
-fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
+fn explore_one(run: &mut OnlineRun, time_limit_s: f64, sensor: &DepthSensor) -> Result<(), String> {
     let sc = scenarios::build(&run.scenario).map_err(|e| e.to_string())?;
     let params = ChainParams::new(run.units)
         .validate()
@@ -110,11 +111,12 @@ fn explore_one(run: &mut OnlineRun, time_limit_s: f64) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let shape = sc.start_shape(run.units).map_err(|e| e.to_string())?;
     let start = Waypoint::new(sc.start.into(), &shape).zeta;
-    let settings = ExploreSettings {
+    let mut settings = ExploreSettings {
         time_limit_s,
         audit: true,
         ..ExploreSettings::default()
     };
+    settings.survey.sensor = sensor.clone();
     let tol = aerial_chain::planner::Query::DEFAULT_GOAL_TOL;
     let ex = explore(
         &sc.grid, params, tables, &start, sc.goal, tol, None, &settings,
