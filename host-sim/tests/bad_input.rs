@@ -267,3 +267,30 @@ fn sizes_beyond_the_budgets_are_refused_by_name() {
     assert!(o.stderr.contains("--vertices"), "{o:?}");
     assert!(!Path::new(&d.join("p.json")).exists());
 }
+
+#[test]
+fn bench_online_refuses_bad_sensor_settings_before_any_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("splay.json"), r#"{"splay_deg": 200}"#).unwrap();
+    let args = [
+        "bench",
+        "online",
+        "--scenarios",
+        "window",
+        "--units",
+        "4",
+        "--robust",
+        "0",
+        "--out-dir",
+        "out",
+    ];
+    for (file, named) in [
+        ("splay.json", "splay_deg = 200"),
+        ("none.json", "none.json"),
+    ] {
+        let o = support::expect(&[&args[..], &["--sensor", file]].concat(), d, 2);
+        assert!(o.stderr.contains(named), "{o:?}");
+        assert!(!d.join("out").exists(), "{file}: wrote the study");
+    }
+}

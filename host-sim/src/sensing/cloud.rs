@@ -52,7 +52,7 @@ fn end_point(
 impl PointCloud {
     /// The cloud of a scan, as a depth camera's driver would give it to OctoMap:
     /// - a [`RayReturn::Hit`] gives its hit point moved a little into the voxel hit
-    ///   ([`end_point`]): along the ray where it can, so that the segment traversed does
+    ///   (`end_point`): along the ray where it can, so that the segment traversed does
     ///   not tilt into an obstacle a grazing ray passes;
     /// - a ray without a return ([`RayReturn::Nothing`]) gives the point at twice the
     ///   maximum range along the ray, which the fusion, as OctoMap, clears up to the
