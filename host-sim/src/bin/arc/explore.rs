@@ -64,7 +64,8 @@ pub struct ExploreArgs {
     #[arg(long, default_value_t = aerial_chain::sensing::survey::DEFAULT_RATE_HZ)]
     sensor_rate: f64,
     /// Every unit's depth sensor as JSON (fields of docs/maps.md "Sensing": fov_h_deg,
-    /// fov_v_deg, min_range, max_range, resolution_deg, mount); fields left out keep
+    /// fov_v_deg, min_range, max_range, resolution_deg, mount, splay_deg: the turn of
+    /// the sensors after the head's, alternately left and right); fields left out keep
     /// their defaults.
     #[arg(long)]
     sensor: Option<PathBuf>,
