@@ -193,7 +193,7 @@ impl DepthSensor {
 
     /// The turn of unit `unit`'s sensor about body z from `mount` (rad, positive to the
     /// left): 0 for the head, then the splay to the left and to the right in turn.
-    pub fn unit_turn(&self, unit: usize) -> f64 {
+    fn unit_turn(&self, unit: usize) -> f64 {
         let splay = self.splay_deg.to_radians();
         match unit {
             0 => 0.0,

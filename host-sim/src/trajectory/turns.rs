@@ -59,8 +59,9 @@ pub(super) fn spread(
         let mut total = 0.0;
         while first > 0 && total < need && carries(&out[first - 1]) {
             first -= 1;
-            times.push(cruise(&out[first], l, limits));
-            total += times[times.len() - 1];
+            let t = cruise(&out[first], l, limits);
+            total += t;
+            times.push(t);
         }
         if times.is_empty() {
             out.push(e);
@@ -108,6 +109,13 @@ mod tests {
     /// The generator's limits: no hold at the start.
     fn limits() -> ReferenceLimits {
         Settings::default().limits.to_reference()
+    }
+
+    /// A straight chain's plan: from (2, 2, 1) along x to `x`, then its head yaw turned
+    /// from 0 to `yaw` in place.
+    fn move_then_turn(x: f64, yaw: f32) -> [([f64; 3], Shape); 3] {
+        let (a, b) = (line(0.0), line(yaw));
+        [([2.0, 2.0, 1.0], a), ([x, 2.0, 1.0], a), ([x, 2.0, 1.0], b)]
     }
 
     fn edges(points: &[([f64; 3], Shape)]) -> Vec<Segment> {
@@ -184,11 +192,9 @@ mod tests {
     fn a_turn_at_the_end_costs_no_time_and_leaves_the_chain_on_the_plan_s_path() {
         let params = ChainParams::new(3);
         let grid = room();
-        let (a, b) = (line(0.0), line(1.5));
-        let straight = [([2.0, 2.0, 1.0], a), ([3.5, 2.0, 1.0], a)];
-        let mut turning = straight.to_vec();
-        turning.push(([3.5, 2.0, 1.0], b));
-        let alone = built(&plan(&params, &straight), &grid);
+        let turning = move_then_turn(3.5, 1.5);
+        let straight = &turning[..2];
+        let alone = built(&plan(&params, straight), &grid);
         let tr = built(&plan(&params, &turning), &grid);
         // The turn alone would add 1.9 s at the yaw rate; 1.5 m take 3 s.
         assert!((tr.duration() - alone.duration()).abs() < 1e-9);
@@ -206,13 +212,7 @@ mod tests {
     fn without_blends_or_past_a_deadline_the_chain_rests_before_the_turn() {
         let params = ChainParams::new(3);
         let grid = room();
-        let (a, b) = (line(0.0), line(1.5));
-        let pts = [
-            ([2.0, 2.0, 1.0], a),
-            ([3.5, 2.0, 1.0], a),
-            ([3.5, 2.0, 1.0], b),
-        ];
-        let p = plan(&params, &pts);
+        let p = plan(&params, &move_then_turn(3.5, 1.5));
         let stop = Settings {
             blend: false,
             ..Settings::default()
@@ -262,12 +262,7 @@ mod tests {
     fn a_turn_longer_than_the_motion_before_it_slows_that_motion_to_its_rate() {
         let params = ChainParams::new(3);
         let grid = room();
-        let (a, b) = (line(0.0), line(3.0));
-        let pts = [
-            ([2.0, 2.0, 1.0], a),
-            ([2.3, 2.0, 1.0], a),
-            ([2.3, 2.0, 1.0], b),
-        ];
+        let pts = move_then_turn(2.3, 3.0);
         let tr = built(&plan(&params, &pts), &grid);
         let turn = built(&plan(&params, &pts[1..]), &grid);
         let step = built(&plan(&params, &pts[..2]), &grid);

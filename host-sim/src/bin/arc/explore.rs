@@ -112,15 +112,18 @@ fn check(a: &ExploreArgs) -> Result<(), CliError> {
     bt("--known", &a.known)
 }
 
+/// The sensor settings of JSON file `p` (`--sensor`), not yet validated.
+pub fn sensor_file(p: &Path) -> Result<DepthSensor, CliError> {
+    let text = std::fs::read_to_string(p)
+        .map_err(|e| CliError::input(format!("{}: cannot read: {e}", p.display())))?;
+    serde_json::from_str::<DepthSensor>(&text)
+        .map_err(|e| CliError::input(format!("{}: {e}", p.display())))
+}
+
 /// The sensors: the file's, the range flag over it, at the rate flag's rate.
 fn survey(a: &ExploreArgs) -> Result<Survey, CliError> {
     let mut sensor = match &a.sensor {
-        Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .map_err(|e| CliError::input(format!("{}: cannot read: {e}", p.display())))?;
-            serde_json::from_str::<DepthSensor>(&text)
-                .map_err(|e| CliError::input(format!("{}: {e}", p.display())))?
-        }
+        Some(p) => sensor_file(p)?,
         None => DepthSensor::default(),
     };
     if let Some(r) = a.sensor_range {

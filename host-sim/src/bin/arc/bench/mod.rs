@@ -687,10 +687,7 @@ fn online_sensor(path: Option<&Path>) -> Result<DepthSensor, CliError> {
     let Some(p) = path else {
         return Ok(DepthSensor::default());
     };
-    let text = std::fs::read_to_string(p)
-        .map_err(|e| CliError::input(format!("{}: cannot read: {e}", p.display())))?;
-    let sensor = serde_json::from_str::<DepthSensor>(&text)
-        .map_err(|e| CliError::input(format!("{}: {e}", p.display())))?;
+    let sensor = super::explore::sensor_file(p)?;
     sensor
         .validate()
         .map_err(|e| CliError::input(format!("{}: {e}", p.display())))?;
