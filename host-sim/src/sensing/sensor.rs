@@ -202,8 +202,8 @@ impl DepthSensor {
         }
     }
 
-    /// The sensor of unit `unit`: this one with its mount turned about body z by
-    /// [`Self::unit_turn`].
+    /// The sensor of unit `unit`: this one with its mount turned about body z, by 0
+    /// for the head and then by [`Self::splay_deg`] to the left and to the right in turn.
     pub fn for_unit(&self, unit: usize) -> DepthSensor {
         let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), self.unit_turn(unit));
         let q = turn * self.mount_rotation();
