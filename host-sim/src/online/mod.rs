@@ -24,8 +24,8 @@
 //! joined onto the committed motion in flight, the corner at the joint blended and
 //! checked on the map of the commit (`crate::trajectory::splice()`), so the chain does
 //! not stop there. Where the route leaves the head's sensor's view the piece ends with
-//! the head yaw (which every unit holds; the other units' sensors are splayed to its
-//! sides) turned along the route.
+//! the head yaw (which every unit holds; the other units' sensors look along it, or to
+//! its sides where `DepthSensor::splay_deg` turns them) turned along the route.
 
 pub mod belief;
 pub mod explore;

@@ -567,7 +567,8 @@ impl OnlinePlanner {
 
     /// Whether a head yaw of `yaw` should turn to `look`: when `look` lies more than a
     /// quarter of the horizontal field of view off it, the route ahead would leave the
-    /// middle half of the head's sensor's view (the others are splayed to its sides).
+    /// middle half of the head's sensor's view (the others' look along it unless
+    /// splayed to its sides).
     fn turn_needed(&self, yaw: f32, look: f32) -> bool {
         let d = crate::collision::verify::wrap((look - yaw) as f64);
         d.abs() > self.sensor.fov_h_deg.to_radians() / 4.0
