@@ -11,11 +11,12 @@ the Rust library ``aerial_chain`` (the ``arc`` command line uses the same code):
     ac.verify(world, plan)                           # raises VerifyError if INVALID
     plan.unit_positions()                            # (waypoints, N, 3) numpy array
     flight = ac.simulate(world, plan)                # flight.unit_positions: (T, N, 3)
+    run = ac.explore(world, units=4)                 # into the unknown, as `arc explore`
     ac.export(world, plan, "window.mcap")            # a ROS 2 bag; .tlog: MAVLink
 
-Bad input raises ``MapError``, ``PlanError``, ``VerifyError``, ``SimError`` or
-``ExportError``, all subclasses of ``ArcError`` (a ``ValueError``), with a message
-naming the file, field or argument and the value.
+Bad input raises ``MapError``, ``PlanError``, ``VerifyError``, ``SimError``,
+``ExploreError`` or ``ExportError``, all subclasses of ``ArcError`` (a
+``ValueError``), with a message naming the file, field or argument and the value.
 """
 
 from . import _native
@@ -23,6 +24,8 @@ from ._native import (
     DEFAULT_CLEARANCE,
     SCENARIOS,
     ArcError,
+    Exploration,
+    ExploreError,
     ExportError,
     Flight,
     Map,
@@ -32,6 +35,7 @@ from ._native import (
     SimError,
     VerifyError,
     VerifyReport,
+    explore,
     export,
     plan,
     simulate,

@@ -15,6 +15,8 @@ _Point = Union[Sequence[float], NDArray[np.float64]]
 __all__ = [
     "ArcError",
     "DEFAULT_CLEARANCE",
+    "Exploration",
+    "ExploreError",
     "ExportError",
     "Flight",
     "Map",
@@ -25,6 +27,7 @@ __all__ = [
     "SimError",
     "VerifyError",
     "VerifyReport",
+    "explore",
     "export",
     "plan",
     "simulate",
@@ -54,6 +57,9 @@ class SimError(ArcError):
 
 class ExportError(ArcError):
     """An export that cannot be made: an output name that is no .mcap or .tlog, options outside their limits."""
+
+class ExploreError(ArcError):
+    """An exploration that cannot run: sensor or planner settings outside their limits, a start whose hull is not free."""
 
 @final
 class Map:
@@ -182,6 +188,62 @@ class Flight:
     def success(self) -> bool:
         """True when the chain reached the plan's goal without touching anything."""
     def __len__(self) -> int: ...
+
+@final
+class Exploration:
+    """What ``explore`` returns: how the run ended, the flight, the committed pieces as
+    one plan, the record of every replan and the map the sensors drew."""
+
+    @property
+    def reached(self) -> bool:
+        """True when the chain reached the goal and settled there."""
+    @property
+    def end(self) -> dict[str, Any]:
+        """How the run ended: ``kind`` (``reached``, ``sealed``, ``time_limit``,
+        ``flight_failed``), the simulated time ``t`` and, but for ``reached``, why."""
+    @property
+    def flight(self) -> Flight:
+        """The flight: the chain's states and its report against the true map."""
+    @property
+    def plan(self) -> Plan:
+        """The committed pieces joined into one plan (``arc explore --plan-out``)."""
+    @property
+    def replans(self) -> list[dict[str, Any]]:
+        """Every replan, in order (docs/model.md, "Explorations")."""
+    @property
+    def summary(self) -> dict[str, Any]:
+        """Replans, pieces, replan latency, field updates, voxels seen."""
+    @property
+    def voxels_seen(self) -> int:
+        """Voxels of the seen map known (free or occupied) at the end."""
+    def write_seen(self, path: _Path) -> None:
+        """Writes the map the sensors drew (``.bt``, as ``arc explore --map-out``)."""
+    def write(self, path: _Path) -> None:
+        """Writes the flight with the record of every replan (``arc-sim/1``, as ``arc
+        explore --out``)."""
+
+def explore(
+    map: Map,
+    units: Optional[int] = None,
+    start: Optional[_Point] = None,
+    goal: Optional[_Point] = None,
+    start_yaw: Optional[float] = None,
+    start_shape: Optional[Sequence[float]] = None,
+    goal_tol: float = 0.3,
+    time_limit: float = 600.0,
+    deadline: float = ...,
+    clearance: float = ...,
+    start_free: str = "hull",
+    sensor: Optional[dict[str, Any]] = None,
+    sensor_rate: float = ...,
+    known: Optional[Map] = None,
+    record_every: int = 10,
+) -> Exploration:
+    """Flies the chain into the unknown on ``map`` as ``arc explore`` does: only the
+    units' simulated sensors (``sensor``: docs/maps.md "Sensing" fields) read ``map``;
+    the online planner replans from what they saw. Raises ``PlanError`` for a bad chain
+    or query, ``ExploreError`` for bad settings or a start that is not free,
+    ``SimError`` when the simulation cannot run."""
 
 def plan(
     map: Map,

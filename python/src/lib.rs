@@ -9,6 +9,8 @@
 //!   file), `plan::verify` (the exact verifier of docs/model.md);
 //! - `sim::simulate` and `sim::Flight`, the chain flown by its control stack as `arc
 //!   sim` flies it (`aerial_chain::flying::fly`);
+//! - `explore::explore` and `explore::Exploration`, the chain flown into the unknown
+//!   as `arc explore` flies it (`aerial_chain::online::explore`);
 //! - `export::export`, a plan or flight as a ROS 2 bag or MAVLink setpoints.
 //!
 //! Configurations and flights come out as NumPy arrays. Bad input raises one of the
@@ -20,6 +22,7 @@
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+mod explore;
 mod export;
 mod map;
 mod plan;
@@ -57,6 +60,12 @@ pyo3::create_exception!(
 );
 pyo3::create_exception!(
     aerial_chain,
+    ExploreError,
+    ArcError,
+    "An exploration that cannot run: sensor or planner settings outside their limits, a start whose hull is not free."
+);
+pyo3::create_exception!(
+    aerial_chain,
     SimError,
     ArcError,
     "The simulation cannot fly the plan: settings outside their limits, a plan it cannot time."
@@ -86,6 +95,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("VerifyError", py.get_type::<VerifyError>())?;
     m.add("SimError", py.get_type::<SimError>())?;
     m.add("ExportError", py.get_type::<ExportError>())?;
+    m.add("ExploreError", py.get_type::<ExploreError>())?;
     m.add(
         "DEFAULT_CLEARANCE",
         aerial_chain::collision::DEFAULT_CLEARANCE,
@@ -98,9 +108,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<plan::Plan>()?;
     m.add_class::<plan::VerifyReport>()?;
     m.add_class::<sim::Flight>()?;
+    m.add_class::<explore::Exploration>()?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(plan::verify, m)?)?;
     m.add_function(wrap_pyfunction!(sim::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(explore::explore, m)?)?;
     m.add_function(wrap_pyfunction!(export::export, m)?)?;
     Ok(())
 }

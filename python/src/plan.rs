@@ -38,7 +38,7 @@ pub struct Plan {
 
 impl Plan {
     /// Wraps a plan after checking the format rules that need no map.
-    fn checked(plan: aerial_chain::plan_file::Plan) -> PyResult<Self> {
+    pub(crate) fn checked(plan: aerial_chain::plan_file::Plan) -> PyResult<Self> {
         let params = plan.check().map_err(err::<PlanError>)?;
         Ok(Plan { plan, params })
     }
@@ -269,7 +269,7 @@ pub fn verify(
 }
 
 /// The chain of `units` units with the docs/model.md defaults, or `PlanError`.
-fn chain(units: i64) -> PyResult<ChainParams> {
+pub(crate) fn chain(units: i64) -> PyResult<ChainParams> {
     let n = u8::try_from(units)
         .ok()
         .filter(|n| (2..=MAX_UNITS as u8).contains(n))
@@ -280,17 +280,17 @@ fn chain(units: i64) -> PyResult<ChainParams> {
 }
 
 /// What the caller of `plan()` gave of the query; the rest comes from the scenario.
-struct Asked {
-    start: Option<[f64; 3]>,
-    goal: Option<[f64; 3]>,
-    start_yaw: Option<f64>,
-    start_shape: Option<Vec<f32>>,
-    goal_tol: f64,
+pub(crate) struct Asked {
+    pub(crate) start: Option<[f64; 3]>,
+    pub(crate) goal: Option<[f64; 3]>,
+    pub(crate) start_yaw: Option<f64>,
+    pub(crate) start_shape: Option<Vec<f32>>,
+    pub(crate) goal_tol: f64,
 }
 
 /// The query: the scenario's start, yaw, goal where not given; the start shape as
 /// given (2N - 1 angles) or the straight line behind the head at the start yaw.
-fn query(map: &Map, params: &ChainParams, asked: Asked) -> PyResult<Query> {
+pub(crate) fn query(map: &Map, params: &ChainParams, asked: Asked) -> PyResult<Query> {
     let Asked {
         start,
         goal,
