@@ -16,11 +16,6 @@ GEB079 = REPO / "maps" / "geb079.bt"
 
 
 @pytest.fixture(scope="module")
-def window():
-    return ac.Map.scenario("window")
-
-
-@pytest.fixture(scope="module")
 def window_plan(window):
     return ac.plan(window, units=5)
 

@@ -10,11 +10,6 @@ import aerial_chain as ac
 
 
 @pytest.fixture(scope="module")
-def window():
-    return ac.Map.scenario("window")
-
-
-@pytest.fixture(scope="module")
 def run(window):
     return ac.explore(window, units=4)
 
