@@ -125,7 +125,8 @@ fn a_sensor_that_sees_almost_nothing_keeps_the_chain_in_known_space() {
     let d = dir.path();
     let run = words("explore --scenario window --units 4 --sensor-range 0.25 --time-limit 15");
     let o = expect(&[&run[..], &OUTPUTS].concat(), d, 1);
-    assert!(o.stderr.contains("time limit"), "{o:?}");
+    assert!(o.stderr.contains("the chain is stuck"), "{o:?}");
+    assert!(o.stderr.contains("nothing new"), "{o:?}");
     let o = expect(&["verify", "--map", "seen.bt", "--plan", "p.json"], d, 0);
     assert!(o.stdout.contains("VALID"), "{o:?}");
     let flight = json(&d.join("f.json"));
@@ -141,6 +142,25 @@ fn a_sensor_that_sees_almost_nothing_keeps_the_chain_in_known_space() {
             "the head went {d} m from its start, past what it saw"
         );
     }
+    assert_eq!(flight["explore"]["end"]["kind"], "stuck");
+    assert!(flight["explore"]["end"]["t"].as_f64().unwrap() < 15.0);
+}
+
+/// A run whose time budget ends first exits 1 saying so, with what it tried; its
+/// flight is written.
+#[test]
+fn a_run_out_of_time_ends_with_what_it_tried() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = words("explore --scenario window --units 4 --time-limit 3 --out f.json");
+    let o = expect(&run, d, 1);
+    assert!(
+        o.stderr.contains("the time limit of 3 simulated s ran out"),
+        "{o:?}"
+    );
+    assert!(o.stderr.contains("replans"), "{o:?}");
+    let flight = json(&d.join("f.json"));
+    assert_eq!(flight["explore"]["end"]["kind"], "time_limit");
 }
 
 #[test]

@@ -48,8 +48,9 @@ impl Exploration {
         self.end.reached()
     }
 
-    /// How the run ended: a dict with `kind` (`reached`, `sealed`, `time_limit` or
-    /// `flight_failed`), the simulated time `t` and, but for `reached`, why.
+    /// How the run ended: a dict with `kind` (`reached`, `sealed`, `stuck`,
+    /// `time_limit` or `flight_failed`), the simulated time `t` and, but for `reached`,
+    /// why.
     #[getter]
     fn end<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         json_to_py(py, &self.end)
@@ -106,6 +107,7 @@ impl Exploration {
         let end = match &self.end {
             ExploreEnd::Reached { t } => format!("reached the goal at {t:.2} s"),
             ExploreEnd::Sealed { t, .. } => format!("found the goal out of reach at {t:.2} s"),
+            ExploreEnd::Stuck { t, .. } => format!("got stuck at {t:.2} s"),
             ExploreEnd::TimeLimit { t, .. } => format!("ran out of time at {t:.0} s"),
             ExploreEnd::FlightFailed { t, .. } => format!("failed in flight at {t:.2} s"),
         };

@@ -64,15 +64,23 @@ def test_the_flight_and_the_seen_map_are_written_as_arc_writes_them(window, run,
     assert ac.verify(seen, run.plan).ok
 
 
-def test_a_sensor_that_sees_almost_nothing_keeps_the_chain_near_its_start(window):
+def test_a_sensor_that_sees_almost_nothing_gets_the_chain_stuck_near_its_start(window):
     short = ac.explore(
         window, units=4, sensor={"max_range": 0.25}, time_limit=15.0, record_every=50
     )
     assert not short.reached
-    assert short.end["kind"] == "time_limit" and "tried" in short.end
+    assert short.end["kind"] == "stuck" and short.end["t"] < 15.0
+    assert "nothing new" in short.end["why"]
     heads = short.flight.unit_positions[:, 0]
     assert np.max(np.linalg.norm(heads - heads[0], axis=1)) < 1.0
     assert short.flight.report["contact"] is False
+
+
+def test_a_run_out_of_time_says_what_it_tried(window):
+    hasty = ac.explore(window, units=4, time_limit=3.0, record_every=50)
+    assert not hasty.reached
+    assert hasty.end["kind"] == "time_limit" and hasty.end["t"] == 3.0
+    assert "replans" in hasty.end["tried"]
 
 
 @pytest.mark.parametrize(

@@ -64,6 +64,16 @@ pub enum ExploreEnd {
         /// Why.
         why: String,
     },
+    /// The chain can get no further: it rests where no piece is found on what its
+    /// sensors see, every retry spent, and they see nothing new
+    /// ([`OnlinePlanner::stuck`]); while the world and the chain stand still, no later
+    /// replan could change that.
+    Stuck {
+        /// When that was found (simulated s).
+        t: f64,
+        /// Where the chain rests and what it tried.
+        why: String,
+    },
     /// The time budget ran out.
     TimeLimit {
         /// The budget (simulated s).
@@ -458,6 +468,9 @@ impl Loop<'_> {
         let record = self.planner.replan(t, trigger);
         if let Outcome::Sealed(why) = record.outcome {
             return Some(ExploreEnd::Sealed { t, why });
+        }
+        if let Some(why) = self.planner.stuck(t) {
+            return Some(ExploreEnd::Stuck { t, why });
         }
         if self.planner.pieces().len() > before {
             self.pending = Some(self.planner.effective_from());

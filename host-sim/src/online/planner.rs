@@ -70,6 +70,7 @@ pub struct OnlinePlanner {
     reached: bool,
     failures: u32,
     failed_on: Option<usize>,
+    failed_at: f64,
     keep_maps: bool,
     records: Vec<ReplanRecord>,
     looked_at_hull: bool,
@@ -136,6 +137,7 @@ impl OnlinePlanner {
             reached: false,
             failures: 0,
             failed_on: None,
+            failed_at: f64::NEG_INFINITY,
             keep_maps: false,
             records: Vec::new(),
             looked_at_hull: false,
@@ -240,6 +242,7 @@ impl OnlinePlanner {
             Outcome::NoRoom => {
                 self.failures += 1;
                 self.failed_on = Some(changed);
+                self.failed_at = now;
             }
             Outcome::Committed | Outcome::Looked => {
                 self.failures = 0;
@@ -303,6 +306,44 @@ impl OnlinePlanner {
                 false
             }
         }
+    }
+
+    /// Why the chain can get no further, when it cannot, at simulated time `now`: the
+    /// committed motion has ended, the due piece was tried on exactly what is known now
+    /// with every retry spent (three, each with twice the deadline before;
+    /// after looking along the route and at the hull where it rests), and the replans
+    /// since, due again, found nothing new for a route period (`route_period_s`, so
+    /// that a voxel the hovering units' sensors see late is not missed). The world
+    /// stands still and the chain rests, so its sensors will see nothing new either: no
+    /// later replan can change the answer. `None` otherwise.
+    pub fn stuck(&self, now: f64) -> Option<String> {
+        let last = self.records.last()?;
+        let idle = last.trigger == Trigger::CommitShort && last.outcome == Outcome::NothingNew;
+        let spent =
+            self.failures > 0 && !self.retry_due() && self.failed_on == Some(self.belief.changed());
+        let waited = now - self.failed_at >= self.settings.route_period_s;
+        if self.reached || now < self.committed.duration() || !(idle && spent && waited) {
+            return None;
+        }
+        let at = head(&self.end);
+        let route = self.route.as_ref()?;
+        let leaves = route.points[self.known_prefix(route)];
+        Some(format!(
+            "no piece from where the chain rests (head at [{:.2}, {:.2}, {:.2}]) on what its \
+             sensors have seen: {} tries failed (deadlines up to {:.2} s), and the sensors \
+             saw nothing new there since; the route to the goal ({:.2} m) leaves known \
+             space {:.2} m from the head, at [{:.2}, {:.2}, {:.2}]",
+            at.x,
+            at.y,
+            at.z,
+            self.failures,
+            self.deadline(),
+            route.length(),
+            (leaves - at).norm(),
+            leaves.x,
+            leaves.y,
+            leaves.z,
+        ))
     }
 
     /// The committed motion in simulated time, from the start: every piece joined.

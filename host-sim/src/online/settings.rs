@@ -24,7 +24,9 @@ pub struct OnlineSettings {
     /// waiting for its next piece. Default 0.3 s.
     pub deadline_s: f64,
     /// Period of the route's replans when nothing cuts it (s): how soon a shortcut
-    /// that sensing opened is taken. Default 1 s.
+    /// that sensing opened is taken; also how long a chain at rest that finds no piece
+    /// waits for something new before it is stuck ([`super::OnlinePlanner::stuck`]).
+    /// Default 1 s.
     pub route_period_s: f64,
     /// What the start is taken to prove free (docs/online.md, "The start"). Default
     /// [`StartFree::Hull`].

@@ -446,3 +446,55 @@ fn pieces_committed_in_time_are_joined_in_flight_without_a_stop() {
         );
     }
 }
+
+/// Sensors that see 0.25 m find no piece from the start of `window`, and where the
+/// chain rests they see nothing new: the run ends as stuck once the retries are spent
+/// and a route period has passed without anything new, saying where the chain rests,
+/// long before its time limit. With its sensors' full range the same run flies on
+/// past that time.
+#[test]
+fn a_chain_that_sees_nothing_new_where_no_piece_is_found_is_stuck() {
+    let (sc, params, tables, start) = window(4);
+    let mut settings = ExploreSettings {
+        time_limit_s: 60.0,
+        ..ExploreSettings::default()
+    };
+    settings.survey.sensor.max_range = 0.25;
+    let run = |s: &ExploreSettings| {
+        explore(
+            &sc.grid,
+            params,
+            tables.clone(),
+            &start,
+            sc.goal,
+            0.3,
+            None,
+            s,
+        )
+        .unwrap()
+    };
+    let ex = run(&settings);
+    let ExploreEnd::Stuck { t, why } = &ex.end else {
+        panic!("{:?}", ex.end);
+    };
+    assert!(*t < 10.0, "stuck only at {t} s");
+    assert!(why.contains("head at [2.00, 4.50, 1.50]"), "{why}");
+    assert!(why.contains("nothing new"), "{why}");
+    let last_failure = ex
+        .replans
+        .iter()
+        .rev()
+        .find(|r| r.outcome == Outcome::NoRoom)
+        .expect("tries that failed");
+    assert!(*t - last_failure.t >= settings.online.route_period_s);
+    assert!(!ex.flight.report.contact);
+    // The default sensor sees the way on: at the same time the run is still going.
+    settings.survey.sensor = Default::default();
+    settings.time_limit_s = *t + 1.0;
+    let ex = run(&settings);
+    assert!(
+        matches!(ex.end, ExploreEnd::TimeLimit { .. }),
+        "{:?}",
+        ex.end
+    );
+}

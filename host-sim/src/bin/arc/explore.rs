@@ -218,6 +218,9 @@ pub fn run(a: ExploreArgs) -> CliResult {
         ExploreEnd::Sealed { t, why } => Err(CliError::failed(format!(
             "the goal cannot be reached (at {t:.2} s): {why}"
         ))),
+        ExploreEnd::Stuck { t, why } => Err(CliError::failed(format!(
+            "the chain is stuck (at {t:.2} s): {why}"
+        ))),
         ExploreEnd::TimeLimit { t, tried } => Err(CliError::failed(format!(
             "the time limit of {t} simulated s ran out: {tried}"
         ))),
@@ -267,6 +270,7 @@ fn say(report: &Report, a: &ExploreArgs, run: &Exploration) {
     let end = match &run.end {
         ExploreEnd::Reached { t } => format!("reached the goal at {t:.2} s"),
         ExploreEnd::Sealed { t, .. } => format!("found the goal out of reach at {t:.2} s"),
+        ExploreEnd::Stuck { t, .. } => format!("got stuck at {t:.2} s"),
         ExploreEnd::TimeLimit { t, .. } => format!("ran out of time at {t:.0} s"),
         ExploreEnd::FlightFailed { t, .. } => format!("failed in flight at {t:.2} s"),
     };

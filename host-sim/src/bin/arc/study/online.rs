@@ -130,6 +130,7 @@ fn explore_one(run: &mut OnlineRun, time_limit_s: f64, sensor: &DepthSensor) -> 
             "reached".into()
         }
         ExploreEnd::Sealed { .. } => "sealed".into(),
+        ExploreEnd::Stuck { .. } => "stuck".into(),
         ExploreEnd::TimeLimit { .. } => "time_limit".into(),
         ExploreEnd::FlightFailed { .. } => "flight_failed".into(),
     };
