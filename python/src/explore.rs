@@ -104,13 +104,7 @@ impl Exploration {
     }
 
     fn __repr__(&self) -> String {
-        let end = match &self.end {
-            ExploreEnd::Reached { t } => format!("reached the goal at {t:.2} s"),
-            ExploreEnd::Sealed { t, .. } => format!("found the goal out of reach at {t:.2} s"),
-            ExploreEnd::Stuck { t, .. } => format!("got stuck at {t:.2} s"),
-            ExploreEnd::TimeLimit { t, .. } => format!("ran out of time at {t:.0} s"),
-            ExploreEnd::FlightFailed { t, .. } => format!("failed in flight at {t:.2} s"),
-        };
+        let end = self.end.headline();
         let s = &self.record.summary;
         format!(
             "Exploration({end}, {} replans, {} pieces, {} voxels seen)",

@@ -95,6 +95,17 @@ impl ExploreEnd {
     pub fn reached(&self) -> bool {
         matches!(self, Self::Reached { .. })
     }
+
+    /// How it ended, in a few words with the time (`arc explore`'s report line).
+    pub fn headline(&self) -> String {
+        match self {
+            Self::Reached { t } => format!("reached the goal at {t:.2} s"),
+            Self::Sealed { t, .. } => format!("found the goal out of reach at {t:.2} s"),
+            Self::Stuck { t, .. } => format!("got stuck at {t:.2} s"),
+            Self::TimeLimit { t, .. } => format!("ran out of time at {t:.0} s"),
+            Self::FlightFailed { t, .. } => format!("failed in flight at {t:.2} s"),
+        }
+    }
 }
 
 /// What the sensors did.

@@ -267,13 +267,7 @@ fn write(
 /// The report: how it ended, the flight, the replans.
 fn say(report: &Report, a: &ExploreArgs, run: &Exploration) {
     let r = &run.flight.report;
-    let end = match &run.end {
-        ExploreEnd::Reached { t } => format!("reached the goal at {t:.2} s"),
-        ExploreEnd::Sealed { t, .. } => format!("found the goal out of reach at {t:.2} s"),
-        ExploreEnd::Stuck { t, .. } => format!("got stuck at {t:.2} s"),
-        ExploreEnd::TimeLimit { t, .. } => format!("ran out of time at {t:.0} s"),
-        ExploreEnd::FlightFailed { t, .. } => format!("failed in flight at {t:.2} s"),
-    };
+    let end = run.end.headline();
     report.line(format_args!(
         "{}: explored {} with N = {}: {end}",
         a.out.display(),
