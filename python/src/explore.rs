@@ -11,10 +11,11 @@ use pyo3::prelude::*;
 
 use aerial_chain::flying::FlyOptions;
 use aerial_chain::online::{self, ExploreEnd, ExploreError as Refused, ExploreSettings};
-use aerial_chain::plan_file::{MapSection, Waypoint};
+use aerial_chain::plan_file::{ChainSection, MapSection, Waypoint};
+use aerial_chain::planning::PlanOptions;
 use aerial_chain::sensing::{DepthSensor, OccupancyMap, Survey};
-use aerial_chain::sim::FlightFile;
-use aerial_chain::tables::{ShapeTables, TableSettings};
+use aerial_chain::sim::{FlightFile, FLIGHT_FORMAT};
+use aerial_chain::tables::ShapeTables;
 
 use crate::map::Map;
 use crate::plan::{chain, query, Asked, Plan};
@@ -36,8 +37,8 @@ pub struct Exploration {
     record: online::ExploreRecord,
     /// The map the sensors drew.
     seen: OccupancyMap,
-    /// The flight as `arc explore --out` writes it (its record included).
-    file: FlightFile,
+    /// The world's name, as the flight file records it.
+    map_name: String,
 }
 
 #[pymethods]
@@ -99,7 +100,19 @@ impl Exploration {
     /// Writes the flight with the record of every replan (`arc-sim/1`, as `arc explore
     /// --out` writes it; `arc view` shows it). Raises `ExploreError` naming the file.
     fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        py.detach(|| self.file.write(&path))
+        let flight = self.flight.get();
+        let record = serde_json::to_value(&self.record).map_err(err::<ExploreError>)?;
+        let file = FlightFile {
+            format: FLIGHT_FORMAT.into(),
+            plan: "arc explore".into(),
+            map: self.map_name.clone(),
+            chain: Some(ChainSection::from_params(&flight.params)),
+            report: flight.report.clone(),
+            record_every: flight.record_every,
+            samples: flight.samples.clone(),
+            explore: Some(record),
+        };
+        py.detach(|| file.write(&path))
             .map_err(|e| err::<ExploreError>(format!("{}: {e}", path.display())))
     }
 
@@ -199,7 +212,9 @@ pub fn explore(
     }
     let start = Waypoint::new(query.start.into(), &query.start_shape).zeta;
     let run = py.detach(|| {
-        let tables = ShapeTables::build(params, &TableSettings::default(), &AtomicUsize::new(0))
+        // `arc plan`'s tables, as `arc explore` builds them.
+        let table_settings = PlanOptions::default().table_settings();
+        let tables = ShapeTables::build(params, &table_settings, &AtomicUsize::new(0))
             .map_err(|e| err::<ExploreError>(format!("shape tables: {e}")))?;
         let prior = known.map(|k| &k.grid);
         online::explore(
@@ -273,8 +288,6 @@ fn exploration(
     record_every: usize,
 ) -> PyResult<Exploration> {
     let record = run.record();
-    let mut file = FlightFile::new(&run.flight, "arc explore", &map.name, record_every);
-    file.explore = Some(serde_json::to_value(&record).map_err(err::<ExploreError>)?);
     let mut plan = run.plan;
     plan.map = MapSection::of(&map.grid).with_source(map.source.clone());
     let flight = run.flight;
@@ -290,6 +303,6 @@ fn exploration(
         plan: Py::new(py, Plan::checked(plan)?)?,
         record,
         seen: run.seen,
-        file,
+        map_name: map.name.clone(),
     })
 }

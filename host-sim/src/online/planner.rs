@@ -70,7 +70,6 @@ pub struct OnlinePlanner {
     reached: bool,
     failures: u32,
     failed_on: Option<usize>,
-    failed_at: f64,
     keep_maps: bool,
     records: Vec<ReplanRecord>,
     looked_at_hull: bool,
@@ -137,7 +136,6 @@ impl OnlinePlanner {
             reached: false,
             failures: 0,
             failed_on: None,
-            failed_at: f64::NEG_INFINITY,
             keep_maps: false,
             records: Vec::new(),
             looked_at_hull: false,
@@ -242,7 +240,6 @@ impl OnlinePlanner {
             Outcome::NoRoom => {
                 self.failures += 1;
                 self.failed_on = Some(changed);
-                self.failed_at = now;
             }
             Outcome::Committed | Outcome::Looked => {
                 self.failures = 0;
@@ -321,8 +318,16 @@ impl OnlinePlanner {
         let idle = last.trigger == Trigger::CommitShort && last.outcome == Outcome::NothingNew;
         let spent =
             self.failures > 0 && !self.retry_due() && self.failed_on == Some(self.belief.changed());
-        let waited = now - self.failed_at >= self.settings.route_period_s;
-        if self.reached || now < self.committed.duration() || !(idle && spent && waited) {
+        if self.reached || now < self.committed.duration() || !(idle && spent) {
+            return None;
+        }
+        // The last failed try, among the records (they are searched only here).
+        let failed = self
+            .records
+            .iter()
+            .rev()
+            .find(|r| r.outcome == Outcome::NoRoom)?;
+        if now - failed.t < self.settings.route_period_s {
             return None;
         }
         let at = head(&self.end);
