@@ -186,3 +186,60 @@ fn bad_sensor_and_start_settings_are_refused_naming_them() {
         assert!(!d.join("f.json").exists(), "{flags:?} wrote the flight");
     }
 }
+
+/// `--settings FILE`: its online section sets the route period and what the start
+/// proves free; a flag given on the command line wins over the file; a bad file is
+/// refused naming the file and the key, before anything is flown.
+#[test]
+fn a_settings_file_tunes_the_online_planner_and_a_flag_wins_over_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let file = r#"{"online": {"route_period_s": 0.5, "start_free": "bodies"}}"#;
+    std::fs::write(d.join("s.json"), file).unwrap();
+    let run = words("explore --scenario window --units 3 --time-limit 2.2 --settings s.json");
+    let periods = |flight: &serde_json::Value| -> Vec<f64> {
+        let replans = flight["explore"]["replans"].as_array().unwrap();
+        replans
+            .iter()
+            .filter(|r| r["trigger"] == "period")
+            .map(|r| r["t"].as_f64().unwrap())
+            .collect()
+    };
+    expect(&[&run[..], &["--out", "f.json"]].concat(), d, 1);
+    let flight = json(&d.join("f.json"));
+    assert_eq!(flight["explore"]["start_free"], "bodies");
+    assert_eq!(periods(&flight)[..4], [0.5, 1.0, 1.5, 2.0]);
+    let hull = ["--start-free", "hull", "--out", "g.json"];
+    expect(&[&run[..], &hull].concat(), d, 1);
+    let flight = json(&d.join("g.json"));
+    assert_eq!(flight["explore"]["start_free"], "hull");
+    expect(
+        &words("explore --scenario window --units 3 --time-limit 2.2 --out h.json"),
+        d,
+        1,
+    );
+    let flight = json(&d.join("h.json"));
+    assert_eq!(periods(&flight)[..2], [1.0, 2.0]);
+
+    std::fs::write(d.join("typo.json"), r#"{"online": {"deadline": 1}}"#).unwrap();
+    std::fs::write(d.join("zero.json"), r#"{"online": {"route_period_s": 0}}"#).unwrap();
+    std::fs::write(d.join("few.json"), r#"{"planner": {"vertices": 0}}"#).unwrap();
+    for (file, named) in [
+        ("typo.json", "typo.json: unknown key `online.deadline`"),
+        ("zero.json", "zero.json: online.route_period_s = 0"),
+        ("few.json", "few.json: planner.vertices"),
+    ] {
+        let args = [
+            "explore",
+            "--scenario",
+            "window",
+            "--out",
+            "x.json",
+            "--settings",
+            file,
+        ];
+        let o = expect(&args, d, 2);
+        assert!(o.stderr.contains(named), "{file}: {o:?}");
+        assert!(!d.join("x.json").exists(), "{file} wrote the flight");
+    }
+}

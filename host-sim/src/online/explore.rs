@@ -549,16 +549,15 @@ impl Loop<'_> {
     /// What was tried, for a run out of time.
     fn tried(&self) -> String {
         let records = self.planner.records();
-        let committed = records
-            .iter()
-            .filter(|r| r.outcome == Outcome::Committed)
-            .count();
+        let pieces = self.planner.pieces();
+        let looks = pieces.iter().filter(|p| p.is_look()).count();
         let end = super::planner::head(self.planner.committed_end());
         let left = self.planner.route().map_or(f64::NAN, |r| r.length());
         format!(
-            "{} replans, {committed} pieces committed, the committed motion ends {:.2} m from \
-             the goal (route {left:.2} m from there), {} voxels seen",
+            "{} replans, {} pieces committed ({looks} of them turns to look), the committed \
+             motion ends {:.2} m from the goal (route {left:.2} m from there), {} voxels seen",
             records.len(),
+            pieces.len(),
             (end - self.goal).norm(),
             self.planner.belief().seen().known()
         )

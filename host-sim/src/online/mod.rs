@@ -43,7 +43,10 @@ pub use explore::{
 pub use planner::{OnlinePlanner, Piece};
 pub use record::{Outcome, ReplanRecord, Trigger};
 pub use route::{Radii, Route};
-pub use settings::{OnlineError, OnlineSettings, StartFree, DEFAULT_DEADLINE_S};
+pub use settings::{
+    OnlineError, OnlineSection, OnlineSettings, StartFree, DEFAULT_DEADLINE_S,
+    DEFAULT_ROUTE_PERIOD_S,
+};
 
 #[cfg(test)]
 mod tests;

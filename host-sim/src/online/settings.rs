@@ -3,12 +3,24 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::planning::{PlanOptions, PlanningError};
+use crate::planner::SettingError;
+use crate::planning::{PlanOptions, PlanningError, SettingsFile};
 use crate::sensing::occupancy::FusionError;
 
 /// Wall time a replan may take by default (s): the built-in scenarios' pieces through
 /// their narrow places are found within it on 2 cores (docs/online.md).
 pub const DEFAULT_DEADLINE_S: f64 = 0.3;
+
+/// Period of the route's replans by default (s); [`OnlineSettings::route_period_s`]
+/// says what it trades.
+pub const DEFAULT_ROUTE_PERIOD_S: f64 = 1.0;
+
+/// Longest deadline (s): a replan longer than this leaves the chain waiting at rest
+/// for a minute; the settings' contract, not tuning.
+const MAX_DEADLINE_S: f64 = 60.0;
+
+/// Longest route period (s): an hour, beyond any flight the simulator records.
+const MAX_ROUTE_PERIOD_S: f64 = 3600.0;
 
 /// How the online planner plans.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -26,7 +38,7 @@ pub struct OnlineSettings {
     /// Period of the route's replans when nothing cuts it (s): how soon a shortcut
     /// that sensing opened is taken; also how long a chain at rest that finds no piece
     /// waits for something new before it is stuck ([`super::OnlinePlanner::stuck`]).
-    /// Default 1 s.
+    /// Default [`DEFAULT_ROUTE_PERIOD_S`].
     pub route_period_s: f64,
     /// What the start is taken to prove free (docs/online.md, "The start"). Default
     /// [`StartFree::Hull`].
@@ -71,9 +83,68 @@ impl Default for OnlineSettings {
             plan: PlanOptions::default(),
             trajectory: crate::trajectory::Settings::default(),
             deadline_s: DEFAULT_DEADLINE_S,
-            route_period_s: 1.0,
+            route_period_s: DEFAULT_ROUTE_PERIOD_S,
             start_free: StartFree::default(),
         }
+    }
+}
+
+impl OnlineSettings {
+    /// The online settings a settings file gives (docs/model.md, "Settings files"):
+    /// its planner, post-processing and trajectory sections for every piece, its
+    /// `online` section for the rest; the planner's clearance stays `clearance`, a flag
+    /// of its own.
+    pub fn from_file(file: &SettingsFile, clearance: f64) -> Self {
+        let d = Self::default();
+        Self {
+            plan: PlanOptions {
+                planner: file.planner.clone(),
+                refine: file.refine.clone(),
+                clearance,
+                ..d.plan
+            },
+            trajectory: file.trajectory,
+            deadline_s: file.online.deadline_s,
+            route_period_s: file.online.route_period_s,
+            start_free: file.online.start_free,
+        }
+    }
+}
+
+/// A settings file's `online` section: the online planner's settings that are not
+/// how a piece is planned or timed (those are the file's other sections). Fields as
+/// [`OnlineSettings`]'s, with the same defaults.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OnlineSection {
+    /// [`OnlineSettings::deadline_s`].
+    pub deadline_s: f64,
+    /// [`OnlineSettings::route_period_s`].
+    pub route_period_s: f64,
+    /// [`OnlineSettings::start_free`].
+    pub start_free: StartFree,
+}
+
+impl Default for OnlineSection {
+    fn default() -> Self {
+        let d = OnlineSettings::default();
+        Self {
+            deadline_s: d.deadline_s,
+            route_period_s: d.route_period_s,
+            start_free: d.start_free,
+        }
+    }
+}
+
+impl OnlineSection {
+    /// Checks every field; the error names it as a file does (`online.deadline_s`).
+    pub fn validate(&self) -> Result<(), SettingError> {
+        check_times(self.deadline_s, self.route_period_s).map_err(|e| match e {
+            OnlineError::Setting { field, value, rule } => {
+                SettingError::new(&format!("online.{field}"), value, rule)
+            }
+            e => SettingError::new("online", e, "valid"),
+        })
     }
 }
 
@@ -104,8 +175,8 @@ pub enum OnlineError {
     },
 }
 
-/// Refuses settings outside their ranges.
-pub(super) fn check_settings(s: &OnlineSettings) -> Result<(), OnlineError> {
+/// Refuses a deadline or a route period outside its range.
+fn check_times(deadline_s: f64, route_period_s: f64) -> Result<(), OnlineError> {
     let positive = |field, value: f64, limit: f64, rule| {
         if value.is_finite() && value > 0.0 && value <= limit {
             Ok(())
@@ -115,16 +186,21 @@ pub(super) fn check_settings(s: &OnlineSettings) -> Result<(), OnlineError> {
     };
     positive(
         "deadline_s",
-        s.deadline_s,
-        60.0,
+        deadline_s,
+        MAX_DEADLINE_S,
         "a positive number of seconds, at most 60",
     )?;
     positive(
         "route_period_s",
-        s.route_period_s,
-        3600.0,
+        route_period_s,
+        MAX_ROUTE_PERIOD_S,
         "a positive number of seconds, at most 3600",
-    )?;
+    )
+}
+
+/// Refuses settings outside their ranges.
+pub(super) fn check_settings(s: &OnlineSettings) -> Result<(), OnlineError> {
+    check_times(s.deadline_s, s.route_period_s)?;
     s.plan.termination().map_err(OnlineError::Planning)?;
     s.trajectory
         .validate()

@@ -1,9 +1,10 @@
 //! Settings files (docs/model.md, "Settings files"): the tuning of a plan in one JSON
-//! object with a section per settings type, read by `arc plan --settings`.
+//! object with a section per settings type, read by `arc plan --settings` and `arc
+//! explore --settings` (which also reads the `online` section).
 //!
 //! ```json
 //! {"planner": {"vertices": 3000}, "refine": {"widen": {"budget": 300}},
-//!  "trajectory": {"dt": 0.01}}
+//!  "trajectory": {"dt": 0.01}, "online": {"route_period_s": 0.5}}
 //! ```
 //!
 //! Every section and every field may be left out and then takes its default; a key
@@ -27,6 +28,9 @@ pub struct SettingsFile {
     /// How a plan is timed into a trajectory (`crate::trajectory::Settings`), when one
     /// is made.
     pub trajectory: crate::trajectory::Settings,
+    /// The online planner's own settings (`arc explore`; `arc plan` checks them and
+    /// does not use them).
+    pub online: crate::online::OnlineSection,
 }
 
 /// Why a settings file cannot be used: each names the file.
@@ -90,7 +94,7 @@ impl SettingsFile {
     }
 
     /// Checks every tuning setting of the sections: the planner's without a flag,
-    /// post-processing's, the trajectory's. (The planner's flag-backed fields are
+    /// post-processing's, the trajectory's, the online planner's. (The planner's flag-backed fields are
     /// checked where `arc plan` reads them, together with its flags.)
     pub fn validate(&self) -> Result<(), SettingError> {
         self.planner.validate_tuning()?;
@@ -116,7 +120,7 @@ impl SettingsFile {
             E::Dt(v) => SettingError::new("trajectory.dt", v, "in (0, 0.1] s"),
             e => SettingError::new("trajectory", e, "valid"),
         })?;
-        Ok(())
+        self.online.validate()
     }
 }
 
@@ -158,7 +162,8 @@ mod tests {
         assert_eq!(SettingsFile::parse("{}", "e.json").unwrap(), d);
         let some = SettingsFile::parse(
             r#"{"planner": {"vertices": 700, "lattice": {"heuristic_weight": 3.0}},
-                "refine": {"widen": {"budget": 10}}, "trajectory": {"dt": 0.01}}"#,
+                "refine": {"widen": {"budget": 10}}, "trajectory": {"dt": 0.01},
+                "online": {"start_free": "bodies"}}"#,
             "s.json",
         )
         .unwrap();
@@ -168,6 +173,8 @@ mod tests {
         assert_eq!(some.refine.widen.budget, 10);
         assert_eq!(some.refine.widen.centred, d.refine.widen.centred);
         assert_eq!(some.trajectory.dt, 0.01);
+        assert_eq!(some.online.start_free, crate::online::StartFree::Bodies);
+        assert_eq!(some.online.deadline_s, d.online.deadline_s);
         let back = serde_json::to_string(&some).unwrap();
         assert_eq!(SettingsFile::parse(&back, "s.json").unwrap(), some);
     }
@@ -236,6 +243,12 @@ mod tests {
                 "0.5",
             ),
             (r#"{"trajectory": {"max_run": 0}}"#, "max_run", "0"),
+            (r#"{"online": {"deadline_s": 0}}"#, "online.deadline_s", "0"),
+            (
+                r#"{"online": {"route_period_s": 1e9}}"#,
+                "online.route_period_s",
+                "1000000000",
+            ),
             (
                 r#"{"refine": {"thread": {"grid_steps": 5000}}}"#,
                 "grid_steps",

@@ -8,12 +8,12 @@ use clap::Args;
 
 use super::checks;
 use super::common::{ProblemArgs, Report};
-use super::plan::load_tables;
+use super::plan::{check_planner, load_tables, read_settings, Given, Loaded};
 use super::{CliError, CliResult};
 use aerial_chain::flying::FlyOptions;
 use aerial_chain::map::{Grid, OcTree};
 use aerial_chain::online::{
-    explore, Exploration, ExploreEnd, ExploreError, ExploreSettings, StartFree,
+    explore, Exploration, ExploreEnd, ExploreError, ExploreSettings, OnlineSettings, StartFree,
 };
 use aerial_chain::plan_file::MapSection;
 use aerial_chain::sensing::{DepthSensor, Survey};
@@ -75,6 +75,12 @@ pub struct ExploreArgs {
     /// Keep one recorded step in this many in the flight file.
     #[arg(long, default_value_t = 10)]
     record_every: usize,
+    /// Tuning from a settings file (JSON; docs/settings.md lists every setting): its
+    /// planner, refine and trajectory sections plan and time every piece, its online
+    /// section sets deadline_s, route_period_s and start_free. A flag given on the
+    /// command line wins over the file; a flag left at its default does not.
+    #[arg(long)]
+    settings: Option<PathBuf>,
 }
 
 /// Checks every option before any work.
@@ -169,24 +175,56 @@ fn known(path: &Path, world: &Grid) -> Result<Grid, CliError> {
     Ok(grid)
 }
 
+/// The online planner's settings: a flag given on the command line (`given`), else
+/// the settings file where it sets the value, else the default.
+fn online(
+    a: &ExploreArgs,
+    file: Option<&Loaded>,
+    given: &Given,
+) -> Result<OnlineSettings, CliError> {
+    let mut s = OnlineSettings::from_file(
+        &file.map(|f| f.file.clone()).unwrap_or_default(),
+        a.clearance,
+    );
+    let flag = |id: &str, key: &str| {
+        given.contains(id) || !file.is_some_and(|f| f.sets(&format!("online.{key}")))
+    };
+    if flag("deadline", "deadline_s") {
+        s.deadline_s = a.deadline;
+    }
+    if flag("start_free", "start_free") {
+        s.start_free = a.start_free;
+    }
+    if let Some(f) = file {
+        check_planner(&s.plan.planner, &|_, field| {
+            format!("{}: planner.{field}", f.name)
+        })?;
+    }
+    Ok(s)
+}
+
 /// Runs `arc explore`: exit 0 when the chain reached the goal, 1 when it could not.
-pub fn run(a: ExploreArgs) -> CliResult {
+pub fn run(a: ExploreArgs, given: &Given) -> CliResult {
     check(&a)?;
+    let file = read_settings(a.settings.as_ref())?;
+    let online = online(&a, file.as_ref(), given)?;
     let survey = survey(&a)?;
     let (loaded, params, query) = a.problem.load()?;
     let truth = loaded.grid;
     let prior = a.known.as_ref().map(|p| known(p, &truth)).transpose()?;
-    let plan_defaults = aerial_chain::planning::PlanOptions::default();
-    let tables = load_tables(None, params, plan_defaults.srs, plan_defaults.srs_seed)?;
-    let mut settings = ExploreSettings {
+    let tables = load_tables(None, params, online.plan.srs, online.plan.srs_seed)?;
+    // The file's trajectory section times the pieces and the flight alike.
+    let fly = FlyOptions {
+        timing: online.trajectory,
+        ..FlyOptions::default()
+    };
+    let settings = ExploreSettings {
         survey,
-        fly: FlyOptions::default(),
+        online,
+        fly,
         time_limit_s: a.time_limit,
         ..ExploreSettings::default()
     };
-    settings.online.deadline_s = a.deadline;
-    settings.online.plan.clearance = a.clearance;
-    settings.online.start_free = a.start_free;
     let start = aerial_chain::plan_file::Waypoint::new(query.start.into(), &query.start_shape).zeta;
     let run = explore(
         &truth,
@@ -276,7 +314,7 @@ fn say(report: &Report, a: &ExploreArgs, run: &Exploration) {
     ));
     let s = run.record().summary;
     report.line(format_args!(
-        "  {} replans ({} pieces committed), latency median {:.1} ms, p95 {:.1} ms, max {:.1} ms",
+        "  {} replans, pieces committed: {}, latency median {:.1} ms, p95 {:.1} ms, max {:.1} ms",
         s.replans,
         run.pieces,
         s.latency_median_s * 1e3,

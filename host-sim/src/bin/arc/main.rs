@@ -192,13 +192,13 @@ where
         Command::Sim(a) => sim::run(a),
         Command::View(a) => view::run(a),
         Command::Export(a) => export::run(*a),
-        Command::Explore(a) => explore::run(*a),
+        Command::Explore(a) => explore::run(*a, &given(&matches, "explore")),
     }
 }
 
 /// The ids of the arguments of subcommand `name` given on the command line, not left
 /// at their defaults: where a settings file and a flag both set a value, the flag
-/// wins (`arc plan --settings`).
+/// wins (`arc plan --settings`, `arc explore --settings`).
 fn given(m: &clap::ArgMatches, name: &str) -> plan::Given {
     let Some(sub) = m.subcommand_matches(name) else {
         return plan::Given::new();

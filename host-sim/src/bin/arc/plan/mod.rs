@@ -160,7 +160,10 @@ fn check(a: &PlanArgs) -> Result<(), CliError> {
 
 /// Checks the planner's settings that have a flag, each named `name(flag, field)`: the
 /// flag where it gave the value, else the settings file's field.
-fn check_planner(s: &Settings, name: &dyn Fn(&str, &str) -> String) -> Result<(), CliError> {
+pub(super) fn check_planner(
+    s: &Settings,
+    name: &dyn Fn(&str, &str) -> String,
+) -> Result<(), CliError> {
     let n = |flag: &str, field: &str| name(flag, field);
     let growth = n("--max-growth", "max_growth");
     checks::count(&growth, s.max_growth, 0, 8, "256 times the vertices")?;
@@ -225,23 +228,23 @@ fn check_planner(s: &Settings, name: &dyn Fn(&str, &str) -> String) -> Result<()
 
 /// A settings file as read: its settings, its name, and the keys it sets (dotted
 /// paths, such as `planner.vertices`).
-struct Loaded {
-    file: SettingsFile,
-    name: String,
+pub(super) struct Loaded {
+    pub(super) file: SettingsFile,
+    pub(super) name: String,
     keys: BTreeSet<String>,
 }
 
 impl Loaded {
     /// Whether the file sets `key`.
-    fn sets(&self, key: &str) -> bool {
+    pub(super) fn sets(&self, key: &str) -> bool {
         self.keys.contains(key)
     }
 }
 
 /// The settings file of `--settings`, read and checked (its tuning settings; those
 /// with a flag are checked with the flags, [`check_planner`]).
-fn read_settings(a: &PlanArgs) -> Result<Option<Loaded>, CliError> {
-    let Some(path) = &a.settings else {
+pub(super) fn read_settings(path: Option<&PathBuf>) -> Result<Option<Loaded>, CliError> {
+    let Some(path) = path else {
         return Ok(None);
     };
     let name = crate::fsutil::input_name(path);
@@ -420,7 +423,7 @@ fn timing(
 /// Runs `arc plan`.
 pub fn run(a: PlanArgs, given: &Given) -> CliResult {
     check(&a)?;
-    let file = read_settings(&a)?;
+    let file = read_settings(a.settings.as_ref())?;
     let options = options(&a, file.as_ref(), given)?;
     let timing = timing(&a, file.as_ref(), given)?;
     if let Some(path) = &a.mission {
