@@ -455,21 +455,12 @@ impl Loop<'_> {
         }
     }
 
-    /// The replan due at `t`, if any.
+    /// The replan due at `t`, if any: none while a committed piece waits for its
+    /// replan's wall time.
     fn due(&self, t: f64, period: f64) -> Option<Trigger> {
-        if self.pending.is_some() || self.planner.reached() {
-            return None;
-        }
-        let remaining = self.planner.committed().duration() - t;
-        let lead = self.planner.commit_lead();
-        if remaining < lead + self.planner.settings().deadline_s + period {
-            Some(Trigger::CommitShort)
-        } else if self.planner.route_cut() {
-            Some(Trigger::RouteCut)
-        } else if t - self.planner.route_searched_at() >= self.planner.settings().route_period_s {
-            Some(Trigger::Period)
-        } else {
-            None
+        match self.pending {
+            Some(_) => None,
+            None => self.planner.due(t, period),
         }
     }
 

@@ -183,6 +183,28 @@ impl OnlinePlanner {
             .is_some_and(|r| !r.holds(self.belief.route_field()))
     }
 
+    /// The replan due at simulated time `now` for a client that observes every
+    /// `period` s (its sensor period), if any: the next piece when the committed motion
+    /// ends within its lead ([`Self::commit_lead`]), a deadline and a period
+    /// ([`Trigger::CommitShort`]), else the route when what was seen cut it
+    /// ([`Trigger::RouteCut`]) or its period elapsed ([`Trigger::Period`]). None once
+    /// the committed motion ends at the goal.
+    pub fn due(&self, now: f64, period: f64) -> Option<Trigger> {
+        if self.reached {
+            return None;
+        }
+        let remaining = self.committed.duration() - now;
+        if remaining < self.commit_lead() + self.settings.deadline_s + period {
+            Some(Trigger::CommitShort)
+        } else if self.route_cut() {
+            Some(Trigger::RouteCut)
+        } else if now - self.route_at >= self.settings.route_period_s {
+            Some(Trigger::Period)
+        } else {
+            None
+        }
+    }
+
     /// When the route was last searched (simulated s).
     pub fn route_searched_at(&self) -> f64 {
         self.route_at
@@ -450,9 +472,13 @@ impl OnlinePlanner {
     /// free, or nearer; first a turn to look along the route when it leaves the view.
     fn commit(&mut self, began: Instant) -> (Outcome, f64) {
         let route = self.route.clone().expect("searched");
+        let known = self.known_prefix(&route);
+        let last = route.points.len() - 1;
         // Look before moving: where the route leaves the sensors' middle view, a piece
-        // planned now would be squeezed into what they saw elsewhere.
-        if self.turn_to_look(&route) {
+        // planned now would be squeezed into what they saw elsewhere. A route known to
+        // the goal (a map known before the flight, space seen before) has nothing left
+        // to show.
+        if known < last && self.turn_to_look(&route) {
             return (Outcome::Looked, 0.0);
         }
         // Any motion along the chain passes through its hull: where part of it is
@@ -462,8 +488,6 @@ impl OnlinePlanner {
         if !self.looked_at_hull && self.look_at_hull() {
             return (Outcome::Looked, 0.0);
         }
-        let known = self.known_prefix(&route);
-        let last = route.points.len() - 1;
         let mut candidates: Vec<usize> = [1.0, 2.0 / 3.0, 1.0 / 3.0]
             .iter()
             .map(|f| ((known as f64) * f).round() as usize)

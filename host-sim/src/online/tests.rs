@@ -146,6 +146,42 @@ fn a_due_piece_is_tried_even_when_a_route_search_took_in_what_was_seen() {
     );
 }
 
+/// With the world known before the flight, the route is known to the goal: the chain,
+/// which starts looking away from the window, commits its way there at once, with no
+/// turn to look, and no replan is due until that motion ends.
+#[test]
+fn a_route_known_to_the_goal_is_flown_without_turning_to_look() {
+    let (sc, params, tables, start) = window(4);
+    let new = |prior| {
+        OnlinePlanner::new(
+            params,
+            tables.clone(),
+            &start,
+            sc.goal,
+            0.3,
+            &sc.grid,
+            prior,
+            OnlineSettings::default(),
+            &crate::sensing::DepthSensor::default(),
+        )
+        .unwrap()
+    };
+    let mut known = new(Some(&sc.grid));
+    let first = known.replan(0.0, Trigger::Start);
+    assert_eq!(first.outcome, Outcome::Committed);
+    assert!(known.reached());
+    assert!(known.pieces().iter().all(|p| !p.is_look()));
+    let end = known.committed().duration();
+    assert_eq!(known.due(end, 0.1), None);
+    // From an empty map the same start turns to look first, and the next piece falls
+    // due as that turn ends.
+    let mut empty = new(None);
+    assert_eq!(empty.replan(0.0, Trigger::Start).outcome, Outcome::Looked);
+    assert_eq!(empty.due(0.0, 0.1), None);
+    let end = empty.committed().duration();
+    assert_eq!(empty.due(end, 0.1), Some(Trigger::CommitShort));
+}
+
 /// Two lanes 12 m long side by side behind a hall, split by a wall: lane A (y < 3)
 /// ends in a wall at x = 10 that the sensors first see from 5 m; lane B (y > 3) is
 /// open to the goal at its far end.
