@@ -12,6 +12,7 @@ the Rust library ``aerial_chain`` (the ``arc`` command line uses the same code):
     plan.unit_positions()                            # (waypoints, N, 3) numpy array
     flight = ac.simulate(world, plan)                # flight.unit_positions: (T, N, 3)
     run = ac.explore(world, units=4)                 # into the unknown, as `arc explore`
+    planner = ac.OnlinePlanner(world, units=4)       # the same, one replan at a time
     ac.export(world, plan, "window.mcap")            # a ROS 2 bag; .tlog: MAVLink
 
 Bad input raises ``MapError``, ``PlanError``, ``VerifyError``, ``SimError``,
@@ -30,6 +31,7 @@ from ._native import (
     Flight,
     Map,
     MapError,
+    OnlinePlanner,
     Plan,
     PlanError,
     SimError,

@@ -21,6 +21,7 @@ __all__ = [
     "Flight",
     "Map",
     "MapError",
+    "OnlinePlanner",
     "Plan",
     "PlanError",
     "SCENARIOS",
@@ -199,8 +200,9 @@ class Exploration:
         """True when the chain reached the goal and settled there."""
     @property
     def end(self) -> dict[str, Any]:
-        """How the run ended: ``kind`` (``reached``, ``sealed``, ``time_limit``,
-        ``flight_failed``), the simulated time ``t`` and, but for ``reached``, why."""
+        """How the run ended: ``kind`` (``reached``, ``sealed``, ``stuck``,
+        ``time_limit``, ``flight_failed``), the simulated time ``t`` and, but for
+        ``reached``, why."""
     @property
     def flight(self) -> Flight:
         """The flight: the chain's states and its report against the true map."""
@@ -221,6 +223,80 @@ class Exploration:
     def write(self, path: _Path) -> None:
         """Writes the flight with the record of every replan (``arc-sim/1``, as ``arc
         explore --out``)."""
+
+@final
+class OnlinePlanner:
+    """The online planner one replan at a time, for a robot's own loop (docs/online.md):
+    feed it clouds and flown unit centres, ask which replan is ``due``, ``replan``, and
+    fly ``committed``. Times are the caller's clock (s); points are in the map's frame."""
+
+    def __new__(
+        cls,
+        map: Map,
+        units: Optional[int] = None,
+        start: Optional[_Point] = None,
+        goal: Optional[_Point] = None,
+        start_yaw: Optional[float] = None,
+        start_shape: Optional[Sequence[float]] = None,
+        goal_tol: float = 0.3,
+        deadline: float = ...,
+        clearance: float = ...,
+        start_free: str = "hull",
+        sensor: Optional[dict[str, Any]] = None,
+        known: Optional[Map] = None,
+    ) -> OnlinePlanner:
+        """A planner in the box of ``map`` (its contents are not read): nothing is known
+        but ``known`` and the start's own space. Raises ``PlanError`` for a bad chain
+        or query, ``ExploreError`` for bad settings."""
+    def observe(
+        self, origin: _Point, points: Union[Sequence[_Point], NDArray[np.float64]], max_range: float
+    ) -> int:
+        """Fuses one sensor's cloud (an (M, 3) array of returns, a miss as a point
+        beyond ``max_range``) as OctoMap's ``insertPointCloud``; the voxels changed."""
+    def observe_flown(self, centres: Union[Sequence[_Point], NDArray[np.float64]]) -> int:
+        """Marks the balls of ``r_u`` plus the clearance about the unit centres seen
+        free; the voxels changed."""
+    def due(self, now: float, period: float = ...) -> Optional[str]:
+        """The replan due at ``now`` (``commit_short``, ``route_cut``, ``period``) for a
+        caller observing every ``period`` s, or ``None``."""
+    def replan(self, now: float, trigger: str) -> dict[str, Any]:
+        """Replans for ``trigger`` (``start``, ``route_cut``, ``period``,
+        ``commit_short``) and returns its record (docs/model.md, "Explorations")."""
+    def committed(
+        self, dt: float = 0.02
+    ) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The committed motion sampled every ``dt`` s: times (K,) and configurations
+        (K, 2N + 2)."""
+    def follow_at_ticks(self, period: float) -> None:
+        """Makes a changed committed motion take effect on the follower's ticks of
+        ``period`` s (0: at once)."""
+    @property
+    def effective_from(self) -> float:
+        """When the committed motion as it is now may be flown (s)."""
+    @property
+    def committed_until(self) -> float:
+        """When the committed motion ends, at rest (s)."""
+    @property
+    def reached(self) -> bool:
+        """True once the committed motion ends at the goal."""
+    def stuck(self, now: float) -> Optional[str]:
+        """Why the chain can get no further at ``now``, or ``None``."""
+    @property
+    def route(self) -> Optional[NDArray[np.float64]]:
+        """The route to the goal as last searched (unknown space free), (P, 3)."""
+    @property
+    def pieces(self) -> int:
+        """Pieces committed so far (turns to look included)."""
+    @property
+    def replans(self) -> list[dict[str, Any]]:
+        """Every replan so far, as ``replan`` returned them."""
+    @property
+    def voxels_seen(self) -> int:
+        """Voxels of the seen map known (free or occupied)."""
+    def plan(self) -> Plan:
+        """The committed pieces joined into one plan (``arc explore --plan-out``)."""
+    def write_seen(self, path: _Path) -> None:
+        """Writes the seen map (``.bt``)."""
 
 def explore(
     map: Map,

@@ -237,7 +237,7 @@ pub fn explore(
 
 /// The settings of `explore()`'s planner and sensors, checked with the words of `arc
 /// explore`.
-fn settings(
+pub(crate) fn settings(
     py: Python<'_>,
     (deadline, clearance, start_free): (f64, f64, &str),
     sensor: Option<Bound<'_, PyAny>>,

@@ -11,6 +11,7 @@
 //!   sim` flies it (`aerial_chain::flying::fly`);
 //! - `explore::explore` and `explore::Exploration`, the chain flown into the unknown
 //!   as `arc explore` flies it (`aerial_chain::online::explore`);
+//! - `online::OnlinePlanner`, its planner one replan at a time, for a robot's own loop;
 //! - `export::export`, a plan or flight as a ROS 2 bag or MAVLink setpoints.
 //!
 //! Configurations and flights come out as NumPy arrays. Bad input raises one of the
@@ -25,6 +26,7 @@ use pyo3::prelude::*;
 mod explore;
 mod export;
 mod map;
+mod online;
 mod plan;
 mod sim;
 
@@ -109,6 +111,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<plan::VerifyReport>()?;
     m.add_class::<sim::Flight>()?;
     m.add_class::<explore::Exploration>()?;
+    m.add_class::<online::OnlinePlanner>()?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(plan::verify, m)?)?;
     m.add_function(wrap_pyfunction!(sim::simulate, m)?)?;
