@@ -92,6 +92,17 @@ class Map:
     @property
     def goal(self) -> Optional[NDArray[np.float64]]:
         """The scenario's head goal (array of 3, m); ``None`` for a map file."""
+    def scan(
+        self,
+        position: _Point,
+        yaw: float = 0.0,
+        attitude: Optional[Sequence[float]] = None,
+        sensor: Optional[dict[str, Any]] = None,
+        unit: int = 0,
+    ) -> Tuple[NDArray[np.float64], NDArray[np.float64], float]:
+        """What one unit's depth sensor measures in this map, as ``arc explore``'s
+        simulated sensors cast it: ``(origin, points, max_range)``, the arguments of
+        ``OnlinePlanner.observe``."""
     @property
     def start_yaw(self) -> Optional[float]:
         """The scenario's start yaw (rad); ``None`` for a map file."""
@@ -267,6 +278,8 @@ class OnlinePlanner:
     ) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The committed motion sampled every ``dt`` s: times (K,) and configurations
         (K, 2N + 2)."""
+    def at(self, t: float) -> NDArray[np.float64]:
+        """The committed configuration zeta at time ``t`` (the end after it ends)."""
     def follow_at_ticks(self, period: float) -> None:
         """Makes a changed committed motion take effect on the follower's ticks of
         ``period`` s (0: at once)."""

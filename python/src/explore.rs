@@ -131,7 +131,10 @@ impl Exploration {
 /// The sensor from `sensor`, a dict of the fields of docs/maps.md "Sensing"
 /// (`fov_h_deg`, `fov_v_deg`, `min_range`, `max_range`, `resolution_deg`, `mount`,
 /// `splay_deg`; left out: the default), as `arc explore --sensor` reads its file.
-fn sensor_from(py: Python<'_>, sensor: Option<Bound<'_, PyAny>>) -> PyResult<DepthSensor> {
+pub(crate) fn sensor_from(
+    py: Python<'_>,
+    sensor: Option<Bound<'_, PyAny>>,
+) -> PyResult<DepthSensor> {
     let Some(sensor) = sensor else {
         return Ok(DepthSensor::default());
     };

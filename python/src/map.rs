@@ -10,8 +10,9 @@ use pyo3::prelude::*;
 use aerial_chain::map::{Grid, OcTree};
 use aerial_chain::plan_file::MapSource;
 use aerial_chain::problem::scenarios::{self, Scenario};
+use aerial_chain::sensing::{raycast, PointCloud, UnitPose};
 
-use crate::{err, MapError};
+use crate::{err, ExploreError, MapError};
 
 /// A map to plan, verify and fly on: an occupancy grid (OctoMap `.bt` file or built-in
 /// scenario) and whether unknown space counts as occupied.
@@ -150,6 +151,54 @@ impl Map {
         Array2::from_shape_vec((rows, 3), centres)
             .expect("three numbers per voxel")
             .into_pyarray(py)
+    }
+
+    /// What one unit's depth sensor measures in this map (the truth, exactly, as `arc
+    /// explore`'s simulated sensors cast it): the unit at `position` (m), level with
+    /// head yaw `yaw` (rad), or at `attitude` (a unit quaternion `[w, x, y, z]`, tilt
+    /// included) when given; `sensor` a dict of docs/maps.md "Sensing" fields (left
+    /// out: the default camera), turned by its splay for unit index `unit` (0: the
+    /// head). Returns `(origin, points, max_range)`: the sensor's origin, its cloud as
+    /// an (M, 3) array (a return moved into the voxel it hit, a ray without a return as
+    /// a point at twice the range, a too-close ray nothing) and its range, the
+    /// arguments of `OnlinePlanner.observe`. Raises `ExploreError` for bad settings.
+    #[pyo3(signature = (position, yaw = 0.0, attitude = None, sensor = None, unit = 0))]
+    #[allow(clippy::type_complexity)] // Two NumPy arrays and a number.
+    fn scan<'py>(
+        &self,
+        py: Python<'py>,
+        position: [f64; 3],
+        yaw: f64,
+        attitude: Option<[f64; 4]>,
+        sensor: Option<Bound<'py, PyAny>>,
+        unit: usize,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, f64)> {
+        let sensor = crate::explore::sensor_from(py, sensor)?;
+        sensor
+            .validate()
+            .map_err(|e| err::<ExploreError>(format!("sensor: {e}")))?;
+        if !yaw.is_finite() {
+            return Err(err::<ExploreError>(format!("yaw = {yaw}: a finite angle (rad)")));
+        }
+        let pose = match attitude {
+            Some(q) => UnitPose::new(position, q),
+            None => UnitPose::new(position, [1.0, 0.0, 0.0, 0.0])
+                .map(|p| UnitPose::level(p.position, yaw)),
+        }
+        .map_err(err::<ExploreError>)?;
+        let sensor = sensor.for_unit(unit);
+        let cloud = py.detach(|| {
+            let scan = raycast::scan(&self.grid, &sensor, &pose);
+            PointCloud::from_scan(&scan, self.grid.resolution())
+        });
+        let mut points = Array2::<f64>::zeros((cloud.points.len(), 3));
+        for (k, p) in cloud.points.iter().enumerate() {
+            for j in 0..3 {
+                points[[k, j]] = f64::from(p[j]);
+            }
+        }
+        let origin = cloud.origin.map(f64::from).to_vec().into_pyarray(py);
+        Ok((origin, points.into_pyarray(py), sensor.max_range))
     }
 
     fn __repr__(&self) -> String {

@@ -271,6 +271,13 @@ impl OnlinePlanner {
         Ok((Array1::from(times).into_pyarray(py), zetas.into_pyarray(py)))
     }
 
+    /// The committed configuration zeta at time `t` (an array of 2N + 2): where the
+    /// chain is to be then; the end of the committed motion after it ends.
+    fn at<'py>(&self, py: Python<'py>, t: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let t = time("t", t)?;
+        Ok(self.inner.committed().zeta(t).into_pyarray(py))
+    }
+
     /// Makes a changed committed motion take effect on the follower's ticks of
     /// `period` s (the multiples of it from 0; 0: at once), so that a piece is joined
     /// in flight only where the follower has not yet flown past the join.

@@ -82,3 +82,39 @@ def test_bad_settings_are_refused_naming_them(window):
         ac.OnlinePlanner(window, units=3, deadline=0.0)
     with pytest.raises(ac.PlanError, match="units"):
         ac.OnlinePlanner(ac.Map.scenario("window"), units=1)
+
+
+def test_a_loop_of_ones_own_flies_the_window_from_nothing(window):
+    """examples/explore_loop.py: a perfect follower, sensors scanned from the truth with
+    `Map.scan`, the planner fed clouds only; the chain comes to rest at the goal, and
+    what was committed is valid on the world."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parents[1] / "examples" / "explore_loop.py"
+    spec = importlib.util.spec_from_file_location("explore_loop", path)
+    loop = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(loop)
+    planner, at = loop.fly(window, 4, time_limit=120.0)
+    assert at is not None, planner
+    assert planner.reached and planner.pieces >= 2
+    assert ac.verify(window, planner.plan()).ok
+    np.testing.assert_allclose(planner.at(at)[:3], planner.plan().heads[-1], atol=1e-5)
+    assert np.linalg.norm(planner.at(at)[:3] - window.goal) <= 0.3
+
+
+def test_a_scan_sees_the_wall_ahead_and_misses_beyond_the_range(window):
+    head = window.start
+    origin, points, max_range = window.scan(head, yaw=0.0)
+    np.testing.assert_allclose(origin, head)
+    assert max_range == 5.0 and points.shape == (59 * 39, 3)
+    reach = np.linalg.norm(points - origin, axis=1)
+    hits = reach < max_range
+    # Looking along +x from x = 2 the dividing wall stands at x = 4, 2 m ahead.
+    assert hits.any() and (reach[~hits] == pytest.approx(2 * max_range, rel=1e-6))
+    ahead = points[hits & (np.abs(points[:, 1] - head[1]) < 0.05) & (np.abs(points[:, 2] - head[2]) < 0.05)]
+    assert len(ahead) and np.all(np.abs(ahead[:, 0] - 4.0) < 0.01)
+    with pytest.raises(ac.ExploreError, match="fov_h_deg"):
+        window.scan(head, sensor={"fov_h_deg": 500})
+    with pytest.raises(ac.ExploreError, match="attitude"):
+        window.scan(head, attitude=[2.0, 0.0, 0.0, 0.0])
