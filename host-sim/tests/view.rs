@@ -232,3 +232,55 @@ fn a_100_m_corridor_page_stays_small() {
     let bytes = std::fs::metadata(d.join("corridor.html")).unwrap().len();
     assert!(bytes <= 5_000_000, "the page weighs {bytes} bytes");
 }
+
+/// The `seen` count the page's info line gives at `fragment`: "K of N boxes seen
+/// occupied".
+fn seen_count(dir: &Path, page: &Path, fragment: &str) -> (usize, usize) {
+    let (dom, _) = browse(dir, page, fragment, "--dump-dom");
+    let tail = dom
+        .split(" boxes seen occupied")
+        .next()
+        .filter(|_| dom.contains(" boxes seen occupied"))
+        .unwrap_or_else(|| panic!("no seen count at #{fragment}"));
+    let words: Vec<&str> = tail.rsplit("; ").next().unwrap().split(' ').collect();
+    match words[..] {
+        [k, "of", n] => (k.parse().unwrap(), n.parse().unwrap()),
+        _ => panic!("seen count {words:?} at #{fragment}"),
+    }
+}
+
+/// An exploration's flight carries the map as it grew: the page draws the boxes its
+/// sensors saw, more of them as time goes on, all of them at the end; a record made
+/// on another map's lattice is refused.
+#[test]
+fn an_explorations_page_grows_the_map_its_sensors_drew() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = "explore --scenario window --units 4 --out f.json --plan-out p.json";
+    expect(&words(run), d, 0);
+    let view = words("view --scenario window --plan p.json --flight f.json --out e.html");
+    let out = expect(&view, d, 0);
+    assert!(out.stdout.contains("its sensors saw as it grew"), "{out:?}");
+    let page = d.join("e.html");
+    assert_runs(d, &page);
+    let (early, n) = seen_count(d, &page, "t=0.05");
+    let (middle, _) = seen_count(d, &page, "t=6");
+    let (end, _) = seen_count(d, &page, "t=100000");
+    assert!(n > 500, "{n} boxes seen");
+    assert!(
+        early < middle && middle < end && end == n,
+        "{early} {middle} {end} of {n}"
+    );
+
+    let mut flight: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("f.json")).unwrap()).unwrap();
+    flight["explore"]["seen_occupied"]["resolution"] = 0.05.into();
+    std::fs::write(d.join("other.json"), flight.to_string()).unwrap();
+    let view = words("view --scenario window --plan p.json --flight other.json --out o.html");
+    let o = expect(&view, d, 2);
+    assert!(
+        o.stderr.contains("other.json") && o.stderr.contains("resolution"),
+        "{o:?}"
+    );
+    assert!(!d.join("o.html").exists());
+}

@@ -227,6 +227,10 @@ class Exploration:
     def summary(self) -> dict[str, Any]:
         """Replans, pieces, replan latency, field updates, voxels seen."""
     @property
+    def seen_growth(self) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The map as it grew: the centres (K, 3) of the seen map's occupied voxels in
+        the order they were seen, and when each was first seen occupied (K,)."""
+    @property
     def voxels_seen(self) -> int:
         """Voxels of the seen map known (free or occupied) at the end."""
     def write_seen(self, path: _Path) -> None:

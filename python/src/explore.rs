@@ -7,6 +7,8 @@
 use std::path::PathBuf;
 use std::sync::atomic::AtomicUsize;
 
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 
 use aerial_chain::flying::FlyOptions;
@@ -82,6 +84,26 @@ impl Exploration {
     #[getter]
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         json_to_py(py, &self.record.summary)
+    }
+
+    /// The map as it grew: `(centres, t)`, the centres (m) of the seen map's occupied
+    /// voxels at the end, an `(K, 3)` array in the order they were seen, and the
+    /// simulated time each was first seen occupied, an array of `K` (s).
+    #[getter]
+    #[allow(clippy::type_complexity)] // A pair of NumPy arrays.
+    fn seen_growth<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>) {
+        let grew = self.record.seen_occupied.clone().unwrap_or_default();
+        let r = grew.resolution;
+        let mut centres = Array2::<f64>::zeros((grew.voxels.len(), 3));
+        for (k, v) in grew.voxels.iter().enumerate() {
+            for j in 0..3 {
+                centres[[k, j]] = (f64::from(v[j]) + 0.5) * r;
+            }
+        }
+        (centres.into_pyarray(py), grew.t.into_pyarray(py))
     }
 
     /// Voxels of the seen map that are known (free or occupied) at the end.

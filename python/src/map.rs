@@ -178,7 +178,9 @@ impl Map {
             .validate()
             .map_err(|e| err::<ExploreError>(format!("sensor: {e}")))?;
         if !yaw.is_finite() {
-            return Err(err::<ExploreError>(format!("yaw = {yaw}: a finite angle (rad)")));
+            return Err(err::<ExploreError>(format!(
+                "yaw = {yaw}: a finite angle (rad)"
+            )));
         }
         let pose = match attitude {
             Some(q) => UnitPose::new(position, q),

@@ -62,6 +62,16 @@ def test_the_flight_and_the_seen_map_are_written_as_arc_writes_them(window, run,
     # Every piece was committed in space seen free, so the plan holds on the seen map
     # with unknown space occupied.
     assert ac.verify(seen, run.plan).ok
+    # The map as it grew holds the seen map's occupied voxels, in the order seen, and
+    # the flight file carries it (`arc view` draws it).
+    centres, t = run.seen_growth
+    occupied = seen.occupied_voxels()
+    assert centres.shape == occupied.shape and t.shape == (len(centres),)
+    key = lambda a: {tuple(np.round(p / seen.resolution - 0.5).astype(int)) for p in a}
+    assert key(centres) == key(occupied)
+    assert np.all(np.diff(t) >= 0) and 0 <= t[0] and t[-1] <= run.end["t"]
+    grew = flight["explore"]["seen_occupied"]
+    assert len(grew["voxels"]) == len(grew["t"]) == len(t)
 
 
 def test_a_sensor_that_sees_almost_nothing_gets_the_chain_stuck_near_its_start(window):

@@ -23,12 +23,14 @@ pub struct Belief {
 }
 
 /// What one observation changed.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Fused {
     /// Voxels inside the box whose state changed.
     pub voxels: usize,
     /// Time spent updating both distance fields (s).
     pub update_s: f64,
+    /// The voxels among them that became occupied (lattice indices).
+    pub occupied: Vec<[i32; 3]>,
 }
 
 impl Belief {
@@ -121,6 +123,11 @@ impl Belief {
         Fused {
             voxels: inside.len(),
             update_s,
+            occupied: inside
+                .iter()
+                .filter(|(_, cell)| *cell == Cell::Occupied)
+                .map(|(v, _)| *v)
+                .collect(),
         }
     }
 

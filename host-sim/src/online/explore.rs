@@ -14,6 +14,7 @@
 //! the planner's committed motion, the piece joined in flight or after the motion's
 //! end (the chain rests there meanwhile).
 
+use std::collections::HashMap;
 use std::time::Instant;
 
 use aerial_chain_core::ChainParams;
@@ -26,7 +27,7 @@ use super::record::{Outcome, ReplanRecord, Trigger};
 use super::settings::{OnlineError, OnlineSettings, StartFree};
 use crate::collision::{verify::verify_plan, CollisionContext, FK_TOLERANCE};
 use crate::flying::FlyOptions;
-use crate::map::{DistanceField, Grid};
+use crate::map::{Cell, DistanceField, Grid};
 use crate::plan_file::{MapSection, Plan};
 use crate::sensing::{raycast, OccupancyMap, PointCloud, Survey, SurveyError, UnitPose};
 use crate::sim::{ChainModel, Flight, FlightEnd, FlightRun, MapClearance, SimError};
@@ -153,6 +154,41 @@ pub struct Exploration {
     /// The joints flown without a stop, in order: one for every piece joined onto the
     /// committed motion in flight.
     pub joints: Vec<crate::trajectory::Joint>,
+    /// The seen map's occupied voxels at the end, each with when it was first seen
+    /// occupied: the map as it grew.
+    pub seen_occupied: SeenOccupied,
+}
+
+/// The occupied voxels of a seen map inside the world's box, each with the simulated
+/// time it was first seen occupied (0 for a voxel known before the flight), in the
+/// order they were seen: what `arc view` draws of the map as it grew (docs/model.md,
+/// "Explorations").
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SeenOccupied {
+    /// The voxel edge (m): voxel `[i, j, k]` is the cube from `[i, j, k]` times it.
+    pub resolution: f64,
+    /// Lattice indices, ordered by `t` (ties by index).
+    pub voxels: Vec<[i32; 3]>,
+    /// When each was first seen occupied (s, to the millisecond).
+    pub t: Vec<f64>,
+}
+
+impl SeenOccupied {
+    /// The occupied voxels of `seen` that `first` times (when each was first seen
+    /// occupied: every voxel inside the world's box that ever was).
+    pub fn of(seen: &OccupancyMap, first: &HashMap<[i32; 3], f64>) -> Self {
+        let mut timed: Vec<(f64, [i32; 3])> = seen
+            .voxels()
+            .filter(|(_, cell)| *cell == Cell::Occupied)
+            .filter_map(|(v, _)| first.get(&v).map(|t| ((t * 1e3).round() / 1e3, v)))
+            .collect();
+        timed.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        Self {
+            resolution: seen.resolution(),
+            voxels: timed.iter().map(|(_, v)| *v).collect(),
+            t: timed.iter().map(|(t, _)| *t).collect(),
+        }
+    }
 }
 
 /// The record of an exploration kept in its flight file (docs/model.md,
@@ -173,6 +209,10 @@ pub struct ExploreRecord {
     pub summary: ExploreSummary,
     /// Every replan, in order.
     pub replans: Vec<ReplanRecord>,
+    /// The seen map's occupied voxels with when each was first seen occupied (a
+    /// record written before 2026-11-29 has none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seen_occupied: Option<SeenOccupied>,
 }
 
 /// What a record without `start_free` took as free at the start.
@@ -233,6 +273,7 @@ impl Exploration {
                 update_median_s: quantile(&upd, 0.5),
             },
             replans: self.replans.clone(),
+            seen_occupied: Some(self.seen_occupied.clone()),
         }
     }
 }
@@ -343,7 +384,14 @@ pub fn explore(
         pending: None,
         sensing: SensingStats::default(),
         goal,
+        occupied_at: HashMap::new(),
     };
+    // What a map known before the flight holds was seen before it.
+    let known = lp.planner.belief().seen().voxels();
+    lp.occupied_at = known
+        .filter(|(_, cell)| *cell == Cell::Occupied)
+        .map(|(v, _)| (v, 0.0))
+        .collect();
     let end = lp.fly()?;
     lp.finish(end, start)
 }
@@ -416,6 +464,8 @@ struct Loop<'a> {
     pending: Option<f64>,
     sensing: SensingStats,
     goal: Point3<f64>,
+    /// When each voxel was first seen occupied (simulated s).
+    occupied_at: HashMap<[i32; 3], f64>,
 }
 
 impl Loop<'_> {
@@ -529,6 +579,10 @@ impl Loop<'_> {
             self.sensing.rays += scan.rays.len();
             let cloud = PointCloud::from_scan(&scan, self.truth.resolution());
             let fused = self.planner.observe(&cloud, scan.max_range)?;
+            let t = self.run.time();
+            for v in &fused.occupied {
+                self.occupied_at.entry(*v).or_insert(t);
+            }
             self.sensing.scans += 1;
             if fused.voxels > 0 {
                 self.sensing.update_s.push(fused.update_s);
@@ -587,6 +641,7 @@ impl Loop<'_> {
             .fold(0.0, |sum, p| sum + p.trajectory.duration());
         let mut sensing = self.sensing;
         sensing.known = planner.belief().seen().known();
+        let seen_occupied = SeenOccupied::of(planner.belief().seen(), &self.occupied_at);
         Ok(Exploration {
             flight,
             end,
@@ -600,6 +655,7 @@ impl Loop<'_> {
             rebuild_s,
             start_free: planner.settings().start_free,
             joints: planner.pieces().iter().filter_map(|p| p.joint).collect(),
+            seen_occupied,
         })
     }
 }

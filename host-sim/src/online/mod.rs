@@ -38,7 +38,7 @@ pub mod settings;
 pub use belief::{Belief, Fused};
 pub use explore::{
     explore, quantile, Exploration, ExploreEnd, ExploreError, ExploreRecord, ExploreSettings,
-    ExploreSummary, SensingStats, RECORD_FORMAT,
+    ExploreSummary, SeenOccupied, SensingStats, RECORD_FORMAT,
 };
 pub use planner::{OnlinePlanner, Piece};
 pub use record::{Outcome, ReplanRecord, Trigger};

@@ -60,10 +60,24 @@ fn the_window_from_an_empty_map_commits_only_pieces_valid_on_what_was_seen() {
     assert!(verify_plan(&sc.grid, &ex.plan).ok);
     assert!(!ex.flight.report.contact);
     // The seen map knows less than the world, and never an obstacle where there is none.
+    let mut occupied = 0;
     for (i, state) in ex.seen.voxels() {
         if state == Cell::Occupied {
             assert_eq!(sc.grid.cell(i), Cell::Occupied, "{i:?}");
+            occupied += 1;
         }
+    }
+    // The map as it grew: every occupied voxel of the end, once, in the order seen,
+    // none before the first scan or after the run.
+    let grew = &ex.seen_occupied;
+    assert_eq!((grew.voxels.len(), grew.t.len()), (occupied, occupied));
+    assert!(occupied > 1000, "{occupied}");
+    let end = ex.flight.report.simulated_time + 1e-9;
+    assert!(grew.t.windows(2).all(|w| w[0] <= w[1]));
+    assert!(grew.t.iter().all(|t| (0.0..=end).contains(t)), "{end}");
+    assert!(grew.t[occupied - 1] > 1.0, "the map grew as the chain flew");
+    for v in &grew.voxels {
+        assert_eq!(ex.seen.state(*v), Cell::Occupied, "{v:?}");
     }
     let record = ex.record();
     assert_eq!(record.format, RECORD_FORMAT);
@@ -440,6 +454,7 @@ fn an_exploration_record_without_start_free_took_the_bodies() {
         start_free: StartFree::Hull,
         summary: Default::default(),
         replans: Vec::new(),
+        seen_occupied: None,
     };
     let mut v = serde_json::to_value(&record).unwrap();
     assert_eq!(v["start_free"], "hull");

@@ -11,12 +11,13 @@ use clap::Args;
 use super::checks;
 use super::common::{parse_point, read_plan, MapArgs};
 use super::{CliError, CliResult};
+use aerial_chain::online::SeenOccupied;
 use scene::{FlightFile, Region, Scene};
 
 /// `arc view`
 #[derive(Args, Debug)]
 #[command(
-    after_help = "Examples:\n  arc view --scenario window --plan window.json --out view.html\n  arc sim --scenario window --plan window.json --out flight.json\n  arc view --scenario window --plan window.json --flight flight.json --out view.html"
+    after_help = "Examples:\n  arc view --scenario window --plan window.json --out view.html\n  arc sim --scenario window --plan window.json --out flight.json\n  arc view --scenario window --plan window.json --flight flight.json --out view.html\n  arc explore --scenario maze --out explored.json --plan-out flown.json\n  arc view --scenario maze --plan flown.json --flight explored.json --out view.html"
 )]
 pub struct ViewArgs {
     #[command(flatten)]
@@ -24,7 +25,9 @@ pub struct ViewArgs {
     /// The plan to show (JSON, arc-plan/1); `-` reads it from standard input.
     #[arg(long)]
     plan: PathBuf,
-    /// A flight of the plan to show against it (the JSON of `arc sim --out`).
+    /// A flight of the plan to show against it (the JSON of `arc sim --out`); an
+    /// exploration's (`arc explore --out`) also shows the map its sensors drew, growing
+    /// as the chain flies.
     #[arg(long)]
     flight: Option<PathBuf>,
     /// The HTML page to write.
@@ -68,8 +71,12 @@ fn check(a: &ViewArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Reads a flight file (`-`: standard input).
-fn read_flight(path: &std::path::Path, units: usize) -> Result<scene::Flown, CliError> {
+/// Reads a flight file (`-`: standard input): the flown units, and the map its
+/// sensors drew when it is an exploration's.
+fn read_flight(
+    path: &std::path::Path,
+    units: usize,
+) -> Result<(scene::Flown, Option<SeenOccupied>), CliError> {
     let name = crate::fsutil::input_name(path);
     let text = if crate::fsutil::is_stdio(path) {
         std::io::read_to_string(std::io::stdin())
@@ -89,11 +96,13 @@ pub fn run(a: ViewArgs) -> CliResult {
     check(&a)?;
     let (plan, plan_name, params) = read_plan(&a.plan)?;
     let units = params.n();
-    let flight = a
-        .flight
-        .as_deref()
-        .map(|p| read_flight(p, units))
-        .transpose()?;
+    let (flight, seen) = match a.flight.as_deref() {
+        Some(p) => {
+            let (flown, seen) = read_flight(p, units)?;
+            (Some(flown), seen)
+        }
+        None => (None, None),
+    };
     let loaded = a.map.load()?;
     let waypoints = scene::waypoints(&plan, &loaded.grid)
         .map_err(|e| CliError::input(format!("{plan_name}: {e}")))?;
@@ -113,6 +122,13 @@ pub fn run(a: ViewArgs) -> CliResult {
         Region::Near(&path, a.near)
     };
     let boxes = scene::boxes(&loaded.grid, &region, a.max_boxes);
+    let seen = match (&seen, &a.flight) {
+        (Some(s), Some(p)) => Some(
+            scene::seen_boxes(&loaded.grid, s, &region, a.max_boxes)
+                .map_err(|e| CliError::input(format!("{}: {e}", crate::fsutil::input_name(p))))?,
+        ),
+        _ => None,
+    };
     let title = match &a.flight {
         Some(f) => format!(
             "{plan_name} and flight {} on {}",
@@ -134,6 +150,7 @@ pub fn run(a: ViewArgs) -> CliResult {
             radius: a.goal_tol,
         }),
         flight,
+        seen,
     };
     let html = page::html(&scene);
     crate::fsutil::write_output(&a.out, html.as_bytes())
@@ -144,10 +161,13 @@ pub fn run(a: ViewArgs) -> CliResult {
             plan.waypoints.len(),
             (scene.boxes.occupied.len() + scene.boxes.unknown.len()) / 3,
             scene.boxes.size,
-            if scene.flight.is_some() {
-                ", with the flight"
-            } else {
-                ""
+            match (&scene.flight, &scene.seen) {
+                (Some(_), Some(s)) => format!(
+                    ", with the flight and the {} boxes its sensors saw as it grew",
+                    s.t.len()
+                ),
+                (Some(_), None) => ", with the flight".to_string(),
+                _ => String::new(),
             },
             a.out.display(),
             html.len().div_ceil(1000)

@@ -6,6 +6,7 @@ use std::collections::{BTreeMap, HashSet};
 
 use aerial_chain::flying::{self, FlyOptions};
 use aerial_chain::map::{Cell, Grid, FACE_NEIGHBOURS};
+use aerial_chain::online::SeenOccupied;
 use aerial_chain::plan_file::Plan;
 use aerial_chain_core::kinematics::positions_into;
 use nalgebra::Vector3;
@@ -32,6 +33,24 @@ pub struct Scene {
     pub goal: Option<Goal>,
     /// The flown chain, when a flight was given.
     pub flight: Option<Flown>,
+    /// The map as the sensors drew it, when the flight is an exploration's.
+    pub seen: Option<Seen>,
+}
+
+/// The occupied voxels an exploration's sensors saw, in the order they were seen: box
+/// `k` (centre `origin + size * boxes[3k..3k+3]`) appears at time `t[k]`.
+#[derive(Serialize)]
+pub struct Seen {
+    /// Edge of one box (m): the voxel edge times `scale`.
+    pub size: f64,
+    /// Voxels per box edge, as for [`Boxes`].
+    pub scale: i32,
+    /// Centre of box index `(0, 0, 0)` (m).
+    pub origin: [f64; 3],
+    /// Box indices `[i, j, k, ...]`, ordered by `t`.
+    pub boxes: Vec<i32>,
+    /// When each box was first seen holding an occupied voxel (s).
+    pub t: Vec<f64>,
 }
 
 /// Obstacle boxes: box `k` has its centre at `origin + size * index_k`.
@@ -82,11 +101,21 @@ pub struct Flown {
     pub units: Vec<f64>,
 }
 
-/// The parts of an `arc sim --out` file (arc-sim/1) the view reads.
+/// The parts of an `arc sim --out` or `arc explore --out` file (arc-sim/1) the view
+/// reads.
 #[derive(Deserialize)]
 pub struct FlightFile {
     format: String,
     samples: Vec<FlightSample>,
+    #[serde(default)]
+    explore: Option<ExplorePart>,
+}
+
+/// The part of an exploration's record the view reads.
+#[derive(Deserialize)]
+struct ExplorePart {
+    #[serde(default)]
+    seen_occupied: Option<SeenOccupied>,
 }
 
 #[derive(Deserialize)]
@@ -181,8 +210,9 @@ pub fn along(units: &[f64], n: usize, step: f64) -> Vec<[f64; 3]> {
     out
 }
 
-/// The flown unit centres of `file`, for a chain of `n` units.
-pub fn flown(file: FlightFile, n: usize) -> Result<Flown, String> {
+/// The flown unit centres of `file`, for a chain of `n` units, and the map its
+/// sensors drew when it is an exploration's.
+pub fn flown(file: FlightFile, n: usize) -> Result<(Flown, Option<SeenOccupied>), String> {
     if file.format != "arc-sim/1" {
         return Err(format!(
             "format = {:?}, expected \"arc-sim/1\" (the file `arc sim --out` writes)",
@@ -210,14 +240,28 @@ pub fn flown(file: FlightFile, n: usize) -> Result<Flown, String> {
     }
     let every = file.samples.len().div_ceil(MAX_FLIGHT_SAMPLES).max(1);
     let kept: Vec<&FlightSample> = file.samples.iter().step_by(every).collect();
-    Ok(Flown {
+    let flown = Flown {
         t: kept.iter().map(|s| mm(s.t)).collect(),
         units: kept
             .iter()
             .flat_map(|s| s.units.iter())
             .flat_map(|u| u.p.map(|v| mm(f64::from(v))))
             .collect(),
-    })
+    };
+    let seen = file.explore.and_then(|e| e.seen_occupied);
+    if let Some(s) = &seen {
+        if s.voxels.len() != s.t.len() {
+            return Err(format!(
+                "explore.seen_occupied has {} voxels and {} times",
+                s.voxels.len(),
+                s.t.len()
+            ));
+        }
+        if let Some(k) = s.t.iter().position(|t| !t.is_finite()) {
+            return Err(format!("explore.seen_occupied.t[{k}] is not finite"));
+        }
+    }
+    Ok((flown, seen))
 }
 
 /// Which obstacles to draw: those within `near` m of `points`, or all.
@@ -232,53 +276,116 @@ pub enum Region<'a> {
 /// of a wall is not drawn), merged into boxes of 2, 4, 8... voxels a side until at
 /// most `max_boxes` remain.
 pub fn boxes(grid: &Grid, region: &Region<'_>, max_boxes: usize) -> Boxes {
-    let res = grid.resolution();
     let (lo, hi) = lattice_range(grid, region);
-    let near_buckets = match region {
-        Region::Near(points, d) => Some((buckets(points, *d), *d)),
-        Region::Whole => None,
-    };
+    let near = Near::of(region);
     let mut surface: Vec<([i32; 3], bool)> = Vec::new();
     for k in lo[2]..=hi[2] {
         for j in lo[1]..=hi[1] {
             for i in lo[0]..=hi[0] {
                 let v = [i, j, k];
-                if !grid.is_obstacle(v) || !touches_free(grid, v) {
-                    continue;
+                if grid.is_obstacle(v) && touches_free(grid, v) && near.keeps(grid, v) {
+                    surface.push((v, grid.cell(v) == Cell::Occupied));
                 }
-                if let Some((set, d)) = &near_buckets {
-                    let c = grid.voxel_center(v);
-                    if !set.contains(&bucket(c.into(), *d)) {
-                        continue;
-                    }
-                }
-                surface.push((v, grid.cell(v) == Cell::Occupied));
             }
         }
     }
-    let mut scale = 1i32;
-    let merged = loop {
-        let mut m: BTreeMap<[i32; 3], bool> = BTreeMap::new();
-        for &(v, occupied) in &surface {
-            let b = v.map(|x| x.div_euclid(scale));
-            *m.entry(b).or_insert(false) |= occupied;
-        }
-        if m.len() <= max_boxes || scale >= 1 << 12 {
-            break m;
-        }
-        scale *= 2;
-    };
+    let (scale, merged) = merge(&surface, max_boxes, false, |a, b| *a |= b);
     let (mut occupied, mut unknown) = (Vec::new(), Vec::new());
     for (b, occ) in merged {
         if occ { &mut occupied } else { &mut unknown }.extend(b);
     }
-    let half = (f64::from(scale) - 1.0) * res / 2.0;
     Boxes {
-        size: res * f64::from(scale),
+        size: grid.resolution() * f64::from(scale),
         scale,
-        origin: grid.voxel_center([0, 0, 0]).map(|c| c + half).into(),
+        origin: box_origin(grid, scale),
         occupied,
         unknown,
+    }
+}
+
+/// The seen voxels of `seen` in `region` of `grid` (the map the view draws, of the
+/// same resolution), merged as [`boxes`] merges, each box timed by the first of its
+/// voxels seen, in the order they were seen.
+pub fn seen_boxes(
+    grid: &Grid,
+    seen: &SeenOccupied,
+    region: &Region<'_>,
+    max_boxes: usize,
+) -> Result<Seen, String> {
+    if (seen.resolution - grid.resolution()).abs() > 1e-9 * grid.resolution() {
+        return Err(format!(
+            "explore.seen_occupied.resolution = {} m, the map's is {} m: view the \
+             exploration on the map it flew",
+            seen.resolution,
+            grid.resolution()
+        ));
+    }
+    let near = Near::of(region);
+    let kept: Vec<([i32; 3], f64)> = seen
+        .voxels
+        .iter()
+        .zip(&seen.t)
+        .filter(|(v, _)| near.keeps(grid, **v))
+        .map(|(v, t)| (*v, *t))
+        .collect();
+    let (scale, merged) = merge(&kept, max_boxes, f64::INFINITY, |a, b| *a = a.min(b));
+    let mut timed: Vec<(f64, [i32; 3])> = merged.into_iter().map(|(b, t)| (t, b)).collect();
+    timed.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    Ok(Seen {
+        size: grid.resolution() * f64::from(scale),
+        scale,
+        origin: box_origin(grid, scale),
+        boxes: timed.iter().flat_map(|(_, b)| *b).collect(),
+        t: timed.iter().map(|(t, _)| mm(*t)).collect(),
+    })
+}
+
+/// Voxels `items` merged into boxes of 1, 2, 4... voxels a side until at most
+/// `max_boxes` remain: each box's value starts at `init` and folds in its voxels'
+/// values with `fold`. Returns the scale and the boxes.
+fn merge<T: Copy>(
+    items: &[([i32; 3], T)],
+    max_boxes: usize,
+    init: T,
+    fold: impl Fn(&mut T, T),
+) -> (i32, BTreeMap<[i32; 3], T>) {
+    let mut scale = 1i32;
+    loop {
+        let mut m: BTreeMap<[i32; 3], T> = BTreeMap::new();
+        for &(v, value) in items {
+            let b = v.map(|x| x.div_euclid(scale));
+            fold(m.entry(b).or_insert(init), value);
+        }
+        if m.len() <= max_boxes || scale >= 1 << 12 {
+            return (scale, m);
+        }
+        scale *= 2;
+    }
+}
+
+/// Centre of box `(0, 0, 0)` of boxes `scale` voxels a side on `grid`'s lattice.
+fn box_origin(grid: &Grid, scale: i32) -> [f64; 3] {
+    let half = (f64::from(scale) - 1.0) * grid.resolution() / 2.0;
+    grid.voxel_center([0, 0, 0]).map(|c| c + half).into()
+}
+
+/// Which voxels a [`Region`] keeps: those whose centres lie in the cubes next to its
+/// points, or all.
+struct Near(Option<(HashSet<[i64; 3]>, f64)>);
+
+impl Near {
+    fn of(region: &Region<'_>) -> Self {
+        Near(match region {
+            Region::Near(points, d) => Some((buckets(points, *d), *d)),
+            Region::Whole => None,
+        })
+    }
+
+    fn keeps(&self, grid: &Grid, v: [i32; 3]) -> bool {
+        match &self.0 {
+            Some((set, d)) => set.contains(&bucket(grid.voxel_center(v).into(), *d)),
+            None => true,
+        }
     }
 }
 

@@ -20,7 +20,8 @@ const KINDS = {
   sampled: [0xad1457, 'shape change: sampled'],
   other: [0x795548, 'other'],
 };
-const ROUTE = 0x1565c0, FLOWN = 0xff8f00, GOAL = 0x43a047, OCC = 0xb8c2cf, UNK = 0xc9b48a;
+const ROUTE = 0x1565c0, FLOWN = 0xff8f00, GOAL = 0x43a047, OCC = 0xb8c2cf, UNK = 0xc9b48a, SEEN = 0x5d7186;
+const S = D.seen;
 
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
 renderer.setPixelRatio(window.devicePixelRatio || 1);
@@ -69,21 +70,26 @@ function balls(count, radius, material) {
 
 // Obstacles, cut above a height the user picks (so the route stays visible).
 const cut = new THREE.Plane(new THREE.Vector3(0, 0, -1), 1e9);
-function boxes(idx, color, opacity) {
+function boxes(idx, color, opacity, at = D.boxes, grow = 1) {
   const n = idx.length / 3;
-  if (n === 0) return;
-  const s = D.boxes.size, o = D.boxes.origin;
+  if (n === 0) return null;
+  const s = at.size, o = at.origin;
   const mat = new THREE.MeshLambertMaterial({ color, clippingPlanes: [cut], transparent: opacity < 1, opacity, depthWrite: opacity >= 1 });
-  const m = new THREE.InstancedMesh(new THREE.BoxGeometry(s, s, s), mat, n);
+  const m = new THREE.InstancedMesh(new THREE.BoxGeometry(s * grow, s * grow, s * grow), mat, n);
   for (let k = 0; k < n; k++) {
     tmp.position.set(o[0] + s * idx[3 * k], o[1] + s * idx[3 * k + 1], o[2] + s * idx[3 * k + 2]);
     tmp.quaternion.identity(); tmp.scale.set(1, 1, 1); tmp.updateMatrix();
     m.setMatrixAt(k, tmp.matrix);
   }
   scene.add(m);
+  return m;
 }
-boxes(D.boxes.occupied, OCC, 1);
-boxes(D.boxes.unknown, UNK, 0.35);
+// With an exploration's map the world turns faint and the boxes its sensors saw
+// appear in the order they were seen (S.t ascending: the first `count` are drawn).
+boxes(D.boxes.occupied, OCC, S ? 0.16 : 1);
+boxes(D.boxes.unknown, UNK, S ? 0.1 : 0.35);
+// (a hair larger than the world's, so that the faint box does not fight the seen one)
+const seenMesh = S ? boxes(S.boxes, SEEN, 1, S, 1.01) : null;
 
 // The head route and the shape-change waypoints on it, coloured by source; on a long
 // route the trails thicken so they stay visible when the whole route is framed.
@@ -118,7 +124,9 @@ if (D.goal) {
 const unitMat = new THREE.MeshStandardMaterial({ color: 0xffffff, roughness: 0.5, transparent: !!F, opacity: F ? 0.45 : 1, depthWrite: !F });
 const chainUnits = balls(N, D.unit_radius, unitMat);
 const chainLinks = sticks(N - 1, D.link_radius, new THREE.MeshStandardMaterial({ color: 0x37474f, roughness: 0.6 }));
-scene.add(chainUnits, chainLinks);
+// An exploration's plan is its pieces joined, whose waypoints have no clock of their
+// own (each piece was timed when it was committed): its flight alone shows the chain.
+if (!S) scene.add(chainUnits, chainLinks);
 const unitsAt = (arr, i) => [...Array(N).keys()].map((u) => v3(arr, i * N + u));
 const linksOf = (ps) => ps.slice(1).map((p, k) => [ps[k], p]);
 
@@ -138,7 +146,7 @@ if (F) {
 // Time: waypoint times are those of `arc sim` with its default limits (a smoothstep
 // ramp stands in for its speed profile on translations); the flight's are its own
 // recorded times. Both start at 0 with the start hold.
-const tEnd = Math.max(W.t[wn - 1], F ? F.t[F.t.length - 1] : 0);
+const tEnd = S ? F.t[F.t.length - 1] : Math.max(W.t[wn - 1], F ? F.t[F.t.length - 1] : 0);
 const slider = document.getElementById('time');
 slider.max = String(tEnd);
 const lastAtOrBefore = (ts, t) => { let lo = 0, hi = ts.length - 1; while (lo < hi) { const m = (lo + hi + 1) >> 1; if (ts[m] <= t) lo = m; else hi = m - 1; } return lo; };
@@ -167,16 +175,24 @@ function setTime(t) {
   const col = new THREE.Color(KINDS[W.kind[i]][0]);
   ps.forEach((_, u) => chainUnits.setColorAt(u, u === 0 ? col.clone().offsetHSL(0, 0, -0.15) : col));
   chainUnits.instanceColor.needsUpdate = true;
-  let text = `t = ${now.toFixed(2)} s of ${tEnd.toFixed(2)} s; waypoint ${i} of ${wn - 1}: ${W.source[i] || W.kind[i]} (reached at ${W.t[i].toFixed(2)} s)${moving}`;
+  let text = `t = ${now.toFixed(2)} s of ${tEnd.toFixed(2)} s`;
+  if (!S) text += `; waypoint ${i} of ${wn - 1}: ${W.source[i] || W.kind[i]} (reached at ${W.t[i].toFixed(2)} s)${moving}`;
+  let head = ps[0];
   if (F) {
     const j = lastAtOrBefore(F.t, now);
     const fp = unitsAt(F.units, j);
+    if (S) head = fp[0];
     flownUnits.setPoints(fp);
     flownLinks.setPoints(linksOf(fp));
     text += `; flown chain at ${F.t[j].toFixed(2)} s`;
   }
+  if (seenMesh) {
+    const k = S.t.length ? lastAtOrBefore(S.t, now) + (S.t[0] <= now ? 1 : 0) : 0;
+    seenMesh.count = k;
+    text += `; ${k} of ${S.t.length} boxes seen occupied`;
+  }
   info.textContent = text;
-  if (follow.checked) { target.copy(ps[0]); place(); }
+  if (follow.checked) { target.copy(head); place(); }
   render();
 }
 // Follow: the camera keeps its direction and distance from the head (long routes).
@@ -278,7 +294,8 @@ entry(ROUTE, 'head route (plan)');
 for (const k of Object.keys(KINDS)) if (W.kind.includes(k) && k !== 'start') entry(KINDS[k][0], KINDS[k][1]);
 if (F) entry(FLOWN, 'flown chain and head trail');
 if (D.goal) entry(GOAL, `goal region (${D.goal.radius} m)`);
-if (D.boxes.occupied.length) entry(OCC, `occupied${D.boxes.scale > 1 ? ` (merged ${D.boxes.scale}x${D.boxes.scale}x${D.boxes.scale} voxels)` : ''}`);
+if (S) entry(SEEN, `seen occupied by then${S.scale > 1 ? ` (merged ${S.scale}x${S.scale}x${S.scale} voxels)` : ''}`);
+if (D.boxes.occupied.length) entry(OCC, `occupied${S ? ' (the world, faint)' : ''}${D.boxes.scale > 1 ? ` (merged ${D.boxes.scale}x${D.boxes.scale}x${D.boxes.scale} voxels)` : ''}`);
 if (D.boxes.unknown.length) entry(UNK, 'unknown, counted as occupied');
 
 setCut(Math.min(box.max.z, Number(cutIn.max)));
