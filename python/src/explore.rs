@@ -20,7 +20,7 @@ use aerial_chain::sim::{FlightFile, FLIGHT_FORMAT};
 use aerial_chain::tables::ShapeTables;
 
 use crate::map::Map;
-use crate::plan::{chain, query, Asked, Plan};
+use crate::plan::{chain_and_query, Asked, Plan};
 use crate::sim::Flight;
 use crate::{err, json_to_py, ExploreError, SimError};
 
@@ -207,10 +207,6 @@ pub fn explore(
     known: Option<&Map>,
     record_every: usize,
 ) -> PyResult<Exploration> {
-    let units = units
-        .or(map.scenario.as_ref().map(|s| i64::from(s.default_units)))
-        .ok_or_else(|| err::<crate::PlanError>("units is required with a map file"))?;
-    let params = chain(units)?;
     let asked = Asked {
         start,
         goal,
@@ -218,7 +214,7 @@ pub fn explore(
         start_shape,
         goal_tol,
     };
-    let query = query(map, &params, asked)?;
+    let (params, query) = chain_and_query(map, units, asked)?;
     let settings = settings(py, (deadline, clearance, start_free), sensor, sensor_rate)?;
     let settings = ExploreSettings {
         time_limit_s: time_limit,

@@ -21,7 +21,7 @@ use aerial_chain::tables::ShapeTables;
 
 use crate::explore::settings;
 use crate::map::Map;
-use crate::plan::{chain, query, Asked, Plan};
+use crate::plan::{chain_and_query, Asked, Plan};
 use crate::{err, json_to_py, ExploreError};
 
 /// The online planner of a chain flying into the unknown (docs/online.md): what is
@@ -121,10 +121,6 @@ impl OnlinePlanner {
         sensor: Option<Bound<'_, PyAny>>,
         known: Option<&Map>,
     ) -> PyResult<Self> {
-        let units = units
-            .or(map.scenario.as_ref().map(|s| i64::from(s.default_units)))
-            .ok_or_else(|| err::<crate::PlanError>("units is required with a map file"))?;
-        let params = chain(units)?;
         let asked = Asked {
             start,
             goal,
@@ -132,7 +128,7 @@ impl OnlinePlanner {
             start_shape,
             goal_tol,
         };
-        let query = query(map, &params, asked)?;
+        let (params, query) = chain_and_query(map, units, asked)?;
         let s = settings(
             py,
             (deadline, clearance, start_free),

@@ -288,6 +288,21 @@ pub(crate) struct Asked {
     pub(crate) goal_tol: f64,
 }
 
+/// The chain of `units` units (default: the scenario's) and the query `asked` on
+/// `map`, as `explore()` and `OnlinePlanner` take them.
+pub(crate) fn chain_and_query(
+    map: &Map,
+    units: Option<i64>,
+    asked: Asked,
+) -> PyResult<(ChainParams, Query)> {
+    let units = units
+        .or(map.scenario.as_ref().map(|s| i64::from(s.default_units)))
+        .ok_or_else(|| err::<PlanError>("units is required with a map file"))?;
+    let params = chain(units)?;
+    let query = query(map, &params, asked)?;
+    Ok((params, query))
+}
+
 /// The query: the scenario's start, yaw, goal where not given; the start shape as
 /// given (2N - 1 angles) or the straight line behind the head at the start yaw.
 pub(crate) fn query(map: &Map, params: &ChainParams, asked: Asked) -> PyResult<Query> {
