@@ -44,7 +44,7 @@ pub use planner::{OnlinePlanner, Piece};
 pub use record::{Outcome, ReplanRecord, Trigger};
 pub use route::{Radii, Route};
 pub use settings::{
-    OnlineError, OnlineSection, OnlineSettings, StartFree, DEFAULT_DEADLINE_S,
+    ExploreSettingsFile, OnlineError, OnlineSection, OnlineSettings, StartFree, DEFAULT_DEADLINE_S,
     DEFAULT_ROUTE_PERIOD_S,
 };
 

@@ -4,7 +4,9 @@
 use serde::{Deserialize, Serialize};
 
 use crate::planner::SettingError;
-use crate::planning::{PlanOptions, PlanningError, SettingsFile};
+use crate::planning::{
+    unknown_key, PlanOptions, PlanningError, SettingsFile, SettingsFileError, ONLINE_SECTION,
+};
 use crate::sensing::occupancy::FusionError;
 
 /// Wall time a replan may take by default (s): the built-in scenarios' pieces through
@@ -94,20 +96,72 @@ impl OnlineSettings {
     /// its planner, post-processing and trajectory sections for every piece, its
     /// `online` section for the rest; the planner's clearance stays `clearance`, a flag
     /// of its own.
-    pub fn from_file(file: &SettingsFile, clearance: f64) -> Self {
+    pub fn from_file(file: &ExploreSettingsFile, clearance: f64) -> Self {
         let d = Self::default();
+        let sections = &file.sections;
         Self {
             plan: PlanOptions {
-                planner: file.planner.clone(),
-                refine: file.refine.clone(),
+                planner: sections.planner.clone(),
+                refine: sections.refine.clone(),
                 clearance,
                 ..d.plan
             },
-            trajectory: file.trajectory,
+            trajectory: sections.trajectory,
             deadline_s: file.online.deadline_s,
             route_period_s: file.online.route_period_s,
             start_free: file.online.start_free,
         }
+    }
+}
+
+/// A settings file as the online planner reads it (`arc explore --settings`): the
+/// sections every plan reads, and the `online` section.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ExploreSettingsFile {
+    /// The planner, post-processing and trajectory sections.
+    pub sections: SettingsFile,
+    /// The `online` section.
+    pub online: OnlineSection,
+}
+
+impl ExploreSettingsFile {
+    /// Reads the settings in `text` (the file `file`, for messages) and checks them,
+    /// as [`SettingsFile::parse`] does, the `online` section included.
+    pub fn parse(text: &str, file: &str) -> Result<Self, SettingsFileError> {
+        let sections = SettingsFile::parse(text, file)?;
+        let format = |message: String| SettingsFileError::Format {
+            file: file.to_string(),
+            message,
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| format(e.to_string()))?;
+        let online = match value.get(ONLINE_SECTION) {
+            None => OnlineSection::default(),
+            Some(v) => {
+                let known =
+                    serde_json::to_value(OnlineSection::default()).expect("the section serializes");
+                if !v.is_object() {
+                    return Err(format(format!("{ONLINE_SECTION}: a JSON object")));
+                }
+                if let Some((key, known)) = unknown_key(v, &known, ONLINE_SECTION) {
+                    return Err(SettingsFileError::UnknownKey {
+                        file: file.to_string(),
+                        key,
+                        known,
+                    });
+                }
+                let section: OnlineSection = serde_json::from_value(v.clone())
+                    .map_err(|e| format(format!("{ONLINE_SECTION}: {e}")))?;
+                section
+                    .validate()
+                    .map_err(|source| SettingsFileError::Value {
+                        file: file.to_string(),
+                        source,
+                    })?;
+                section
+            }
+        };
+        Ok(Self { sections, online })
     }
 }
 
@@ -206,4 +260,71 @@ pub(super) fn check_settings(s: &OnlineSettings) -> Result<(), OnlineError> {
         .validate()
         .map_err(|e| OnlineError::Map(format!("trajectory settings: {e}")))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_settings_file_gives_the_online_section_and_the_pieces_sections() {
+        let d = ExploreSettingsFile::parse("{}", "e.json").unwrap();
+        assert_eq!(d, ExploreSettingsFile::default());
+        let f = ExploreSettingsFile::parse(
+            r#"{"planner": {"vertices": 700}, "trajectory": {"dt": 0.01},
+                "online": {"start_free": "bodies", "route_period_s": 0.5}}"#,
+            "s.json",
+        )
+        .unwrap();
+        assert_eq!(f.online.start_free, StartFree::Bodies);
+        assert_eq!(f.online.deadline_s, DEFAULT_DEADLINE_S);
+        let s = OnlineSettings::from_file(&f, 0.07);
+        assert_eq!(s.plan.planner.vertices, 700);
+        assert_eq!((s.plan.clearance, s.trajectory.dt), (0.07, 0.01));
+        assert_eq!((s.route_period_s, s.start_free), (0.5, StartFree::Bodies));
+    }
+
+    #[test]
+    fn docs_settings_md_lists_every_online_setting() {
+        let doc = include_str!("../../../docs/settings.md");
+        let known = serde_json::to_value(OnlineSection::default()).unwrap();
+        let keys = known.as_object().unwrap().keys();
+        assert_eq!(keys.len(), 3);
+        for k in keys {
+            let row = format!("| `online.{k}` |");
+            assert!(doc.contains(&row), "docs/settings.md lacks online.{k}");
+        }
+    }
+
+    #[test]
+    fn a_bad_online_section_is_refused_naming_the_file_and_the_key() {
+        for (text, says) in [
+            (
+                r#"{"online": {"deadline": 1}}"#,
+                "t.json: unknown key `online.deadline`",
+            ),
+            (
+                r#"{"online": {"deadline_s": 0}}"#,
+                "t.json: online.deadline_s = 0",
+            ),
+            (
+                r#"{"online": {"route_period_s": 1e9}}"#,
+                "t.json: online.route_period_s = 1000000000",
+            ),
+            (
+                r#"{"online": {"start_free": "all"}}"#,
+                "t.json: online: unknown variant",
+            ),
+            (r#"{"online": 3}"#, "t.json: online: a JSON object"),
+            (
+                r#"{"refine": {"widen": {"budgte": 3}}}"#,
+                "refine.widen.budgte",
+            ),
+        ] {
+            let e = ExploreSettingsFile::parse(text, "t.json")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(says), "{text}: {e}");
+        }
+    }
 }

@@ -28,7 +28,8 @@ pub use arrival::Arrival;
 pub use error::{NoPlan, PlanningError};
 pub use mission::{plan_mission, LegError, MissionPlanned};
 pub use options::{PlanOptions, DEFAULT_TIME_LIMIT_S, MAX_TIME_LIMIT_S};
-pub use settings_file::{SettingsFile, SettingsFileError};
+pub(crate) use settings_file::unknown_key;
+pub use settings_file::{SettingsFile, SettingsFileError, ONLINE_SECTION};
 
 use crate::collision::CollisionContext;
 use crate::goal::GoalPose;

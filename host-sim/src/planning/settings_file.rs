@@ -1,6 +1,7 @@
 //! Settings files (docs/model.md, "Settings files"): the tuning of a plan in one JSON
 //! object with a section per settings type, read by `arc plan --settings` and `arc
-//! explore --settings` (which also reads the `online` section).
+//! explore --settings`. The `online` section is the online planner's, read with the
+//! others by `online::ExploreSettingsFile` and skipped here.
 //!
 //! ```json
 //! {"planner": {"vertices": 3000}, "refine": {"widen": {"budget": 300}},
@@ -28,10 +29,11 @@ pub struct SettingsFile {
     /// How a plan is timed into a trajectory (`crate::trajectory::Settings`), when one
     /// is made.
     pub trajectory: crate::trajectory::Settings,
-    /// The online planner's own settings (`arc explore`; `arc plan` checks them and
-    /// does not use them).
-    pub online: crate::online::OnlineSection,
 }
+
+/// The section of a settings file that holds the online planner's own settings: read
+/// by the online planner's file type, skipped by [`SettingsFile::parse`].
+pub const ONLINE_SECTION: &str = "online";
 
 /// Why a settings file cannot be used: each names the file.
 #[derive(Debug, thiserror::Error)]
@@ -71,11 +73,12 @@ impl SettingsFile {
             file: file.to_string(),
             message,
         };
-        let value: Value = serde_json::from_str(text).map_err(|e| format(e.to_string()))?;
+        let mut value: Value = serde_json::from_str(text).map_err(|e| format(e.to_string()))?;
         let known = serde_json::to_value(Self::default()).expect("settings serialize");
-        if !value.is_object() {
+        let Some(sections) = value.as_object_mut() else {
             return Err(format("a settings file is one JSON object".into()));
-        }
+        };
+        sections.remove(ONLINE_SECTION);
         if let Some((key, known)) = unknown_key(&value, &known, "") {
             return Err(SettingsFileError::UnknownKey {
                 file: file.to_string(),
@@ -94,7 +97,7 @@ impl SettingsFile {
     }
 
     /// Checks every tuning setting of the sections: the planner's without a flag,
-    /// post-processing's, the trajectory's, the online planner's. (The planner's flag-backed fields are
+    /// post-processing's, the trajectory's. (The planner's flag-backed fields are
     /// checked where `arc plan` reads them, together with its flags.)
     pub fn validate(&self) -> Result<(), SettingError> {
         self.planner.validate_tuning()?;
@@ -120,13 +123,13 @@ impl SettingsFile {
             E::Dt(v) => SettingError::new("trajectory.dt", v, "in (0, 0.1] s"),
             e => SettingError::new("trajectory", e, "valid"),
         })?;
-        self.online.validate()
+        Ok(())
     }
 }
 
 /// The first key of `value` (an object, at `path`) that `known` (the defaults, as
 /// JSON) does not have, with the keys known there; objects are searched within.
-fn unknown_key(value: &Value, known: &Value, path: &str) -> Option<(String, String)> {
+pub(crate) fn unknown_key(value: &Value, known: &Value, path: &str) -> Option<(String, String)> {
     let (Value::Object(v), Value::Object(k)) = (value, known) else {
         return None;
     };
@@ -163,7 +166,7 @@ mod tests {
         let some = SettingsFile::parse(
             r#"{"planner": {"vertices": 700, "lattice": {"heuristic_weight": 3.0}},
                 "refine": {"widen": {"budget": 10}}, "trajectory": {"dt": 0.01},
-                "online": {"start_free": "bodies"}}"#,
+                "online": {"anything": "skipped here"}}"#,
             "s.json",
         )
         .unwrap();
@@ -173,8 +176,6 @@ mod tests {
         assert_eq!(some.refine.widen.budget, 10);
         assert_eq!(some.refine.widen.centred, d.refine.widen.centred);
         assert_eq!(some.trajectory.dt, 0.01);
-        assert_eq!(some.online.start_free, crate::online::StartFree::Bodies);
-        assert_eq!(some.online.deadline_s, d.online.deadline_s);
         let back = serde_json::to_string(&some).unwrap();
         assert_eq!(SettingsFile::parse(&back, "s.json").unwrap(), some);
     }
@@ -243,12 +244,6 @@ mod tests {
                 "0.5",
             ),
             (r#"{"trajectory": {"max_run": 0}}"#, "max_run", "0"),
-            (r#"{"online": {"deadline_s": 0}}"#, "online.deadline_s", "0"),
-            (
-                r#"{"online": {"route_period_s": 1e9}}"#,
-                "online.route_period_s",
-                "1000000000",
-            ),
             (
                 r#"{"refine": {"thread": {"grid_steps": 5000}}}"#,
                 "grid_steps",

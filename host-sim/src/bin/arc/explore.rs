@@ -8,12 +8,13 @@ use clap::Args;
 
 use super::checks;
 use super::common::{ProblemArgs, Report};
-use super::plan::{check_planner, load_tables, read_settings, Given, Loaded};
+use super::plan::{check_planner, load_tables, settings_text, Given};
 use super::{CliError, CliResult};
 use aerial_chain::flying::FlyOptions;
 use aerial_chain::map::{Grid, OcTree};
 use aerial_chain::online::{
-    explore, Exploration, ExploreEnd, ExploreError, ExploreSettings, OnlineSettings, StartFree,
+    explore, Exploration, ExploreEnd, ExploreError, ExploreSettings, ExploreSettingsFile,
+    OnlineSettings, StartFree,
 };
 use aerial_chain::plan_file::MapSection;
 use aerial_chain::sensing::{DepthSensor, Survey};
@@ -176,38 +177,33 @@ fn known(path: &Path, world: &Grid) -> Result<Grid, CliError> {
 }
 
 /// The online planner's settings: a flag given on the command line (`given`), else
-/// the settings file where it sets the value, else the default.
-fn online(
-    a: &ExploreArgs,
-    file: Option<&Loaded>,
-    given: &Given,
-) -> Result<OnlineSettings, CliError> {
-    let mut s = OnlineSettings::from_file(
-        &file.map(|f| f.file.clone()).unwrap_or_default(),
-        a.clearance,
-    );
-    let flag = |id: &str, key: &str| {
-        given.contains(id) || !file.is_some_and(|f| f.sets(&format!("online.{key}")))
+/// the settings file (`--settings`) where it sets the value, else the default.
+fn online(a: &ExploreArgs, given: &Given) -> Result<OnlineSettings, CliError> {
+    let Some((text, name, keys)) = settings_text(a.settings.as_ref())? else {
+        let mut s = OnlineSettings::from_file(&ExploreSettingsFile::default(), a.clearance);
+        (s.deadline_s, s.start_free) = (a.deadline, a.start_free);
+        return Ok(s);
     };
+    let file =
+        ExploreSettingsFile::parse(&text, &name).map_err(|e| CliError::input(e.to_string()))?;
+    let mut s = OnlineSettings::from_file(&file, a.clearance);
+    let flag = |id: &str, key: &str| given.contains(id) || !keys.contains(&format!("online.{key}"));
     if flag("deadline", "deadline_s") {
         s.deadline_s = a.deadline;
     }
     if flag("start_free", "start_free") {
         s.start_free = a.start_free;
     }
-    if let Some(f) = file {
-        check_planner(&s.plan.planner, &|_, field| {
-            format!("{}: planner.{field}", f.name)
-        })?;
-    }
+    check_planner(&s.plan.planner, &|_, field| {
+        format!("{name}: planner.{field}")
+    })?;
     Ok(s)
 }
 
 /// Runs `arc explore`: exit 0 when the chain reached the goal, 1 when it could not.
 pub fn run(a: ExploreArgs, given: &Given) -> CliResult {
     check(&a)?;
-    let file = read_settings(a.settings.as_ref())?;
-    let online = online(&a, file.as_ref(), given)?;
+    let online = online(&a, given)?;
     let survey = survey(&a)?;
     let (loaded, params, query) = a.problem.load()?;
     let truth = loaded.grid;

@@ -228,33 +228,44 @@ pub(super) fn check_planner(
 
 /// A settings file as read: its settings, its name, and the keys it sets (dotted
 /// paths, such as `planner.vertices`).
-pub(super) struct Loaded {
-    pub(super) file: SettingsFile,
-    pub(super) name: String,
+struct Loaded {
+    file: SettingsFile,
+    name: String,
     keys: BTreeSet<String>,
 }
 
 impl Loaded {
     /// Whether the file sets `key`.
-    pub(super) fn sets(&self, key: &str) -> bool {
+    fn sets(&self, key: &str) -> bool {
         self.keys.contains(key)
     }
 }
 
 /// The settings file of `--settings`, read and checked (its tuning settings; those
 /// with a flag are checked with the flags, [`check_planner`]).
-pub(super) fn read_settings(path: Option<&PathBuf>) -> Result<Option<Loaded>, CliError> {
+fn read_settings(path: Option<&PathBuf>) -> Result<Option<Loaded>, CliError> {
+    let Some((text, name, keys)) = settings_text(path)? else {
+        return Ok(None);
+    };
+    let file = SettingsFile::parse(&text, &name).map_err(|e| CliError::input(e.to_string()))?;
+    Ok(Some(Loaded { file, name, keys }))
+}
+
+/// The text of the settings file at `path`, its name for messages and the keys it
+/// sets (dotted paths); `None` without a file.
+pub(super) fn settings_text(
+    path: Option<&PathBuf>,
+) -> Result<Option<(String, String, BTreeSet<String>)>, CliError> {
     let Some(path) = path else {
         return Ok(None);
     };
     let name = crate::fsutil::input_name(path);
     let text =
         crate::fsutil::read_input(path).map_err(|e| CliError::input(format!("{name}: {e}")))?;
-    let file = SettingsFile::parse(&text, &name).map_err(|e| CliError::input(e.to_string()))?;
     let value: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
     let mut keys = BTreeSet::new();
     key_paths(&value, "", &mut keys);
-    Ok(Some(Loaded { file, name, keys }))
+    Ok(Some((text, name, keys)))
 }
 
 /// Every key of the JSON object `v` and of the objects within, as dotted paths.
