@@ -39,6 +39,9 @@ pub struct OnlinePlanner {
     flown_radius: f64,
 }
 
+/// Most samples `committed` returns: the trajectory module's bound on one motion.
+const MAX_SAMPLES: usize = aerial_chain::trajectory::MAX_SAMPLES;
+
 /// `points` as an (M, 3) array of floats, or why not (naming `what`).
 fn rows<'py>(py: Python<'py>, points: &Bound<'py, PyAny>, what: &str) -> PyResult<Vec<[f64; 3]>> {
     let array = py
@@ -255,7 +258,14 @@ impl OnlinePlanner {
         }
         let reference = self.inner.committed();
         let end = reference.duration();
-        let steps = (end / dt).ceil() as usize;
+        let steps = (end / dt).ceil();
+        if steps > MAX_SAMPLES as f64 {
+            return Err(err::<ExploreError>(format!(
+                "dt = {dt}: {steps} samples of the {end:.1} s committed motion, more than \
+                 {MAX_SAMPLES}; sample it more coarsely or with at(t)"
+            )));
+        }
+        let steps = steps as usize;
         let times: Vec<f64> = (0..=steps).map(|k| (k as f64 * dt).min(end)).collect();
         let width = reference.end().len();
         let mut zetas = Array2::<f64>::zeros((times.len(), width));

@@ -65,6 +65,7 @@ def test_from_nothing_it_commits_no_motion_until_clouds_show_the_way(window, tmp
         (lambda p: p.observe([0, np.inf, 0], [[1.0, 1.0, 1.0]], 5.0), "origin"),
         (lambda p: p.observe([1, 1, 1], [[2.0, 1.0, 1.0]], -5.0), "range"),
         (lambda p: p.committed(dt=0.0), "dt = 0"),
+        (lambda p: (p.replan(0.0, "start"), p.committed(dt=1e-9)), "samples"),
         (lambda p: p.follow_at_ticks(-1.0), "period = -1"),
         (lambda p: p.stuck(float("nan")), "now = NaN"),
     ],
