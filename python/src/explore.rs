@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 use std::sync::atomic::AtomicUsize;
 
-use numpy::ndarray::Array2;
+use aerial_chain_core::ChainParams;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 
@@ -22,7 +22,7 @@ use aerial_chain::tables::ShapeTables;
 use crate::map::Map;
 use crate::plan::{chain_and_query, Asked, Plan};
 use crate::sim::Flight;
-use crate::{err, json_to_py, ExploreError, SimError};
+use crate::{err, json_to_py, points_array, ExploreError, SimError};
 
 /// What `explore()` returns: how the run ended, the flight, the committed pieces joined
 /// into one plan, the record of every replan (as `arc explore --out` writes it under
@@ -97,13 +97,11 @@ impl Exploration {
     ) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>) {
         let grew = self.record.seen_occupied.clone().unwrap_or_default();
         let r = grew.resolution;
-        let mut centres = Array2::<f64>::zeros((grew.voxels.len(), 3));
-        for (k, v) in grew.voxels.iter().enumerate() {
-            for j in 0..3 {
-                centres[[k, j]] = (f64::from(v[j]) + 0.5) * r;
-            }
-        }
-        (centres.into_pyarray(py), grew.t.into_pyarray(py))
+        let centres = grew
+            .voxels
+            .iter()
+            .map(|v| v.map(|i| (f64::from(i) + 0.5) * r));
+        (points_array(py, centres), grew.t.into_pyarray(py))
     }
 
     /// Voxels of the seen map that are known (free or occupied) at the end.
@@ -233,15 +231,11 @@ pub fn explore(
     }
     let start = Waypoint::new(query.start.into(), &query.start_shape).zeta;
     let run = py.detach(|| {
-        // `arc plan`'s tables, as `arc explore` builds them.
-        let table_settings = PlanOptions::default().table_settings();
-        let tables = ShapeTables::build(params, &table_settings, &AtomicUsize::new(0))
-            .map_err(|e| err::<ExploreError>(format!("shape tables: {e}")))?;
         let prior = known.map(|k| &k.grid);
         online::explore(
             &map.grid,
             params,
-            tables,
+            arc_tables(params)?,
             &start,
             query.goal,
             query.goal_tol,
@@ -254,6 +248,13 @@ pub fn explore(
         })
     })?;
     exploration(py, run, map, record_every)
+}
+
+/// `arc plan`'s shape tables for the chain `params`, as `arc explore` builds them.
+pub(crate) fn arc_tables(params: ChainParams) -> PyResult<ShapeTables> {
+    let table_settings = PlanOptions::default().table_settings();
+    ShapeTables::build(params, &table_settings, &AtomicUsize::new(0))
+        .map_err(|e| err::<ExploreError>(format!("shape tables: {e}")))
 }
 
 /// The settings of `explore()`'s planner and sensors, checked with the words of `arc

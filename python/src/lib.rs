@@ -78,6 +78,18 @@ pub(crate) fn err<T: pyo3::PyTypeInfo>(e: impl std::fmt::Display) -> PyErr {
     PyErr::new::<T, _>(e.to_string())
 }
 
+/// Points as a `(K, 3)` NumPy array, one row per point.
+pub(crate) fn points_array<'py>(
+    py: Python<'py>,
+    points: impl IntoIterator<Item = [f64; 3]>,
+) -> Bound<'py, numpy::PyArray2<f64>> {
+    use numpy::IntoPyArray;
+    let flat: Vec<f64> = points.into_iter().flatten().collect();
+    numpy::ndarray::Array2::from_shape_vec((flat.len() / 3, 3), flat)
+        .expect("three numbers per point")
+        .into_pyarray(py)
+}
+
 /// A JSON value (serde) as the Python object `json.loads` makes of it.
 pub(crate) fn json_to_py<'py>(
     py: Python<'py>,

@@ -3,7 +3,6 @@
 
 use std::path::PathBuf;
 
-use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 
@@ -12,7 +11,7 @@ use aerial_chain::plan_file::MapSource;
 use aerial_chain::problem::scenarios::{self, Scenario};
 use aerial_chain::sensing::{raycast, PointCloud, UnitPose};
 
-use crate::{err, ExploreError, MapError};
+use crate::{err, points_array, ExploreError, MapError};
 
 /// A map to plan, verify and fly on: an occupancy grid (OctoMap `.bt` file or built-in
 /// scenario) and whether unknown space counts as occupied.
@@ -139,18 +138,14 @@ impl Map {
         z_range: Option<(f64, f64)>,
     ) -> Bound<'py, PyArray2<f64>> {
         let (lo, hi) = z_range.unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
-        let centres: Vec<f64> = self
+        let centres = self
             .grid
             .known_voxels()
             .filter(|&(_, occupied)| occupied)
             .map(|(i, _)| self.grid.voxel_center(i))
             .filter(|c| (lo..=hi).contains(&c[2]))
-            .flat_map(|c| [c.x, c.y, c.z])
-            .collect();
-        let rows = centres.len() / 3;
-        Array2::from_shape_vec((rows, 3), centres)
-            .expect("three numbers per voxel")
-            .into_pyarray(py)
+            .map(|c| [c.x, c.y, c.z]);
+        points_array(py, centres)
     }
 
     /// What one unit's depth sensor measures in this map (the truth, exactly, as `arc
@@ -193,14 +188,9 @@ impl Map {
             let scan = raycast::scan(&self.grid, &sensor, &pose);
             PointCloud::from_scan(&scan, self.grid.resolution())
         });
-        let mut points = Array2::<f64>::zeros((cloud.points.len(), 3));
-        for (k, p) in cloud.points.iter().enumerate() {
-            for j in 0..3 {
-                points[[k, j]] = f64::from(p[j]);
-            }
-        }
+        let points = cloud.points.iter().map(|p| p.map(f64::from));
         let origin = cloud.origin.map(f64::from).to_vec().into_pyarray(py);
-        Ok((origin, points.into_pyarray(py), sensor.max_range))
+        Ok((origin, points_array(py, points), sensor.max_range))
     }
 
     fn __repr__(&self) -> String {

@@ -5,7 +5,6 @@
 //! simulated run.
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicUsize;
 
 use nalgebra::Point3;
 use numpy::ndarray::{Array1, Array2};
@@ -14,15 +13,13 @@ use pyo3::prelude::*;
 
 use aerial_chain::online::{self, Trigger};
 use aerial_chain::plan_file::{MapSection, Waypoint};
-use aerial_chain::planning::PlanOptions;
 use aerial_chain::sensing::survey::DEFAULT_RATE_HZ;
 use aerial_chain::sensing::PointCloud;
-use aerial_chain::tables::ShapeTables;
 
-use crate::explore::settings;
+use crate::explore::{arc_tables, settings};
 use crate::map::Map;
 use crate::plan::{chain_and_query, Asked, Plan};
-use crate::{err, json_to_py, ExploreError};
+use crate::{err, json_to_py, points_array, ExploreError};
 
 /// The online planner of a chain flying into the unknown (docs/online.md): what is
 /// committed always lies in space seen free and ends at rest; the route to the goal
@@ -140,12 +137,9 @@ impl OnlinePlanner {
         )?;
         let start = Waypoint::new(query.start.into(), &query.start_shape).zeta;
         let inner = py.detach(|| {
-            let table_settings = PlanOptions::default().table_settings();
-            let tables = ShapeTables::build(params, &table_settings, &AtomicUsize::new(0))
-                .map_err(|e| err::<ExploreError>(format!("shape tables: {e}")))?;
             online::OnlinePlanner::new(
                 params,
-                tables,
+                arc_tables(params)?,
                 &start,
                 query.goal,
                 query.goal_tol,
@@ -327,13 +321,10 @@ impl OnlinePlanner {
     #[getter]
     fn route<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
         let route = self.inner.route()?;
-        let mut a = Array2::<f64>::zeros((route.points.len(), 3));
-        for (k, p) in route.points.iter().enumerate() {
-            for j in 0..3 {
-                a[[k, j]] = p[j];
-            }
-        }
-        Some(a.into_pyarray(py))
+        Some(points_array(
+            py,
+            route.points.iter().map(|p| [p.x, p.y, p.z]),
+        ))
     }
 
     /// Pieces committed so far (turns to look included).

@@ -373,6 +373,14 @@ pub fn explore(
     let rest = planner.committed().clone();
     let obstacles = MapClearance::new(truth, &params);
     let run = FlightRun::start(ChainModel::new(params), rest, &cfg, Some(&obstacles), 0)?;
+    // What a map known before the flight holds was seen before it.
+    let occupied_at = planner
+        .belief()
+        .seen()
+        .voxels()
+        .filter(|(_, cell)| *cell == Cell::Occupied)
+        .map(|(v, _)| (v, 0.0))
+        .collect();
     let mut lp = Loop {
         truth,
         settings,
@@ -384,14 +392,8 @@ pub fn explore(
         pending: None,
         sensing: SensingStats::default(),
         goal,
-        occupied_at: HashMap::new(),
+        occupied_at,
     };
-    // What a map known before the flight holds was seen before it.
-    let known = lp.planner.belief().seen().voxels();
-    lp.occupied_at = known
-        .filter(|(_, cell)| *cell == Cell::Occupied)
-        .map(|(v, _)| (v, 0.0))
-        .collect();
     let end = lp.fly()?;
     lp.finish(end, start)
 }

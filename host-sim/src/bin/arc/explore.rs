@@ -179,13 +179,14 @@ fn known(path: &Path, world: &Grid) -> Result<Grid, CliError> {
 /// The online planner's settings: a flag given on the command line (`given`), else
 /// the settings file (`--settings`) where it sets the value, else the default.
 fn online(a: &ExploreArgs, given: &Given) -> Result<OnlineSettings, CliError> {
-    let Some((text, name, keys)) = settings_text(a.settings.as_ref())? else {
-        let mut s = OnlineSettings::from_file(&ExploreSettingsFile::default(), a.clearance);
-        (s.deadline_s, s.start_free) = (a.deadline, a.start_free);
-        return Ok(s);
+    let (file, name, keys) = match settings_text(a.settings.as_ref())? {
+        Some((text, name, keys)) => {
+            let file = ExploreSettingsFile::parse(&text, &name)
+                .map_err(|e| CliError::input(e.to_string()))?;
+            (file, Some(name), keys)
+        }
+        None => Default::default(),
     };
-    let file =
-        ExploreSettingsFile::parse(&text, &name).map_err(|e| CliError::input(e.to_string()))?;
     let mut s = OnlineSettings::from_file(&file, a.clearance);
     let flag = |id: &str, key: &str| given.contains(id) || !keys.contains(&format!("online.{key}"));
     if flag("deadline", "deadline_s") {
@@ -194,9 +195,11 @@ fn online(a: &ExploreArgs, given: &Given) -> Result<OnlineSettings, CliError> {
     if flag("start_free", "start_free") {
         s.start_free = a.start_free;
     }
-    check_planner(&s.plan.planner, &|_, field| {
-        format!("{name}: planner.{field}")
-    })?;
+    if let Some(name) = name {
+        check_planner(&s.plan.planner, &|_, field| {
+            format!("{name}: planner.{field}")
+        })?;
+    }
     Ok(s)
 }
 

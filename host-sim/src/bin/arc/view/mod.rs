@@ -122,13 +122,12 @@ pub fn run(a: ViewArgs) -> CliResult {
         Region::Near(&path, a.near)
     };
     let boxes = scene::boxes(&loaded.grid, &region, a.max_boxes);
-    let seen = match (&seen, &a.flight) {
-        (Some(s), Some(p)) => Some(
-            scene::seen_boxes(&loaded.grid, s, &region, a.max_boxes)
-                .map_err(|e| CliError::input(format!("{}: {e}", crate::fsutil::input_name(p))))?,
-        ),
-        _ => None,
-    };
+    // Only a flight file holds an exploration's record.
+    let flight_name = a.flight.as_deref().map(crate::fsutil::input_name);
+    let seen = seen
+        .map(|s| scene::seen_boxes(&loaded.grid, &s, &region, a.max_boxes))
+        .transpose()
+        .map_err(|e| CliError::input(format!("{}: {e}", flight_name.unwrap_or_default())))?;
     let title = match &a.flight {
         Some(f) => format!(
             "{plan_name} and flight {} on {}",
