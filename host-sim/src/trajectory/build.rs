@@ -25,7 +25,10 @@
 //! What a blend or a merge can break is the chain's validity (the map, self-collision,
 //! the bend limit) and the clearance the planner kept: the sampled trajectory is checked
 //! exactly ([`super::check_samples`]), and where the motion is not the plan's own every
-//! body must also keep `Settings::clearance` from the map. A blended corner where the
+//! body must also keep `Settings::clearance` from the map, or as much as the plan's own
+//! edges there keep where that is less (a piece committed beside unknown space keeps
+//! millimetres less than the margin, and no blend of it could keep the margin). A
+//! blended corner where the
 //! check fails is unblended, else a merged motion there gives way a step (a run is
 //! halved, a pair flies less of its translation or comes apart), and the timing is
 //! redone, until the whole passes. Without blends the chain is on the plan's own edges, resting
@@ -40,11 +43,12 @@
 //! the last, so what is kept is a trajectory as valid as the plan, less smooth.
 
 use std::collections::HashSet;
+use std::ops::Range;
 use std::time::Instant;
 
 use aerial_chain_core::ChainParams;
 
-use super::check::{check_with_margin, Violation};
+use super::check::{check_with_margin, move_clearance, Problem, Violation};
 use super::stages::{Stage, Stages};
 use super::{group, merge};
 use super::{Plan, Settings, TrajectoryError, MAX_SAMPLES};
@@ -204,6 +208,9 @@ fn build_leg(
     // What the last round checked: its segments, and the first sample it found wrong.
     let mut last: Option<(Vec<Segment>, usize)> = None;
     let mut stages = Stages::default();
+    // What the plan's own edges keep from the map, measured where a blend needs it.
+    let margin = settings.clearance;
+    let mut kept = Kept::new(&edges, margin);
     // Set by the first round that begins after the deadline: it gives way everywhere.
     let mut cut_short = false;
     // Each round runs the stages in `Stage::ROUND`'s order.
@@ -211,6 +218,7 @@ fn build_leg(
         if !cut_short && deadline.is_some_and(|d| Instant::now() >= d) {
             cut_short = true;
             (edges, turns) = (own.clone(), 0);
+            kept = Kept::new(&edges, margin);
             demands.clear();
             grouping = group::Grouping::new(&edges, l, false, settings);
         }
@@ -241,11 +249,21 @@ fn build_leg(
         let merged_m = motions.merged;
         let reference = Reference::from_segments(params.n(), &waypoints[0], segments);
         let (times, zetas) = sample(&reference, settings.dt)?;
-        let windows = windows(reference.segments(), &blend_m, &merged_m, settings.dt);
+        let spans: Vec<_> = grouping.edge_spans().collect();
+        let windows = windows(
+            reference.segments(),
+            (&blend_m, &merged_m),
+            &spans,
+            settings.dt,
+        );
         let margin = settings.clearance;
-        let required = |t: f64| match windows.iter().any(|w| w.0 <= t && t <= w.1) {
-            true => margin,
-            false => 0.0,
+        let needs: Vec<f64> = windows.iter().map(|w| kept.need(&w.edges)).collect();
+        let required = |t: f64| {
+            let inside = windows.iter().zip(&needs).filter(|(w, _)| w.holds(t));
+            inside
+                .map(|(_, need)| *need)
+                .reduce(f64::min)
+                .unwrap_or(0.0)
         };
         // Samples before the first segment that changed passed last round's check.
         let from = last.as_ref().map_or(0, |(before, bad)| {
@@ -284,6 +302,16 @@ fn build_leg(
         let segs = reference.segments();
         last = Some((segs.to_vec(), v.sample));
         let gave_way = stages.run(Stage::GiveWay, || {
+            // A blend short of the margin may keep what the plan's own edges keep
+            // there: those edges are measured before anything gives way.
+            if matches!(v.problem, Problem::Clearance { .. }) {
+                let t = at(&v, settings.dt);
+                let near = windows.iter().filter(|w| w.holds(t));
+                let edges: Vec<usize> = near.flat_map(|w| w.edges.clone()).collect();
+                if kept.measure(&edges, grid, &params) {
+                    return (true, 0);
+                }
+            }
             if let Some(m) = corner_near(segs, &blend_m, &v, settings.dt) {
                 unblended.insert(starts[m].to_bits());
             } else if let Some(m) = merged_near(segs, &merged_m, &v, settings.dt) {
@@ -300,20 +328,92 @@ fn build_leg(
     }
 }
 
+/// A time where the motion is not the plan's own, and the plan's edges it replaces.
+struct Window {
+    /// From when to when (s).
+    time: (f64, f64),
+    /// The edges (indices into the plan's edges as timed) whose path it leaves.
+    edges: Range<usize>,
+}
+
+impl Window {
+    fn holds(&self, t: f64) -> bool {
+        self.time.0 <= t && t <= self.time.1
+    }
+}
+
 /// The times (one sample either side) where the motion is not the plan's own: the
-/// overlap of every blended corner and every merged motion.
-fn windows(segments: &[Segment], blend: &[bool], merged: &[bool], dt: f64) -> Vec<(f64, f64)> {
+/// overlap of every blended corner (the edges of both motions) and every merged motion
+/// (its edges); `spans` are the edges each motion flies.
+fn windows(
+    segments: &[Segment],
+    (blend, merged): (&[bool], &[bool]),
+    spans: &[Range<usize>],
+    dt: f64,
+) -> Vec<Window> {
     let end = |s: &Segment| s.t0 + s.duration;
     let mut w = Vec::new();
     for (m, s) in segments.iter().enumerate() {
         if blend[m] && m > 0 {
-            w.push((s.t0 - dt, end(&segments[m - 1]) + dt));
+            w.push(Window {
+                time: (s.t0 - dt, end(&segments[m - 1]) + dt),
+                edges: spans[m - 1].start..spans[m].end,
+            });
         }
         if merged[m] {
-            w.push((s.t0 - dt, end(s) + dt));
+            w.push(Window {
+                time: (s.t0 - dt, end(s) + dt),
+                edges: spans[m].clone(),
+            });
         }
     }
     w
+}
+
+/// The clearance from the map each of the plan's edges keeps, capped at the margin,
+/// measured only where a blend or merge fell short of the margin (most plans' blends
+/// never do). A motion that is not the plan's own keeps the margin, or what the edges
+/// it replaces keep where that is less: it comes no closer to the map than the plan
+/// there, nor closer than the margin where the plan keeps it.
+struct Kept {
+    /// Each edge's start and end configuration.
+    moves: Vec<(Vec<f64>, Vec<f64>)>,
+    /// Each edge's clearance once measured.
+    clearance: Vec<Option<f64>>,
+    margin: f64,
+}
+
+impl Kept {
+    fn new(edges: &[Segment], margin: f64) -> Self {
+        Self {
+            moves: edges.iter().map(|s| (s.from.clone(), s.to())).collect(),
+            clearance: vec![None; edges.len()],
+            margin,
+        }
+    }
+
+    /// What a motion replacing `edges` must keep: the margin, or less where an edge
+    /// measured keeps less.
+    fn need(&self, edges: &Range<usize>) -> f64 {
+        let measured = edges
+            .clone()
+            .filter_map(|k| self.clearance.get(k).copied().flatten());
+        measured.fold(self.margin, f64::min)
+    }
+
+    /// Measures those of `edges` not measured yet; whether there were any.
+    fn measure(&mut self, edges: &[usize], grid: &Grid, params: &ChainParams) -> bool {
+        let mut any = false;
+        for &k in edges {
+            if k >= self.clearance.len() || self.clearance[k].is_some() {
+                continue;
+            }
+            let (a, b) = &self.moves[k];
+            self.clearance[k] = Some(move_clearance(grid, params, (a, b), self.margin));
+            any = true;
+        }
+        any
+    }
 }
 
 /// The sample from which a trajectory of `now` segments must be checked again when one

@@ -205,6 +205,42 @@ pub fn check_samples(
     check_with_margin(grid, params, limits, (times, zetas), horizon, &|_| 0.0)
 }
 
+/// The smallest clearance from the map (capped at `horizon`) of any body over the
+/// straight move in `zeta` from `z0` to `z1`, sampled as the check samples an interval;
+/// 0 where a configuration on it is not valid. What a plan's own edge keeps, which a
+/// blend or merge replacing it need not exceed.
+pub(super) fn move_clearance(
+    grid: &Grid,
+    params: &ChainParams,
+    (z0, z1): (&[f64], &[f64]),
+    horizon: f64,
+) -> f64 {
+    // Only the configurations are asked for: no rate between them is a limit's.
+    let unbounded = Limits {
+        speed: f64::INFINITY,
+        accel: f64::INFINITY,
+        angular_rate: f64::INFINITY,
+        angular_accel: f64::INFINITY,
+        yaw_rate: f64::INFINITY,
+        yaw_accel: f64::INFINITY,
+    };
+    let mut c = Checker {
+        grid,
+        params,
+        limits: &unbounded,
+        horizon,
+        required: &|_| 0.0,
+        run: usize::MAX,
+        rep: CheckReport::empty(horizon),
+    };
+    let valid = c.configuration(z0, 0.0).is_ok() && c.interval(z0, z1, 0.0, 1.0).is_ok();
+    if valid {
+        c.rep.min_clearance
+    } else {
+        0.0
+    }
+}
+
 /// [`check_samples`], and every configuration at time `t` must also keep
 /// `required(t)` from the map (the generator's own rule for blends; `horizon` must be at
 /// least as large).

@@ -214,6 +214,13 @@ impl Grouping {
         self.motions.iter().map(|m| m.start)
     }
 
+    /// The edges each motion flies (whole or in part), by index.
+    pub(super) fn edge_spans(&self) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        self.motions
+            .iter()
+            .map(|m| m.start.floor() as usize..m.end.ceil() as usize)
+    }
+
     /// The plan's corners (places where two edges meet) inside merged motions.
     pub(super) fn merged_corners(&self) -> usize {
         self.motions

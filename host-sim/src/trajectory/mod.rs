@@ -168,7 +168,8 @@ pub struct Settings {
     pub blend: bool,
     /// Clearance (m) every body keeps from the map wherever the motion is not the
     /// plan's own (a blend, a merge), so that a controller's tracking error cannot turn
-    /// a shortcut into a contact; the planner's default margin.
+    /// a shortcut into a contact; the planner's default margin. Where the plan's own
+    /// edges there keep less, the motion keeps what they keep: no closer than the plan.
     /// Larger: fewer blends and merges pass, longer flights.
     pub clearance: f64,
     /// How far (m) a run's straight move may carry any unit from where the plan has it

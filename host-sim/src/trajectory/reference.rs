@@ -351,6 +351,15 @@ pub struct Reference {
 }
 
 impl Segment {
+    /// Where it ends: `from` plus `delta` (angles continuous).
+    pub fn to(&self) -> Vec<f64> {
+        self.from
+            .iter()
+            .zip(&self.delta)
+            .map(|(a, d)| a + d)
+            .collect()
+    }
+
     /// Whether the chain rests through it.
     pub fn is_hold(&self) -> bool {
         self.kind == SegmentKind::Hold

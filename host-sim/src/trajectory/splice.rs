@@ -17,12 +17,13 @@
 //! again ([`Joint::until`]) it is new: those samples are checked exactly on the map
 //! given (the online planner's: unknown space occupied), and wherever the motion
 //! leaves both pieces' paths (the overlap) every body keeps the trajectory settings'
-//! clearance from the map, as a blend of one plan does.
+//! clearance from the map, or what the two motions keep there where that is less, as a
+//! blend of one plan does.
 
 use aerial_chain_core::ChainParams;
 
 use super::build::{ramp_length, FIT_UNDERSHOOT};
-use super::check::{check_with_margin, Violation};
+use super::check::{check_with_margin, move_clearance, Problem, Violation};
 use super::reference::{same_configuration, Reference, Scaling, Segment};
 use super::Settings;
 use crate::map::Grid;
@@ -220,7 +221,7 @@ fn retimed(s: &Segment, t0: f64, scaling: Scaling) -> Segment {
 /// Checks the new part of `reference` at `joint` exactly on `grid`: from `take_by` to
 /// `until` (a sample beyond each), sampled every `settings.dt`, within the limits;
 /// within the blend (a sample either side) every body keeps `settings.clearance` from
-/// the map. What a join is checked by, and what an audit of a flown motion checks again.
+/// the map, or what the motions the blend joins keep on their own where that is less. What a join is checked by, and what an audit of a flown motion checks again.
 pub fn check_joint(
     reference: &Reference,
     params: &ChainParams,
@@ -235,22 +236,41 @@ pub fn check_joint(
     let times: Vec<f64> = (0..count).map(|j| start + j as f64 * dt).collect();
     let zetas: Vec<Vec<f64>> = times.iter().map(|&t| reference.zeta(t)).collect();
     let margin = settings.clearance;
-    let required = |t: f64| match blend.0 - dt <= t && t <= blend.1 + dt {
-        true => margin,
-        false => 0.0,
+    let check = |need: f64| {
+        let required = |t: f64| match blend.0 - dt <= t && t <= blend.1 + dt {
+            true => need,
+            false => 0.0,
+        };
+        let lim = &settings.limits;
+        check_with_margin(grid, params, lim, (&times, &zetas), margin, &required).violation
     };
-    let rep = check_with_margin(
-        grid,
-        params,
-        &settings.limits,
-        (&times, &zetas),
-        margin,
-        &required,
-    );
-    match rep.violation {
+    match check(margin) {
+        // Short of the margin, the blend may keep what the two pieces' own motions
+        // there keep (a blend of one plan's rule).
+        Some(v) if matches!(v.problem, Problem::Clearance { .. }) => {
+            match check(blended_kept(reference, params, grid, blend, margin)) {
+                Some(v) => Err(v),
+                None => Ok(()),
+            }
+        }
         Some(v) => Err(v),
         None => Ok(()),
     }
+}
+
+/// The smallest clearance (capped at `margin`) of the straight moves of `reference`
+/// whose time overlaps `blend`: what the motions the blend joins keep on their own.
+fn blended_kept(
+    reference: &Reference,
+    params: &ChainParams,
+    grid: &Grid,
+    blend: (f64, f64),
+    margin: f64,
+) -> f64 {
+    let overlaps = |s: &&Segment| s.t0 <= blend.1 && blend.0 <= s.t0 + s.duration;
+    let kept = |s: &Segment| move_clearance(grid, params, (&s.from, &s.to()), margin);
+    let segments = reference.segments().iter().filter(overlaps);
+    segments.map(kept).fold(margin, f64::min)
 }
 
 #[cfg(test)]

@@ -208,3 +208,33 @@ fn a_joint_whose_ramps_cannot_fit_or_that_would_be_slower_is_refused() {
     );
     assert_eq!(refused.unwrap_err(), NoSplice::Elsewhere);
 }
+
+#[test]
+fn a_joint_beside_a_wall_the_pieces_keep_close_keeps_what_they_keep() {
+    let (params, s) = (ChainParams::new(3), Settings::default());
+    // The bodies pass the wall's face at 3 cm, less than the 5 cm margin.
+    let mut grid = room();
+    grid.fill_box([0.51, 1.21, 0.51], [3.49, 1.29, 1.49], Cell::Occupied);
+    let a = piece(&params, &grid, [1.5, 1.02, 1.0], [2.3, 1.02, 1.0]);
+    let b = piece(&params, &grid, [2.3, 1.02, 1.0], [3.3, 1.02, 1.0]);
+    let j = splice(a.reference(), b.reference(), &params, &grid, &s, 0.0).unwrap();
+    let (t, z) = crate::trajectory::build::sample(&j.reference, s.dt).unwrap();
+    let rep = crate::trajectory::check_samples(&grid, &params, &s.limits, &t, &z, 1.0);
+    assert!(rep.ok, "{:?}", rep.violation);
+    assert!(
+        (rep.min_clearance - 0.03).abs() < 1e-6,
+        "{}",
+        rep.min_clearance
+    );
+    // Rounding a corner closer to a voxel than the pieces pass it is still refused:
+    // the pieces keep 3.5 cm, the rounded joint would lift the tail to 1.5 cm.
+    let mut blocked = room();
+    blocked.fill_box([1.61, 0.51, 1.21], [1.69, 1.49, 1.29], Cell::Occupied);
+    let a = piece(&params, &blocked, [1.6, 1.0, 1.015], [2.955, 1.0, 1.015]);
+    let b = piece(&params, &blocked, [2.955, 1.0, 1.015], [2.955, 1.0, 1.8]);
+    let refused = splice(a.reference(), b.reference(), &params, &blocked, &s, 0.0);
+    assert!(
+        matches!(&refused, Err(NoSplice::Inadmissible(v)) if matches!(v.problem, crate::trajectory::Problem::Clearance { .. })),
+        "{refused:?}"
+    );
+}

@@ -20,7 +20,8 @@ pub enum Stage {
     /// the first sample a change since the last round can reach.
     Check,
     /// Where the check failed: a blended corner unblended, or a merged motion giving
-    /// way a step (`super::group`).
+    /// way a step (`super::group`); where it failed on the clearance a blend keeps,
+    /// first the plan's own edges there measured (a blend keeps no more than they do).
     GiveWay,
 }
 

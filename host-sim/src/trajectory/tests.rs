@@ -187,12 +187,18 @@ fn blended_tour_keeps_every_limit_and_is_faster() {
 /// Head along +x, then up: the chain's tail rounds the corner below a voxel that the
 /// plan's own edges pass at 5 mm.
 fn corner(params: &ChainParams) -> Plan {
+    corner_below(params, 0.0)
+}
+
+/// `corner` flown `drop` (m) lower.
+fn corner_below(params: &ChainParams, drop: f64) -> Plan {
     let s = Shape::line(3, 0.0);
+    let z = 1.045 - drop;
     plan(
         params,
         &[
-            ([1.6, 1.0, 1.045], s),
-            ([2.955, 1.0, 1.045], s),
+            ([1.6, 1.0, z], s),
+            ([2.955, 1.0, z], s),
             ([2.955, 1.0, 1.8], s),
         ],
     )
@@ -600,4 +606,81 @@ fn runs_of_short_steps_may_cut_their_corners_by_more() {
     // change and translation fly as a pair).
     let long = built(&arc_follow(0.6, 0.3, 3), &grid);
     assert_eq!(long.corners() + 1 - long.merged(), 3);
+}
+
+/// The smallest clearance any body keeps along the plan's own edges (the verifier's,
+/// which knows nothing of the generator), and along the trajectory's samples.
+fn plan_and_flown_clearance(grid: &Grid, plan: &Plan, tr: &Trajectory) -> (f64, f64) {
+    let own = crate::collision::verify::verify_plan(grid, plan);
+    assert!(own.ok, "{:?}", own.violation);
+    let params = *tr.params();
+    let lim = &tr.settings().limits;
+    let flown = check_samples(grid, &params, lim, tr.times(), tr.zetas(), 1.0);
+    assert!(flown.ok, "{:?}", flown.violation);
+    (own.min_clearance, flown.min_clearance)
+}
+
+/// Three units along +x beside a wall whose face the bodies pass at 3 cm, less than
+/// the 5 cm margin: the plan's two edges lie on one line.
+fn along_a_close_wall(params: &ChainParams) -> (Plan, Grid) {
+    let s = Shape::line(3, 0.0);
+    let plan = plan(
+        params,
+        &[
+            ([1.6, 1.02, 1.0], s),
+            ([2.3, 1.02, 1.0], s),
+            ([3.0, 1.02, 1.0], s),
+        ],
+    );
+    let mut grid = room();
+    grid.fill_box([0.51, 1.21, 0.51], [3.49, 1.29, 1.49], Cell::Occupied);
+    (plan, grid)
+}
+
+#[test]
+fn a_blend_beside_a_wall_the_plan_keeps_close_keeps_what_the_plan_keeps() {
+    let params = ChainParams::new(3);
+    let (plan, grid) = along_a_close_wall(&params);
+    let tr = built(&plan, &grid);
+    // Straight on: the corner is flown without a stop, as in a free room.
+    assert_eq!(
+        tr.blended() + tr.merged(),
+        1,
+        "the corner is not flown through"
+    );
+    let free = built(&plan, &room());
+    assert!((tr.duration() - free.duration()).abs() < 1e-9);
+    let (own, flown) = plan_and_flown_clearance(&grid, &plan, &tr);
+    assert!((own - 0.03).abs() < 1e-6, "the plan keeps {own}");
+    assert!(flown >= own - 1e-9, "flown {flown} < the plan's {own}");
+}
+
+#[test]
+fn a_blend_that_comes_closer_than_the_plan_below_the_margin_is_not_flown() {
+    let params = ChainParams::new(3);
+    // The corner of `corner` 3 cm lower, its voxel 10 cm further back: the plan's own
+    // edges keep 3.5 cm from it, and the rounded corner lifts the tail closer.
+    let mut grid = room();
+    grid.fill_box([1.61, 0.51, 1.21], [1.69, 1.49, 1.29], Cell::Occupied);
+    let plan = corner_below(&params, 0.03);
+    let tr = built(&plan, &grid);
+    assert_eq!(
+        tr.blended(),
+        0,
+        "the rounded corner comes closer than the plan"
+    );
+    let (own, flown) = plan_and_flown_clearance(&grid, &plan, &tr);
+    assert!(own < Settings::default().clearance, "the plan keeps {own}");
+    assert!(flown >= own - 1e-9, "flown {flown} < the plan's {own}");
+    // Blended, it would keep less than the plan: the rule, not the map, refuses it.
+    let free = built(&plan, &room());
+    assert_eq!(free.blended(), 1);
+    let lim = &free.settings().limits;
+    let blended = check_samples(&grid, &params, lim, free.times(), free.zetas(), 1.0);
+    assert!(blended.ok, "{:?}", blended.violation);
+    assert!(
+        blended.min_clearance < own,
+        "{} >= {own}",
+        blended.min_clearance
+    );
 }
