@@ -28,10 +28,9 @@
 //! body must also keep `Settings::clearance` from the map, or as much as the plan's own
 //! edges there keep where that is less (a piece committed beside unknown space keeps
 //! millimetres less than the margin, and no blend of it could keep the margin). A
-//! blended corner where the
-//! check fails is unblended, else a merged motion there gives way a step (a run is
-//! halved, a pair flies less of its translation or comes apart), and the timing is
-//! redone, until the whole passes. Without blends the chain is on the plan's own edges, resting
+//! blended corner where the check fails is unblended, else a merged motion there gives
+//! way a step (a run is halved, a pair flies less of its translation or comes apart),
+//! and the timing is redone, until the whole passes. Without blends the chain is on the plan's own edges, resting
 //! on a sample at every waypoint, so only a plan that is itself inadmissible fails.
 //!
 //! With blends, a turn of the head yaw alone first runs during the edges before it
@@ -256,7 +255,6 @@ fn build_leg(
             &spans,
             settings.dt,
         );
-        let margin = settings.clearance;
         let needs: Vec<f64> = windows.iter().map(|w| kept.need(&w.edges)).collect();
         let required = |t: f64| {
             let inside = windows.iter().zip(&needs).filter(|(w, _)| w.holds(t));

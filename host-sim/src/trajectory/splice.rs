@@ -221,7 +221,8 @@ fn retimed(s: &Segment, t0: f64, scaling: Scaling) -> Segment {
 /// Checks the new part of `reference` at `joint` exactly on `grid`: from `take_by` to
 /// `until` (a sample beyond each), sampled every `settings.dt`, within the limits;
 /// within the blend (a sample either side) every body keeps `settings.clearance` from
-/// the map, or what the motions the blend joins keep on their own where that is less. What a join is checked by, and what an audit of a flown motion checks again.
+/// the map, or what the motions the blend joins keep on their own where that is less.
+/// What a join is checked by, and what an audit of a flown motion checks again.
 pub fn check_joint(
     reference: &Reference,
     params: &ChainParams,
