@@ -159,7 +159,7 @@ pub fn run(a: ViewArgs) -> CliResult {
             "{plan_name}: {} waypoints, {} obstacle boxes of {} m{}; wrote {} ({} kB)",
             plan.waypoints.len(),
             (scene.boxes.occupied.len() + scene.boxes.unknown.len()) / 3,
-            scene.boxes.size,
+            scene.boxes.lattice.size,
             match (&scene.flight, &scene.seen) {
                 (Some(_), Some(s)) => format!(
                     ", with the flight and the {} boxes its sensors saw as it grew",

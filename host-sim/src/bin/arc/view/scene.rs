@@ -37,31 +37,49 @@ pub struct Scene {
     pub seen: Option<Seen>,
 }
 
-/// The occupied voxels an exploration's sensors saw, in the order they were seen: box
-/// `k` (centre `origin + size * boxes[3k..3k+3]`) appears at time `t[k]`.
+/// The lattice of boxes of `scale` voxels a side: box index `(i, j, k)` has its centre
+/// at `origin + size * (i, j, k)`. Written flat into the box sets below.
 #[derive(Serialize)]
-pub struct Seen {
-    /// Edge of one box (m): the voxel edge times `scale`.
-    pub size: f64,
-    /// Voxels per box edge, as for [`Boxes`].
-    pub scale: i32,
-    /// Centre of box index `(0, 0, 0)` (m).
-    pub origin: [f64; 3],
-    /// Box indices `[i, j, k, ...]`, ordered by `t`.
-    pub boxes: Vec<i32>,
-    /// When each box was first seen holding an occupied voxel (s).
-    pub t: Vec<f64>,
-}
-
-/// Obstacle boxes: box `k` has its centre at `origin + size * index_k`.
-#[derive(Serialize)]
-pub struct Boxes {
+pub struct BoxLattice {
     /// Edge of one box (m): the voxel edge times `scale`.
     pub size: f64,
     /// Voxels per box edge (1 unless the map was thinned to stay light).
     pub scale: i32,
     /// Centre of box index `(0, 0, 0)` (m).
     pub origin: [f64; 3],
+}
+
+impl BoxLattice {
+    /// Boxes of `scale` voxels a side on `grid`'s lattice.
+    fn of(grid: &Grid, scale: i32) -> Self {
+        let half = (f64::from(scale) - 1.0) * grid.resolution() / 2.0;
+        Self {
+            size: grid.resolution() * f64::from(scale),
+            scale,
+            origin: grid.voxel_center([0, 0, 0]).map(|c| c + half).into(),
+        }
+    }
+}
+
+/// The occupied voxels an exploration's sensors saw, in the order they were seen: box
+/// `k` (indices `boxes[3k..3k+3]` on the lattice) appears at time `t[k]`.
+#[derive(Serialize)]
+pub struct Seen {
+    /// Where the boxes lie.
+    #[serde(flatten)]
+    pub lattice: BoxLattice,
+    /// Box indices `[i, j, k, ...]`, ordered by `t`.
+    pub boxes: Vec<i32>,
+    /// When each box was first seen holding an occupied voxel (s).
+    pub t: Vec<f64>,
+}
+
+/// Obstacle boxes on a lattice.
+#[derive(Serialize)]
+pub struct Boxes {
+    /// Where the boxes lie.
+    #[serde(flatten)]
+    pub lattice: BoxLattice,
     /// Box indices `[i, j, k, ...]` of boxes holding an occupied voxel.
     pub occupied: Vec<i32>,
     /// Box indices of boxes holding only unknown voxels counted as obstacles.
@@ -295,9 +313,7 @@ pub fn boxes(grid: &Grid, region: &Region<'_>, max_boxes: usize) -> Boxes {
         if occ { &mut occupied } else { &mut unknown }.extend(b);
     }
     Boxes {
-        size: grid.resolution() * f64::from(scale),
-        scale,
-        origin: box_origin(grid, scale),
+        lattice: BoxLattice::of(grid, scale),
         occupied,
         unknown,
     }
@@ -332,9 +348,7 @@ pub fn seen_boxes(
     let mut timed: Vec<(f64, [i32; 3])> = merged.into_iter().map(|(b, t)| (t, b)).collect();
     timed.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     Ok(Seen {
-        size: grid.resolution() * f64::from(scale),
-        scale,
-        origin: box_origin(grid, scale),
+        lattice: BoxLattice::of(grid, scale),
         boxes: timed.iter().flat_map(|(_, b)| *b).collect(),
         t: timed.iter().map(|(t, _)| mm(*t)).collect(),
     })
@@ -361,12 +375,6 @@ fn merge<T: Copy>(
         }
         scale *= 2;
     }
-}
-
-/// Centre of box `(0, 0, 0)` of boxes `scale` voxels a side on `grid`'s lattice.
-fn box_origin(grid: &Grid, scale: i32) -> [f64; 3] {
-    let half = (f64::from(scale) - 1.0) * grid.resolution() / 2.0;
-    grid.voxel_center([0, 0, 0]).map(|c| c + half).into()
 }
 
 /// Which voxels a [`Region`] keeps: those whose centres lie in the cubes next to its
