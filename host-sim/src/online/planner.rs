@@ -496,6 +496,10 @@ impl OnlinePlanner {
         candidates.dedup();
         let r_v = self.belief.route_field().grid().resolution();
         let count = candidates.len();
+        // A piece found ends the search, so its timing may use what is left of the
+        // whole deadline, not only its own share of it: cut short, a trajectory gives
+        // way everywhere and flies the piece stop and go.
+        let until = began.checked_add(Duration::from_secs_f64(self.deadline()));
         for (tried, k) in candidates.into_iter().enumerate() {
             let final_piece = k == last;
             let (goal, tol) = match final_piece {
@@ -513,7 +517,7 @@ impl OnlinePlanner {
                 break;
             }
             let look = (!final_piece).then(|| self.look_yaw(&route, k));
-            if let Some(piece) = self.plan_piece(goal, tol, look, deadline) {
+            if let Some(piece) = self.plan_piece(goal, tol, look, deadline, until) {
                 let m = piece.trajectory.head_path_m();
                 self.push(piece);
                 self.looked_at_hull = false;
@@ -580,17 +584,18 @@ impl OnlinePlanner {
 
     /// Plans a piece from the committed end to within `tol` of `goal`, on the map with
     /// unknown space occupied; where `look` lies out of the sensors' middle view, the
-    /// piece ends by turning the head yaw to it (a head yaw moves no body); timed and
-    /// checked on that map.
+    /// piece ends by turning the head yaw to it (a head yaw moves no body); searched
+    /// within `deadline` (s), then timed (its blends until `until`) and checked on
+    /// that map.
     fn plan_piece(
         &mut self,
         goal: Point3<f64>,
         tol: f64,
         look: Option<f32>,
         deadline: f64,
+        until: Option<Instant>,
     ) -> Option<Piece> {
         self.searches += 1;
-        let stop = Instant::now().checked_add(Duration::from_secs_f64(deadline));
         let shape = Shape::from_slice(self.params.units, &eta(&self.end)).ok()?;
         let mut query = Query::new(head(&self.end), shape, goal);
         query.goal_tol = tol;
@@ -617,7 +622,7 @@ impl OnlinePlanner {
                 });
             }
         }
-        self.timed(plan, request.grid(), stop)
+        self.timed(plan, request.grid(), until)
     }
 
     /// `plan` as a piece: timed (its blending rounds stopped at `deadline`) and checked
