@@ -207,6 +207,17 @@ mod tests {
         ids
     }
 
+    /// The binned search's answer for every point is what reading every point finds.
+    fn matches_brute_force(points: &[[f64; 3]], r: f64, k: usize) -> Result<(), TestCaseError> {
+        let got = nearest_within(points, r, k, |_| true);
+        prop_assert_eq!(got.len(), points.len());
+        for (i, mut near) in got.into_iter().enumerate() {
+            near.sort_unstable();
+            prop_assert_eq!(near, brute(points, i, r, k), "point {}", i);
+        }
+        Ok(())
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(200))]
 
@@ -224,13 +235,7 @@ mod tests {
                 .iter()
                 .map(|p| [p[0] * stretch[0], p[1] * stretch[1], p[2] * stretch[2]])
                 .collect();
-            let got = nearest_within(&points, r, k, |_| true);
-            prop_assert_eq!(got.len(), points.len());
-            for (i, near) in got.into_iter().enumerate() {
-                let mut near = near;
-                near.sort_unstable();
-                prop_assert_eq!(near, brute(&points, i, r, k), "point {}", i);
-            }
+            matches_brute_force(&points, r, k)?;
         }
     }
 
@@ -247,12 +252,7 @@ mod tests {
             r in 0.5f64..3.0,
             k in 1usize..40,
         ) {
-            let got = nearest_within(&points, r, k, |_| true);
-            for (i, near) in got.into_iter().enumerate() {
-                let mut near = near;
-                near.sort_unstable();
-                prop_assert_eq!(near, brute(&points, i, r, k), "point {}", i);
-            }
+            matches_brute_force(&points, r, k)?;
         }
     }
 
