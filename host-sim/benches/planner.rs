@@ -1,6 +1,7 @@
 //! Criterion benches of the planner's parts: the uniform head roadmap's build on
-//! `window` and on a seen room of it, one ARCplanner query on `window` with N = 5, batches of translation and shape-change
-//! checks, and the full-state PRM's roadmap build for comparison.
+//! `window` and on a seen room of it, one ARCplanner query on `window` with N = 5,
+//! batches of translation and shape-change checks, and the full-state PRM's roadmap
+//! build for comparison.
 //!
 //! `cargo bench -p aerial-chain --bench planner`
 
@@ -29,8 +30,8 @@ fn window(units: u8) -> (Scenario, CollisionContext, ShapeTables) {
     (sc, ctx, tables)
 }
 
-fn planner(ctx: &CollisionContext, tables: &ShapeTables) -> ArcPlanner {
-    ArcPlanner::new(ctx.clone(), tables.clone(), Settings::default()).expect("same chain")
+fn planner(ctx: &CollisionContext, tables: &ShapeTables, settings: &Settings) -> ArcPlanner {
+    ArcPlanner::new(ctx.clone(), tables.clone(), settings.clone()).expect("same chain")
 }
 
 /// The uniform head roadmap's 1500 vertices (the paper's planner: with the head
@@ -57,7 +58,7 @@ fn roadmap_build(c: &mut Criterion) {
     for (name, ctx) in [("window", &ctx), ("seen_room", &seen)] {
         g.bench_function(format!("roadmap_build/{name}_1500"), |b| {
             b.iter_batched(
-                || ArcPlanner::new(ctx.clone(), tables.clone(), settings.clone()).expect("chain"),
+                || planner(ctx, &tables, &settings),
                 |mut p| {
                     p.setup(&query, Termination::default());
                     p
@@ -78,7 +79,7 @@ fn query_and_prm(c: &mut Criterion) {
     g.bench_function("solve/window_n5", |b| {
         b.iter_batched(
             || {
-                let mut p = planner(&ctx, &tables);
+                let mut p = planner(&ctx, &tables, &Settings::default());
                 p.setup(&query, Termination::default());
                 p
             },

@@ -35,8 +35,8 @@ pub struct OnlineSettings {
     pub trajectory: crate::trajectory::Settings,
     /// Wall time a replan may take (s): what a piece's search and post-processing
     /// get, shared among the targets it tries, and what is left of it the found
-    /// piece's timing. Longer finds pieces through harder places; shorter keeps the chain from
-    /// waiting for its next piece. Default 0.3 s.
+    /// piece's timing. Longer finds pieces through harder places; shorter keeps the
+    /// chain from waiting for its next piece. Default 0.3 s.
     pub deadline_s: f64,
     /// Period of the route's replans when nothing cuts it (s): how soon a shortcut
     /// that sensing opened is taken; also how long a chain at rest that finds no piece

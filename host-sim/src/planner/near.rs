@@ -4,12 +4,13 @@
 //! in cubes and each point reads the cubes about its own ring by ring (the cubes at
 //! Chebyshev distance 0, 1, 2, ... in cube steps), stopping as soon as `k` of the
 //! points read lie nearer than any point not yet read can, or every cube within `r_T`
-//! is read. The cubes are half as wide as the ball that holds `k` points at the
-//! points' mean density, so two or three rings hold a point's `k` nearest, whatever
+//! is read. The cubes' edge is half the radius of the ball that holds `k` points at
+//! the points' mean density, so two or three rings hold a point's `k` nearest, whatever
 //! the density: where the points are sparse the cubes are `r_T` wide and one ring (the
 //! 27 cubes about a point's own) holds every point within `r_T`; where they are dense
 //! (a roadmap sampled in the few cubic metres an online piece has seen free, hundreds
-//! of vertices within `r_T` of each) reading those 27 cubes read nearly every point.
+//! of vertices within `r_T` of each) the cubes shrink, where reading the 27 cubes of
+//! edge `r_T` about each point would read nearly every point.
 //! `cargo bench --bench planner -- roadmap_build`: the whole roadmap's build took 4.1
 //! ms where reading the 27 `r_T` cubes took 6.7 ms on `window`, and 6.5 ms against
 //! 15.5 ms on a seen room of it. (Reading cubes in order is cheaper than a k-d tree's
@@ -94,7 +95,7 @@ impl Bins {
     /// runs of `items` (the cubes along x are adjacent in it): passed to `f`.
     fn ring(&self, c: [usize; 3], m: usize, mut f: impl FnMut(&[u32])) {
         let span = |a: usize| c[a].saturating_sub(m)..=(c[a] + m).min(self.dims[a] - 1);
-        let (x0, x1) = (c[0].saturating_sub(m), (c[0] + m).min(self.dims[0] - 1));
+        let (x0, x1) = span(0).into_inner();
         for z in span(2) {
             for y in span(1) {
                 if z.abs_diff(c[2]) == m || y.abs_diff(c[1]) == m {

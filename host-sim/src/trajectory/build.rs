@@ -30,8 +30,9 @@
 //! millimetres less than the margin, and no blend of it could keep the margin). A
 //! blended corner where the check fails is unblended, else a merged motion there gives
 //! way a step (a run is halved, a pair flies less of its translation or comes apart),
-//! and the timing is redone, until the whole passes. Without blends the chain is on the plan's own edges, resting
-//! on a sample at every waypoint, so only a plan that is itself inadmissible fails.
+//! and the timing is redone, until the whole passes. Without blends the chain is on
+//! the plan's own edges, resting on a sample at every waypoint, so only a plan that is
+//! itself inadmissible fails.
 //!
 //! With blends, a turn of the head yaw alone first runs during the edges before it
 //! (`super::turns`): the yaw moves no body, so the bodies still move as the plan's
