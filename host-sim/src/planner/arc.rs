@@ -239,8 +239,12 @@ impl ArcPlanner {
             self.settings.clearance_weight,
             self.ctx.params().reach() as f64 / 2.0,
         );
-        let r_t =
-            self.settings.r_t * (self.settings.vertices as f64 / vertices.max(1) as f64).cbrt();
+        // An empty roadmap samples nothing to keep neighbours with: its radius only
+        // joins the query vertices to each other, as near as on the uniform roadmap.
+        let r_t = match vertices {
+            0 => self.settings.r_t,
+            n => self.settings.r_t * (self.settings.vertices as f64 / n as f64).cbrt(),
+        };
         let near = (r_t, self.settings.max_neighbours);
         Roadmap::build(&self.ctx, vertices, near, weight, &mut rng, deadline)
     }
@@ -727,5 +731,44 @@ impl SolutionStats for Stats {
                 serde_json::json!(<[f64; 3]>::from(at)),
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::AtomicUsize;
+    use std::sync::Arc;
+
+    use aerial_chain_core::ChainParams;
+
+    use super::*;
+    use crate::collision::DEFAULT_CLEARANCE;
+    use crate::map::DistanceField;
+    use crate::problem::scenarios;
+    use crate::tables::TableSettings;
+
+    /// The route-only roadmap (nothing sampled) joins its query vertices as the
+    /// uniform one does, within `r_T`: a start and a goal farther apart are joined only
+    /// by the head route the query adds, so the construction flies the route rather
+    /// than a straight edge to the goal that the route bends away from.
+    #[test]
+    fn an_empty_roadmap_joins_query_vertices_only_within_r_t() {
+        let sc = scenarios::build("window").unwrap();
+        let params = ChainParams::new(3);
+        let small = TableSettings {
+            srs: 60,
+            ..TableSettings::default()
+        };
+        let tables = ShapeTables::build(params, &small, &AtomicUsize::new(0)).unwrap();
+        let field = Arc::new(DistanceField::new(sc.grid.clone()));
+        let ctx = CollisionContext::new(field, params, DEFAULT_CLEARANCE).unwrap();
+        let planner = ArcPlanner::new(ctx, tables, Settings::default()).unwrap();
+        let r_t = planner.settings.r_t;
+        let mut roadmap = planner.sampled_roadmap(0, None);
+        let start = roadmap.add_query_vertex([2.0, 1.0, 1.5]);
+        let far = roadmap.add_query_vertex([2.0, 1.0 + 2.0 * r_t, 1.5]);
+        let near = roadmap.add_query_vertex([2.0, 1.0 + 0.5 * r_t, 1.5]);
+        assert!(roadmap.cost_to_go(&[near])[start].is_finite());
+        assert!(!roadmap.cost_to_go(&[far])[start].is_finite());
     }
 }
