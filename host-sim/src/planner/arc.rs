@@ -231,20 +231,25 @@ impl ArcPlanner {
         self.roadmap = Some(self.sampled_roadmap(vertices, deadline));
     }
 
-    /// A roadmap of `vertices` uniform samples (0: an empty one, for a query over
-    /// the lattice's head route alone).
+    /// A roadmap of `vertices` uniform samples.
     fn sampled_roadmap(&self, vertices: usize, deadline: Option<Instant>) -> Roadmap {
+        let r_t = self.settings.r_t * (self.settings.vertices as f64 / vertices as f64).cbrt();
+        self.roadmap_of(vertices, r_t, deadline)
+    }
+
+    /// An empty roadmap, for a query over the lattice's head route alone: it samples
+    /// nothing, so its radius only joins the query's start and goal when they lie
+    /// within `joins` of each other.
+    fn route_roadmap(&self, joins: f64) -> Roadmap {
+        self.roadmap_of(0, joins, None)
+    }
+
+    fn roadmap_of(&self, vertices: usize, r_t: f64, deadline: Option<Instant>) -> Roadmap {
         let mut rng = Pcg64::seed_from_u64(self.settings.seed);
         let weight = (
             self.settings.clearance_weight,
             self.ctx.params().reach() as f64 / 2.0,
         );
-        // An empty roadmap samples nothing to keep neighbours with: its radius only
-        // joins the query vertices to each other, as near as on the uniform roadmap.
-        let r_t = match vertices {
-            0 => self.settings.r_t,
-            n => self.settings.r_t * (self.settings.vertices as f64 / n as f64).cbrt(),
-        };
         let near = (r_t, self.settings.max_neighbours);
         Roadmap::build(&self.ctx, vertices, near, weight, &mut rng, deadline)
     }
@@ -402,10 +407,12 @@ impl ArcPlanner {
 
     /// The online construction along the lattice's head route in `built` alone (no
     /// sampled vertices): `Ok(None)` when there is no route or the chain cannot
-    /// follow it. Where the head's route itself keeps the preferred clearance, the
-    /// chain may not give way below it (the uniform roadmap may hold a route on which
-    /// the whole chain keeps it): the construction ends at the first edge that asks,
-    /// rather than flying the rest of the route for a plan that would be refused.
+    /// follow it. Where the route bends, the straight edge from start to goal is tried
+    /// first, without random shapes; then the route's edges. Where the head's route
+    /// itself keeps the preferred clearance, the chain may not give way below it (the
+    /// uniform roadmap may hold a route on which the whole chain keeps it): the
+    /// construction ends at the first edge that asks, rather than flying the rest of
+    /// the route for a plan that would be refused.
     fn solve_on_route(
         &self,
         query: &Query,
@@ -416,19 +423,24 @@ impl ArcPlanner {
         let Some(route) = &built.route else {
             return Ok(None);
         };
-        let mut roadmap = self.sampled_roadmap(0, stop.deadline(began));
         let inner = &route.points[1..route.points.len() - 1];
-        let mut construction =
-            Construction::new(self, &mut roadmap, query, Some(inner), stop, began)
-                .without_replans();
-        if route.narrowest_margin >= self.ctx.clearance_margin() {
-            construction = construction.without_giving_way();
+        let keeps_clearance = route.narrowest_margin >= self.ctx.clearance_margin();
+        // Where the route bends, the straight edge from start to goal may still pass
+        // the head's lazy check (the route was pulled taut by a more conservative
+        // one): flown whole, or by a follower, it is the shorter plan. It is tried
+        // without random shapes, whose search for one long edge the route bends away
+        // from costs more than the route.
+        if !inner.is_empty() {
+            let mut straight = self.route_roadmap(f64::INFINITY);
+            let construction = Construction::new(self, &mut straight, query, None, stop, began)
+                .without_random_shapes();
+            if let Some(solved) = flown_alone(construction, keeps_clearance)? {
+                return Ok(Some(solved));
+            }
         }
-        match construction.run() {
-            Ok(solved) => Ok(Some(solved)),
-            Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. }) => Ok(None),
-            Err(e) => Err(e),
-        }
+        let mut roadmap = self.route_roadmap(self.settings.r_t);
+        let construction = Construction::new(self, &mut roadmap, query, Some(inner), stop, began);
+        flown_alone(construction, keeps_clearance)
     }
 
     /// The chain following its head along the route in `built`, straightened through
@@ -637,6 +649,24 @@ impl ArcPlanner {
     }
 }
 
+/// `construction` run without replans (over a lone route there is none to replan
+/// onto), without giving way where the route `keeps_clearance`: `Ok(None)` where no
+/// shape flies an edge.
+fn flown_alone(
+    construction: Construction<'_>,
+    keeps_clearance: bool,
+) -> Result<Option<(Vec<Step>, Stats)>, PlanError> {
+    let mut construction = construction.without_replans();
+    if keeps_clearance {
+        construction = construction.without_giving_way();
+    }
+    match construction.run() {
+        Ok(solved) => Ok(Some(solved)),
+        Err(PlanError::NoShape { .. } | PlanError::Unreachable { .. }) => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
 /// What a query built and searched before its construction, timed apart.
 #[derive(Default)]
 struct Built {
@@ -747,10 +777,11 @@ mod tests {
     use crate::problem::scenarios;
     use crate::tables::TableSettings;
 
-    /// The route-only roadmap (nothing sampled) joins its query vertices as the
-    /// uniform one does, within `r_T`: a start and a goal farther apart are joined only
-    /// by the head route the query adds, so the construction flies the route rather
-    /// than a straight edge to the goal that the route bends away from.
+    /// The roadmap the route's edges are flown on (nothing sampled) joins start and
+    /// goal as the uniform one does, within `r_T`: farther apart, they are joined only
+    /// by the head route the query adds, so a straight edge to the goal that no shape
+    /// flies cannot end the attempt before the route's own edges are tried (it took
+    /// the uniform roadmap's radius scaled to one vertex, 17 m).
     #[test]
     fn an_empty_roadmap_joins_query_vertices_only_within_r_t() {
         let sc = scenarios::build("window").unwrap();
@@ -764,7 +795,7 @@ mod tests {
         let ctx = CollisionContext::new(field, params, DEFAULT_CLEARANCE).unwrap();
         let planner = ArcPlanner::new(ctx, tables, Settings::default()).unwrap();
         let r_t = planner.settings.r_t;
-        let mut roadmap = planner.sampled_roadmap(0, None);
+        let mut roadmap = planner.route_roadmap(r_t);
         let start = roadmap.add_query_vertex([2.0, 1.0, 1.5]);
         let far = roadmap.add_query_vertex([2.0, 1.0 + 2.0 * r_t, 1.5]);
         let near = roadmap.add_query_vertex([2.0, 1.0 + 0.5 * r_t, 1.5]);

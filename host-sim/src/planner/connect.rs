@@ -84,6 +84,9 @@ impl Construction<'_> {
                 return Some(legs);
             }
         }
+        if !self.random_shapes {
+            return None;
+        }
         self.connect_srs(a, b)
             .map(|changes| vec![Leg { changes, to: b }])
     }

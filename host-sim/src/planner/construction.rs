@@ -61,6 +61,9 @@ pub(super) struct Construction<'p> {
     /// Whether an edge of the head route may be flown below the preferred clearance
     /// where it fails at it ([`Self::connect`]).
     pub(super) may_give_way: bool,
+    /// Whether an edge no kept, turned, library or follower shape flies may ask
+    /// SRSConnect (d).
+    pub(super) random_shapes: bool,
     /// The margin the start's units keep, rounded down to a millimetre, where it is
     /// below the preferred clearance: an edge leaving the start may keep only that.
     start_margin: Option<f64>,
@@ -112,6 +115,7 @@ impl<'p> Construction<'p> {
             relaxed: Vec::new(),
             max_replans: planner.settings.max_replans,
             may_give_way: true,
+            random_shapes: true,
             srs_memo: Default::default(),
             start_margin: start_margin(&planner.ctx, start, &shape),
         }
@@ -129,6 +133,13 @@ impl<'p> Construction<'p> {
     /// preferred clearance instead of giving way on it.
     pub(super) fn without_giving_way(mut self) -> Self {
         self.may_give_way = false;
+        self
+    }
+
+    /// This construction without SRSConnect: an edge that no kept, turned, library
+    /// or follower shape flies fails.
+    pub(super) fn without_random_shapes(mut self) -> Self {
+        self.random_shapes = false;
         self
     }
 
