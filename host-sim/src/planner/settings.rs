@@ -68,7 +68,8 @@ pub struct Settings {
     /// More: the uniform roadmap finds ways through more of the map, for setup time and
     /// memory (the lattice route comes first and needs none).
     pub vertices: usize,
-    /// Head roadmap connection radius `r_T` (m).
+    /// Head roadmap connection radius `r_T` (m); on the quick route's own roadmap,
+    /// how near start and goal must lie to be joined straight beside the route.
     /// Larger: longer head edges and more neighbours, for more checks per edge.
     pub r_t: f64,
     /// Most neighbours a vertex takes (the nearest within `r_T`).
