@@ -73,6 +73,9 @@ pub struct OnlinePlanner {
     keep_maps: bool,
     records: Vec<ReplanRecord>,
     looked_at_hull: bool,
+    /// The route direction the chain last turned to look along from where it rests
+    /// (`None` once it moves, or after a look at its hull).
+    looked_along: Option<f32>,
     searches: usize,
     committed: Reference,
     effective: f64,
@@ -139,6 +142,7 @@ impl OnlinePlanner {
             keep_maps: false,
             records: Vec::new(),
             looked_at_hull: false,
+            looked_along: None,
             searches: 0,
             committed,
             effective: 0.0,
@@ -521,6 +525,7 @@ impl OnlinePlanner {
                 let m = piece.trajectory.head_path_m();
                 self.push(piece);
                 self.looked_at_hull = false;
+                self.looked_along = None;
                 self.reached = final_piece;
                 // The route goes on from where the piece ended (within a voxel of
                 // route point `k`).
@@ -649,14 +654,51 @@ impl OnlinePlanner {
         d.abs() > self.sensor.fov_h_deg.to_radians() / 4.0
     }
 
-    /// Commits a turn in place of the head yaw toward the route, when the route leaves
-    /// the sensors' view. A head yaw moves no body, so the turn is always valid.
+    /// Commits a turn in place of the head yaw to look along the route
+    /// ([`Self::look_from_rest`]), when the route leaves the sensors' middle view. A
+    /// head yaw moves no body, so the turn is always valid. Once turned, the chain looks
+    /// again from the same rest only when the route has moved out of the middle of the
+    /// view it looked along.
     fn turn_to_look(&mut self, route: &Route) -> bool {
-        let look = self.look_yaw(route, 0);
-        if !self.turn_needed(self.end[3] as f32, look) {
+        let (along, to) = self.look_from_rest(route);
+        let from = self.looked_along.unwrap_or(self.end[3] as f32);
+        if !self.turn_needed(from, along) || !self.commit_turn(to, TURN_TO_LOOK) {
             return false;
         }
-        self.commit_turn(look, TURN_TO_LOOK)
+        self.looked_along = Some(along);
+        true
+    }
+
+    /// How a chain resting at the committed end looks along `route`: the route's
+    /// direction toward the point one chain length ahead (the stretch its body flies
+    /// into first; a link length at least), and the head yaw to turn to, that direction
+    /// turned a quarter of the horizontal view toward the side of the route the chain's
+    /// body lies on. The route stays in the middle half of the view, and the sensors see
+    /// the side the tail swings through as the head moves on, which a piece planned now
+    /// needs free (sensors look along the head yaw, so the body's side is the one a look
+    /// straight along the route leaves unseen).
+    fn look_from_rest(&self, route: &Route) -> (f32, f32) {
+        let l = self.params.link_length as f64;
+        let chain = l * (self.params.n() - 1) as f64;
+        let from = route.points[0];
+        let d = route.point_after(0, chain.max(l)) - from;
+        if d.xy().norm() < 1e-9 {
+            let yaw = self.end[3] as f32;
+            return (yaw, yaw);
+        }
+        let along = d.y.atan2(d.x);
+        let centres = unit_centres(&self.params, &self.end);
+        let body = centres
+            .iter()
+            .map(|c| c.coords)
+            .sum::<nalgebra::Vector3<f64>>()
+            / centres.len() as f64
+            - head(&self.end).coords;
+        // The sine of the angle from the route to the body: +-1 for a body across the
+        // route, 0 for one trailing straight behind the head (or lying ahead).
+        let across = (d.x * body.y - d.y * body.x) / (d.xy().norm() * body.xy().norm()).max(1e-9);
+        let quarter = self.sensor.fov_h_deg.to_radians() / 4.0;
+        (along as f32, (along + across * quarter) as f32)
     }
 
     /// Commits a turn of the head yaw toward where the units' sensors see most of the
@@ -671,7 +713,12 @@ impl OnlinePlanner {
         let Some(yaw) = look::best_view(&self.sensor, &centres, self.end[3], &unseen) else {
             return false;
         };
-        self.commit_turn(yaw as f32, LOOK_AT_HULL)
+        // Turned away from the route: the next look along it is judged from here.
+        let turned = self.commit_turn(yaw as f32, LOOK_AT_HULL);
+        if turned {
+            self.looked_along = None;
+        }
+        turned
     }
 
     /// Commits a turn of the head yaw to `yaw` in place (a head yaw moves no body, so
@@ -832,17 +879,19 @@ mod tests {
     use super::*;
     use crate::map::Cell;
     use crate::online::tests::chain;
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
-    /// A planner for a chain of 3 units in a 4 x 2 x 2 m box at 0.1 m, seen free but
-    /// for one occupied voxel centred at (2.05, 1.05, 1.05) and one unseen voxel centred
-    /// at (3.05, 1.05, 1.05).
-    fn planner() -> OnlinePlanner {
+    /// A planner for a straight chain of 3 units, its head at (`x`, 1.05, 1.05) and its
+    /// body trailing along -x, in a 4 x 2 x 2 m box at 0.1 m, seen free but for one
+    /// occupied voxel centred at (2.05, 1.05, 1.05) and one unseen voxel centred at
+    /// (3.05, 1.05, 1.05).
+    fn planner_at(x: f64) -> OnlinePlanner {
         let (params, tables) = chain(3);
         let bounds = Grid::new(0.1, [0, 0, 0], [40, 20, 20], Cell::Free, true).unwrap();
         let mut prior = bounds.clone();
         prior.set([20, 10, 10], Cell::Occupied);
         prior.set([30, 10, 10], Cell::Unknown);
-        let start = crate::plan_file::Waypoint::new([1.05, 1.05, 1.05], &Shape::line(3, 0.0)).zeta;
+        let start = crate::plan_file::Waypoint::new([x, 1.05, 1.05], &Shape::line(3, 0.0)).zeta;
         let goal = Point3::new(3.55, 1.05, 1.05);
         OnlinePlanner::new(
             params,
@@ -860,7 +909,7 @@ mod tests {
 
     #[test]
     fn a_route_point_beside_a_seen_wall_is_known_and_one_beside_unseen_space_is_not() {
-        let p = planner();
+        let p = planner_at(1.05);
         // Both keep 0.15 m to a voxel's face, less than the route radius (0.2 m).
         let by_wall = Point3::new(2.25, 1.05, 1.05);
         let by_unseen = Point3::new(3.25, 1.05, 1.05);
@@ -871,5 +920,63 @@ mod tests {
         assert!(p.known(&by_wall), "a narrow place seen whole");
         assert!(!p.known(&by_unseen), "unseen space within the route radius");
         assert!(p.known(&Point3::new(1.55, 0.45, 1.05)), "room to spare");
+    }
+
+    /// A route from the head's voxel at (1.55, 1.05, 1.05) at `deg` degrees, 0.8 m long.
+    fn route_at(deg: f64) -> Route {
+        let (s, c) = deg.to_radians().sin_cos();
+        let points = (0..=8)
+            .map(|i| Point3::new(1.55 + 0.1 * i as f64 * c, 1.05 + 0.1 * i as f64 * s, 1.05))
+            .collect();
+        Route {
+            points,
+            radius: 0.2,
+        }
+    }
+
+    #[test]
+    fn a_look_from_rest_turns_toward_the_side_the_body_lies_on() {
+        let p = planner_at(1.55);
+        let quarter = DepthSensor::default().fov_h_deg.to_radians() / 4.0;
+        let close = |a: f32, b: f64| (a as f64 - b).abs() < 1e-6;
+        // The straight chain trails behind its head along -x.
+        let (along, to) = p.look_from_rest(&route_at(0.0));
+        assert!(
+            close(along, 0.0) && close(to, 0.0),
+            "{along} {to}: straight behind"
+        );
+        // Across a route to the left (+y) the body lies on its left, behind a route to
+        // the right on its right: the look turns a quarter of the view toward it.
+        let (along, to) = p.look_from_rest(&route_at(90.0));
+        assert!(
+            close(along, FRAC_PI_2) && close(to, FRAC_PI_2 + quarter),
+            "{along} {to}"
+        );
+        let (along, to) = p.look_from_rest(&route_at(-90.0));
+        assert!(
+            close(along, -FRAC_PI_2) && close(to, -FRAC_PI_2 - quarter),
+            "{along} {to}"
+        );
+        // Half across (45 degrees): half the turn, by the sine.
+        let (_, to) = p.look_from_rest(&route_at(45.0));
+        assert!(close(to, FRAC_PI_4 + quarter * FRAC_PI_4.sin()), "{to}");
+    }
+
+    #[test]
+    fn a_chain_that_looked_looks_again_only_when_the_route_leaves_the_view_it_looked_along() {
+        let mut p = planner_at(1.55);
+        assert!(
+            !p.turn_to_look(&route_at(10.0)),
+            "in the middle of the view"
+        );
+        assert!(p.turn_to_look(&route_at(90.0)));
+        assert_eq!(p.pieces().len(), 1);
+        // Turned past the route toward the body, it is still in the middle of the view
+        // looked along, also when the route moves a little.
+        assert!(!p.turn_to_look(&route_at(90.0)));
+        assert!(!p.turn_to_look(&route_at(80.0)));
+        assert_eq!(p.pieces().len(), 1);
+        assert!(p.turn_to_look(&route_at(150.0)), "out of that view");
+        assert_eq!(p.pieces().len(), 2);
     }
 }
