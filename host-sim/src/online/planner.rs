@@ -672,9 +672,11 @@ impl OnlinePlanner {
     /// How a chain resting at the committed end looks along `route`: the route's
     /// direction toward the point one chain length ahead (the stretch its body flies
     /// into first; a link length at least), and the head yaw to turn to, that direction
-    /// turned a quarter of the horizontal view toward the side of the route the chain's
-    /// body lies on. The route stays in the middle half of the view, and the sensors see
-    /// the side the tail swings through as the head moves on, which a piece planned now
+    /// turned toward the side of the route the chain's body lies on by a quarter of the
+    /// horizontal view times the sine of the angle from the route to the body (the
+    /// whole quarter for a body across the route, none for one trailing straight
+    /// behind). The route stays in the middle half of the view, and the sensors see the
+    /// side the tail swings through as the head moves on, which a piece planned now
     /// needs free (sensors look along the head yaw, so the body's side is the one a look
     /// straight along the route leaves unseen).
     fn look_from_rest(&self, route: &Route) -> (f32, f32) {
