@@ -578,13 +578,9 @@ impl OnlinePlanner {
     /// one sensor reach ahead (a link length at least).
     fn look_yaw(&self, route: &Route, k: usize) -> f32 {
         let ahead = (self.params.link_length as f64).max(1.0);
-        let from = route.points[k];
-        let to = route.point_after(k, ahead);
-        let d = to - from;
-        if d.xy().norm() < 1e-9 {
-            return self.end[3] as f32;
-        }
-        d.y.atan2(d.x) as f32
+        route
+            .heading(k, ahead)
+            .map_or(self.end[3] as f32, |yaw| yaw as f32)
     }
 
     /// Plans a piece from the committed end to within `tol` of `goal`, on the map with
@@ -682,13 +678,10 @@ impl OnlinePlanner {
     fn look_from_rest(&self, route: &Route) -> (f32, f32) {
         let l = self.params.link_length as f64;
         let chain = l * (self.params.n() - 1) as f64;
-        let from = route.points[0];
-        let d = route.point_after(0, chain.max(l)) - from;
-        if d.xy().norm() < 1e-9 {
+        let Some(along) = route.heading(0, chain.max(l)) else {
             let yaw = self.end[3] as f32;
             return (yaw, yaw);
-        }
-        let along = d.y.atan2(d.x);
+        };
         let centres = unit_centres(&self.params, &self.end);
         let body = centres
             .iter()
@@ -698,7 +691,8 @@ impl OnlinePlanner {
             - head(&self.end).coords;
         // The sine of the angle from the route to the body: +-1 for a body across the
         // route, 0 for one trailing straight behind the head (or lying ahead).
-        let across = (d.x * body.y - d.y * body.x) / (d.xy().norm() * body.xy().norm()).max(1e-9);
+        let (sin, cos) = along.sin_cos();
+        let across = (cos * body.y - sin * body.x) / body.xy().norm().max(1e-9);
         let quarter = self.sensor.fov_h_deg.to_radians() / 4.0;
         (along as f32, (along + across * quarter) as f32)
     }

@@ -72,6 +72,15 @@ impl Route {
         }
         *self.points.last().expect("a route has points")
     }
+
+    /// The horizontal direction (rad, from +x) from point `from` toward the point
+    /// `ahead` metres along the route ([`Self::point_after`]); `None` where that is
+    /// straight up or down, or the same point.
+    pub fn heading(&self, from: usize, ahead: f64) -> Option<f64> {
+        let d = self.point_after(from, ahead) - self.points[from.min(self.points.len() - 1)];
+        // A floating-point guard, not tuning: below it the two points are one.
+        (d.xy().norm() >= 1e-9).then(|| d.y.atan2(d.x))
+    }
 }
 
 /// What a search found.
