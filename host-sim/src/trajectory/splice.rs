@@ -9,15 +9,18 @@
 //! length `R` that changes the velocity from `a`'s cruise to `b`'s within the limits
 //! (`super::build`'s rule), and `b` starts `R` before `a` ends. `a` is in flight, so its
 //! cruise rate stays and its ramps must fit (`r (U + W) / 2 <= 1`) as they are; `b`'s
-//! rate is lowered until its ramps fit too, when `b` ends at rest (nothing after it
-//! depends on its rate), but never so far that `b` would end later than after a stop
-//! at the joint. Up to the time where either `a`'s old or its new ramp down begins,
+//! rate is lowered until its ramps fit too. Where `b` blends into the piece's next
+//! segment `c`, their corner is timed again for `b`'s new rate, and `c`, whose cruise
+//! rate stays (so nothing after it changes), must fit the new ramp up. Never so far
+//! that the segments timed anew would end later than after a stop at the joint. Up
+//! to the time where either `a`'s old or its new ramp down begins,
 //! the joined motion is the committed one, so it can replace it while the chain flies
 //! there ([`Joint::take_by`]). From then until the piece's motion is timed as its own
 //! again ([`Joint::until`]) it is new: those samples are checked exactly on the map
 //! given (the online planner's: unknown space occupied), and wherever the motion
-//! leaves both pieces' paths (the overlap) every body keeps the trajectory settings'
-//! clearance from the map, or what the two motions keep there where that is less, as a
+//! leaves both pieces' paths (the overlaps: at the joint, and at `b`'s corner with `c`
+//! where that was timed again) every body keeps the trajectory settings' clearance
+//! from the map, or what the motions there keep on their own where that is less, as a
 //! blend of one plan does.
 
 use aerial_chain_core::ChainParams;
@@ -44,13 +47,15 @@ pub struct Joint {
     /// then the two are the same motion.
     pub take_by: f64,
     /// When the joined motion is the piece's own again, shifted in time: the later end
-    /// of the piece's first ramp up as joined and as timed alone, or the end of its
-    /// first motion where that was slowed down. From `take_by` to here the motion is
-    /// new, and checked ([`check_joint`]).
+    /// of the ramp up of the last of the piece's motions timed anew (its first, or the
+    /// next where their corner was timed again) as joined and as timed alone, or the
+    /// end of its first motion where that was slowed down and ends at rest. From
+    /// `take_by` to here the motion is new, and checked ([`check_joint`]).
     pub until: f64,
     /// When the joined motion leaves both pieces' paths and when it is back on the
-    /// piece's: the blend of the corner at the joint, where every body keeps the
-    /// trajectory's clearance.
+    /// piece's: the blend of the corner at the joint (through the piece's first corner
+    /// where that was timed again), where every body keeps the trajectory's
+    /// clearance.
     pub blend: (f64, f64),
 }
 
@@ -81,8 +86,9 @@ pub enum NoSplice {
         /// The earliest it can (s).
         not_before: f64,
     },
-    /// The joined motion would reach the end of the piece's first motion later than a
-    /// stop at the joint would (the piece's first motion slowed down too much to fit).
+    /// The joined motion would reach the end of the piece's motions timed anew (its
+    /// first, and the next where their corner was timed again) later than a stop at
+    /// the joint would (the piece's first motion slowed down too much to fit).
     #[error("the joined motion is slower than a stop at the joint")]
     Slower,
     /// The joined motion fails the exact check or the blend's clearance.
@@ -121,8 +127,9 @@ pub fn splice(
     if !same_configuration(&b.from, current.end()) {
         return Err(NoSplice::Elsewhere);
     }
-    let (sa, sb) = (&a.scaling, &b.scaling);
-    let (rate, ramp) = fit(a, b, next, settings).ok_or(NoSplice::RampsDoNotFit)?;
+    let sa = &a.scaling;
+    let fitted = fit(a, b, next, settings).ok_or(NoSplice::RampsDoNotFit)?;
+    let ramp = fitted.ramp;
     // The cruise of `a` ends where its ramp down begins: the old one or the new one.
     let take_by = a.t0 + 1.0 / sa.rate + (sa.ramp - sa.ramp_down.max(ramp)) / 2.0;
     if take_by < not_before {
@@ -133,29 +140,33 @@ pub fn splice(
     }
     let a_new = retimed(a, a.t0, Scaling::with_ramps(sa.rate, sa.ramp, ramp));
     let a_end = a_new.t0 + a_new.duration;
-    let b_new = retimed(
-        b,
-        a_end - ramp,
-        Scaling::with_ramps(rate, ramp, sb.ramp_down),
-    );
-    // Stopping at the joint, `b` would end no earlier than this.
-    let stopped_end = current.duration() + b.duration;
-    if b_new.t0 + b_new.duration > stopped_end {
+    let new = timed_anew(next, a_end, &fitted);
+    let (old, last) = (&next.segments()[new.len() - 1], &new[new.len() - 1]);
+    let (old_end, last_end) = (old.t0 + old.duration, last.t0 + last.duration);
+    // Stopping at the joint, the segments timed anew would end no earlier than this.
+    if last_end > current.duration() + old_end {
         return Err(NoSplice::Slower);
     }
-    // The piece's later segments keep their times relative to the end of `b`.
-    let shift = (b_new.t0 + b_new.duration) - (b.t0 + b.duration);
+    // The piece's later segments keep their times relative to the end of the last
+    // one timed anew, which is timed as in the piece (shifted) once both its ramps up
+    // are over; where it cruises slower than in the piece, only after its end.
+    let shift = last_end - old_end;
+    let new_to = match last.scaling.rate < old.scaling.rate {
+        true => last_end,
+        false => (last.t0 + last.scaling.ramp).max(shift + old.t0 + old.scaling.ramp),
+    };
+    // Where the motion leaves both pieces' paths: the joint's corner, and `b`'s
+    // corner with the next segment where that was timed anew.
+    let b_new = &new[0];
+    let blend = match fitted.then {
+        None => (b_new.t0, a_end),
+        Some(_) => (b_new.t0, b_new.t0 + b_new.duration),
+    };
+    let count = new.len();
     let mut joined: Vec<Segment> = segments[..segments.len() - 1].to_vec();
     joined.push(a_new);
-    // `b` is timed as in the piece (shifted) once both its ramps up are over; where
-    // it cruises slower than after a stop, only after its end.
-    let new_to = match rate < sb.rate {
-        true => b_new.t0 + b_new.duration,
-        false => (b_new.t0 + ramp).max(shift + sb.ramp),
-    };
-    let blend = (b_new.t0, a_end);
-    joined.push(b_new);
-    joined.extend(next.segments()[1..].iter().cloned().map(|mut s| {
+    joined.extend(new);
+    joined.extend(next.segments()[count..].iter().cloned().map(|mut s| {
         s.t0 += shift;
         s
     }));
@@ -170,27 +181,67 @@ pub fn splice(
     Ok(Splice { reference, joint })
 }
 
+/// The piece `next`'s first segments timed anew for a joint whose ramp ends at
+/// `a_end` (s) as `fit` has it: its first segment `b` at the fitted rate, starting the
+/// joint's ramp before `a_end`; and where `b`'s corner with the next segment was timed
+/// again, that segment too, its cruise kept and its ramp up the corner's new one.
+fn timed_anew(next: &Reference, a_end: f64, fit: &Fit) -> Vec<Segment> {
+    let b = &next.segments()[0];
+    let down = fit.then.unwrap_or(b.scaling.ramp_down);
+    let scaling = Scaling::with_ramps(fit.rate, fit.ramp, down);
+    let b_new = retimed(b, a_end - fit.ramp, scaling);
+    let b_end = b_new.t0 + b_new.duration;
+    let mut new = vec![b_new];
+    if let Some(up) = fit.then {
+        let c = &next.segments()[1];
+        let scaling = Scaling::with_ramps(c.scaling.rate, up, c.scaling.ramp_down);
+        new.push(retimed(c, b_end - up, scaling));
+    }
+    new
+}
+
+/// How a joint fits: `b`'s cruise rate, the joint's ramp, and where `b` was slowed
+/// and blends into the piece's next motion, the ramp of that corner timed anew.
+struct Fit {
+    rate: f64,
+    ramp: f64,
+    then: Option<f64>,
+}
+
 /// The cruise rate of `b` and the joint's ramp: the ramp that changes the velocity
 /// from `a`'s cruise to `b`'s within the limits, `b`'s rate lowered until both
 /// segments' ramps fit (as `super::build` fits a plan's), in at most
-/// `settings.fit_rounds` rounds. `b`'s rate is lowered only when `b` ends at rest, so
-/// that nothing after it depends on it; `None` when they do not fit.
-fn fit(a: &Segment, b: &Segment, next: &Reference, settings: &Settings) -> Option<(f64, f64)> {
+/// `settings.fit_rounds` rounds. Where `b` blends into the piece's next motion `c`,
+/// slowing `b` changes that corner too: its ramp is taken again for `b`'s new rate,
+/// and it must fit `c` at `c`'s own rate, so that nothing after `c` changes. `None`
+/// when they do not fit.
+fn fit(a: &Segment, b: &Segment, next: &Reference, settings: &Settings) -> Option<Fit> {
     let (sa, sb) = (&a.scaling, &b.scaling);
     let b_end = b.t0 + b.duration;
-    let b_rests = next.segments().get(1).is_none_or(|c| c.t0 >= b_end);
+    let c = next.segments().get(1).filter(|c| c.t0 < b_end);
+    let lim = &settings.limits;
+    let change = |from: (&Segment, f64), to: (&Segment, f64)| -> Vec<f64> {
+        (from.0.delta.iter().zip(&to.0.delta))
+            .map(|(df, dt)| to.1 * dt - from.1 * df)
+            .collect()
+    };
     let mut rate = sb.rate;
     for _ in 0..settings.fit_rounds {
-        let change: Vec<f64> = (a.delta.iter().zip(&b.delta))
-            .map(|(da, db)| rate * db - sa.rate * da)
-            .collect();
-        let ramp = ramp_length(&settings.limits, &change);
-        let excess = (sa.rate * (sa.ramp + ramp) / 2.0).max(rate * (ramp + sb.ramp_down) / 2.0);
+        let ramp = ramp_length(lim, &change((a, sa.rate), (b, rate)));
+        // `b`'s corner with `c` as the piece timed it, or again for a slowed `b`.
+        let then = c
+            .filter(|_| rate < sb.rate)
+            .map(|c| ramp_length(lim, &change((b, rate), (c, c.scaling.rate))));
+        let down = then.unwrap_or(sb.ramp_down);
+        let c_excess = match (c, then) {
+            (Some(c), Some(up)) => c.scaling.rate * (up + c.scaling.ramp_down) / 2.0,
+            _ => 0.0,
+        };
+        let excess = (sa.rate * (sa.ramp + ramp) / 2.0)
+            .max(rate * (ramp + down) / 2.0)
+            .max(c_excess);
         if excess <= 1.0 {
-            return Some((rate, ramp));
-        }
-        if !b_rests {
-            return None;
+            return Some(Fit { rate, ramp, then });
         }
         rate /= excess.sqrt() * FIT_UNDERSHOOT;
     }

@@ -166,12 +166,56 @@ fn the_rest_of_a_piece_is_flown_as_timed_after_its_joint() {
     let n = ((b.reference().duration() - own_from) / s.dt) as usize;
     for k in 0..=n {
         let t = own_from + k as f64 * s.dt;
-        let (x, y) = (b.reference().zeta(t), j.reference.zeta(t + shift));
-        let d = x
-            .iter()
-            .zip(&y)
-            .map(|(p, q)| (p - q).abs())
-            .fold(0.0, f64::max);
+        let d = max_difference(&b.reference().zeta(t), &j.reference.zeta(t + shift));
+        assert!(d < 1e-9, "the piece's motion differs by {d} at {t} s of it");
+    }
+    assert_joined_respects_limits(&grid, &params, &s, &j.reference);
+}
+
+/// The largest difference of any coordinate of `x` and `y`.
+fn max_difference(x: &[f64], y: &[f64]) -> f64 {
+    x.iter()
+        .zip(y)
+        .map(|(p, q)| (p - q).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_short_first_motion_that_blends_into_the_next_is_slowed_and_that_corner_timed_anew() {
+    let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
+    // 0.2 m across, then on along x: at its own cruise the first motion cannot take
+    // the joint's ramp, and it blends into the next, whose rate stays.
+    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.5, 1.0, 1.0]);
+    let b = path(
+        &params,
+        &grid,
+        &[[2.5, 1.0, 1.0], [2.5, 1.2, 1.0], [3.5, 1.2, 1.0]],
+    );
+    let own = b.reference().segments();
+    assert_eq!(own.len(), 2, "two motions");
+    assert!(own[1].t0 < own[0].duration, "blended in the piece");
+    let j = splice(a.reference(), b.reference(), &params, &grid, &s, 0.0).unwrap();
+    let joined = j.reference.segments();
+    let (jb, jc) = (&joined[joined.len() - 2], &joined[joined.len() - 1]);
+    assert!(
+        jb.scaling.rate < own[0].scaling.rate,
+        "the first motion slowed"
+    );
+    assert_eq!(
+        jc.scaling.rate, own[1].scaling.rate,
+        "the next one's cruise kept"
+    );
+    assert!(jc.t0 < jb.t0 + jb.duration, "and still blended");
+    // Both corners lie within the blend, where the bodies keep the clearance.
+    assert_eq!(j.joint.blend, (jb.t0, jb.t0 + jb.duration));
+    let stopped = a.reference().duration() + b.reference().duration();
+    assert!(j.reference.duration() < stopped, "a stop saved");
+    // From `until` on, the piece's own motion, shifted.
+    let shift = j.reference.duration() - b.reference().duration();
+    let n = ((b.reference().duration() - (j.joint.until - shift)) / s.dt) as usize;
+    for k in 0..=n {
+        let t = j.joint.until - shift + k as f64 * s.dt;
+        let d = max_difference(&b.reference().zeta(t), &j.reference.zeta(t + shift));
         assert!(d < 1e-9, "the piece's motion differs by {d} at {t} s of it");
     }
     assert_joined_respects_limits(&grid, &params, &s, &j.reference);
@@ -180,14 +224,16 @@ fn the_rest_of_a_piece_is_flown_as_timed_after_its_joint() {
 #[test]
 fn a_joint_whose_ramps_cannot_fit_or_that_would_be_slower_is_refused() {
     let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
-    // The piece's first motion, 0.2 m, blends into its next, so it cannot be slowed:
-    // the joint's ramp does not fit it.
+    // The piece's first motion, 0.3 m, blends into a next one that goes on almost
+    // straight: slowed to take the joint's ramp, it would leave that next motion a
+    // ramp up nearly from rest, which does not fit it at its own rate.
     let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.5, 1.0, 1.0]);
     let b = path(
         &params,
         &grid,
-        &[[2.5, 1.0, 1.0], [2.5, 1.2, 1.0], [3.5, 1.2, 1.0]],
+        &[[2.5, 1.0, 1.0], [2.5, 1.3, 1.0], [2.55, 1.6, 1.0]],
     );
+    assert_eq!(b.reference().segments().len(), 2, "two motions");
     let no_fit = splice(a.reference(), b.reference(), &params, &grid, &s, 0.0);
     assert_eq!(no_fit.unwrap_err(), NoSplice::RampsDoNotFit);
     // Turning straight back for 2.3 m: the joint's ramp fits the motion before it only
