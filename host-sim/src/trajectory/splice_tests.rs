@@ -29,6 +29,13 @@ fn straight_on(params: &ChainParams, grid: &Grid) -> (Trajectory, Trajectory) {
     )
 }
 
+/// A metre along x from [1.5, 1, 1], then a piece through the heads `heads` from its
+/// end.
+fn a_metre_then(params: &ChainParams, grid: &Grid, heads: &[[f64; 3]]) -> (Trajectory, Trajectory) {
+    let a = piece(params, grid, [1.5, 1.0, 1.0], [2.5, 1.0, 1.0]);
+    (a, path(params, grid, heads))
+}
+
 /// Every limit of `s` and the map of `grid` kept by `r` at its samples every `s.dt`
 /// (the trajectory's own sampling), by the tests' own reading of the limits.
 fn assert_joined_respects_limits(grid: &Grid, params: &ChainParams, s: &Settings, r: &Reference) {
@@ -149,8 +156,7 @@ fn joins_that_cannot_be_made_are_refused_by_name() {
 #[test]
 fn the_rest_of_a_piece_is_flown_as_timed_after_its_joint() {
     let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
-    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.5, 1.0, 1.0]);
-    let b = path(
+    let (a, b) = a_metre_then(
         &params,
         &grid,
         &[[2.5, 1.0, 1.0], [3.0, 1.0, 1.0], [3.0, 2.0, 1.0]],
@@ -161,23 +167,26 @@ fn the_rest_of_a_piece_is_flown_as_timed_after_its_joint() {
     );
     let j = splice(a.reference(), b.reference(), &params, &grid, &s, 0.0).unwrap();
     // After the joint the piece's own motion, shifted by one time.
-    let shift = j.reference.duration() - b.reference().duration();
-    let own_from = j.joint.until - shift;
-    let n = ((b.reference().duration() - own_from) / s.dt) as usize;
-    for k in 0..=n {
-        let t = own_from + k as f64 * s.dt;
-        let d = max_difference(&b.reference().zeta(t), &j.reference.zeta(t + shift));
-        assert!(d < 1e-9, "the piece's motion differs by {d} at {t} s of it");
-    }
+    assert_own_motion_from_until(b.reference(), &j, s.dt);
     assert_joined_respects_limits(&grid, &params, &s, &j.reference);
 }
 
-/// The largest difference of any coordinate of `x` and `y`.
-fn max_difference(x: &[f64], y: &[f64]) -> f64 {
-    x.iter()
-        .zip(y)
-        .map(|(p, q)| (p - q).abs())
-        .fold(0.0, f64::max)
+/// From `j`'s `until` on, the joined motion is `piece`'s own shifted by one time, at
+/// every `dt`.
+fn assert_own_motion_from_until(piece: &Reference, j: &Splice, dt: f64) {
+    let shift = j.reference.duration() - piece.duration();
+    let own_from = j.joint.until - shift;
+    let n = ((piece.duration() - own_from) / dt) as usize;
+    for k in 0..=n {
+        let t = own_from + k as f64 * dt;
+        let (x, y) = (piece.zeta(t), j.reference.zeta(t + shift));
+        let d = x
+            .iter()
+            .zip(&y)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
+        assert!(d < 1e-9, "the piece's motion differs by {d} at {t} s of it");
+    }
 }
 
 #[test]
@@ -185,8 +194,7 @@ fn a_short_first_motion_that_blends_into_the_next_is_slowed_and_that_corner_time
     let (params, grid, s) = (ChainParams::new(3), room(), Settings::default());
     // 0.2 m across, then on along x: at its own cruise the first motion cannot take
     // the joint's ramp, and it blends into the next, whose rate stays.
-    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.5, 1.0, 1.0]);
-    let b = path(
+    let (a, b) = a_metre_then(
         &params,
         &grid,
         &[[2.5, 1.0, 1.0], [2.5, 1.2, 1.0], [3.5, 1.2, 1.0]],
@@ -211,13 +219,7 @@ fn a_short_first_motion_that_blends_into_the_next_is_slowed_and_that_corner_time
     let stopped = a.reference().duration() + b.reference().duration();
     assert!(j.reference.duration() < stopped, "a stop saved");
     // From `until` on, the piece's own motion, shifted.
-    let shift = j.reference.duration() - b.reference().duration();
-    let n = ((b.reference().duration() - (j.joint.until - shift)) / s.dt) as usize;
-    for k in 0..=n {
-        let t = j.joint.until - shift + k as f64 * s.dt;
-        let d = max_difference(&b.reference().zeta(t), &j.reference.zeta(t + shift));
-        assert!(d < 1e-9, "the piece's motion differs by {d} at {t} s of it");
-    }
+    assert_own_motion_from_until(b.reference(), &j, s.dt);
     assert_joined_respects_limits(&grid, &params, &s, &j.reference);
 }
 
@@ -227,8 +229,7 @@ fn a_joint_whose_ramps_cannot_fit_or_that_would_be_slower_is_refused() {
     // The piece's first motion, 0.3 m, blends into a next one that goes on almost
     // straight: slowed to take the joint's ramp, it would leave that next motion a
     // ramp up nearly from rest, which does not fit it at its own rate.
-    let a = piece(&params, &grid, [1.5, 1.0, 1.0], [2.5, 1.0, 1.0]);
-    let b = path(
+    let (a, b) = a_metre_then(
         &params,
         &grid,
         &[[2.5, 1.0, 1.0], [2.5, 1.3, 1.0], [2.55, 1.6, 1.0]],
