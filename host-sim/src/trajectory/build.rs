@@ -478,6 +478,19 @@ pub(super) fn ramp_length(limits: &super::Limits, change: &[f64]) -> f64 {
     RAMP_PEAK * (head / limits.accel).max(angles)
 }
 
+/// The length of a ramp that takes the chain from cruising along segment `from` at
+/// its rate to cruising along `to` at its (`None`: at rest) within `limits`.
+pub(super) fn ramp_between(
+    limits: &super::Limits,
+    from: Option<(&Segment, f64)>,
+    to: Option<(&Segment, f64)>,
+) -> f64 {
+    let v = |e: Option<(&Segment, f64)>, j: usize| e.map_or(0.0, |(s, r)| r * s.delta[j]);
+    let dim = from.or(to).map_or(0, |(s, _)| s.delta.len());
+    let change: Vec<f64> = (0..dim).map(|j| v(to, j) - v(from, j)).collect();
+    ramp_length(limits, &change)
+}
+
 /// What timing the edges needs.
 struct Timing<'a> {
     settings: &'a Settings,
@@ -489,10 +502,7 @@ impl Timing<'_> {
     /// The length of a ramp that takes the chain from cruising along `from` to
     /// cruising along `to` (`None`: at rest) within the acceleration limits.
     fn ramp(&self, from: Option<(&Segment, f64)>, to: Option<(&Segment, f64)>) -> f64 {
-        let v = |e: Option<(&Segment, f64)>, j: usize| e.map_or(0.0, |(s, r)| r * s.delta[j]);
-        let dim = self.edges.first().map_or(0, |e| e.delta.len());
-        let change: Vec<f64> = (0..dim).map(|j| v(to, j) - v(from, j)).collect();
-        ramp_length(&self.settings.limits, &change)
+        ramp_between(&self.settings.limits, from, to)
     }
 
     /// Ramps up and down of every edge at cruise rates `rates`.

@@ -25,7 +25,7 @@
 
 use aerial_chain_core::ChainParams;
 
-use super::build::{ramp_length, FIT_UNDERSHOOT};
+use super::build::{ramp_between, ramp_length, FIT_UNDERSHOOT};
 use super::check::{check_with_margin, move_clearance, Problem, Violation};
 use super::reference::{same_configuration, Reference, Scaling, Segment};
 use super::Settings;
@@ -220,18 +220,13 @@ fn fit(a: &Segment, b: &Segment, next: &Reference, settings: &Settings) -> Optio
     let b_end = b.t0 + b.duration;
     let c = next.segments().get(1).filter(|c| c.t0 < b_end);
     let lim = &settings.limits;
-    let change = |from: (&Segment, f64), to: (&Segment, f64)| -> Vec<f64> {
-        (from.0.delta.iter().zip(&to.0.delta))
-            .map(|(df, dt)| to.1 * dt - from.1 * df)
-            .collect()
-    };
     let mut rate = sb.rate;
     for _ in 0..settings.fit_rounds {
-        let ramp = ramp_length(lim, &change((a, sa.rate), (b, rate)));
+        let ramp = ramp_between(lim, Some((a, sa.rate)), Some((b, rate)));
         // `b`'s corner with `c` as the piece timed it, or again for a slowed `b`.
         let then = c
             .filter(|_| rate < sb.rate)
-            .map(|c| ramp_length(lim, &change((b, rate), (c, c.scaling.rate))));
+            .map(|c| ramp_between(lim, Some((b, rate)), Some((c, c.scaling.rate))));
         let down = then.unwrap_or(sb.ramp_down);
         let c_excess = match (c, then) {
             (Some(c), Some(up)) => c.scaling.rate * (up + c.scaling.ramp_down) / 2.0,
